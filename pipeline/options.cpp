@@ -1,0 +1,73 @@
+#include "pipeline/options.h"
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+
+namespace floesim {
+
+Check<double> positive() {
+  return [](const double& x) { return x > 0 && std::isfinite(x) ? "" : std::string("must be > 0"); };
+}
+Check<double> non_negative() {
+  return [](const double& x) { return x >= 0 && std::isfinite(x) ? "" : std::string("must be >= 0"); };
+}
+Check<double> in_range(double lo, double hi) {
+  return [lo, hi](const double& x) {
+    return x >= lo && x <= hi ? std::string()
+                              : "must be in [" + Json(lo).dump() + ", " + Json(hi).dump() + "]";
+  };
+}
+Check<int> positive_int() {
+  return [](const int& x) { return x > 0 ? "" : std::string("must be > 0"); };
+}
+Check<int> int_in_range(int lo, int hi) {
+  return [lo, hi](const int& x) {
+    return x >= lo && x <= hi ? std::string() : "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  };
+}
+Check<std::string> one_of(std::vector<std::string> choices) {
+  return [choices](const std::string& s) {
+    if (std::find(choices.begin(), choices.end(), s) != choices.end()) return std::string();
+    std::string m = "must be one of";
+    for (auto& c : choices) m += " \"" + c + "\"";
+    return m;
+  };
+}
+
+Json load_json_file(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw Error(file.string() + ": cannot open (does the file exist and is it readable?)");
+  try {
+    return Json::parse(in, nullptr, true, /*ignore_comments=*/true);
+  } catch (const Json::parse_error& e) {
+    throw Error(file.string() + ": not valid JSON: " + e.what());
+  }
+}
+
+OptionReader::OptionReader(const Json& j, std::string file, std::string path)
+    : OptionReader(j, std::move(file), std::move(path), std::make_shared<std::vector<std::string>>()) {}
+
+OptionReader::OptionReader(const Json& j, std::string file, std::string path,
+                           std::shared_ptr<std::vector<std::string>> p)
+    : j_(j), file_(std::move(file)), path_(std::move(path)), problems_(std::move(p)) {}
+
+void OptionReader::check_unknown() {
+  if (!j_.is_object()) return;
+  for (auto it = j_.begin(); it != j_.end(); ++it) {
+    if (std::find(seen_.begin(), seen_.end(), it.key()) != seen_.end()) continue;
+    std::string known;
+    for (auto& s : seen_) known += (known.empty() ? "" : ", ") + s;
+    problems_->push_back(where(it.key()) + " is not a known key (a typo?); known keys here: " + known);
+  }
+}
+
+void OptionReader::finish() {
+  if (problems_->empty()) return;
+  std::ostringstream os;
+  os << file_ << ": " << problems_->size() << " problem" << (problems_->size() > 1 ? "s" : "") << " in the options:";
+  for (auto& p : *problems_) os << "\n  - " << p;
+  throw Error(os.str());
+}
+
+}  // namespace floesim

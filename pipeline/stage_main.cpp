@@ -1,0 +1,29 @@
+#include "pipeline/stage_main.h"
+
+#include <iostream>
+
+#include "pipeline/error.h"
+#include "pipeline/provenance.h"
+
+namespace floesim {
+
+int run_stage(CLI::App& app, int argc, char** argv, const std::function<void()>& body) {
+  app.set_version_flag("--version", std::string(app.get_name()) + " (floesim) " + version());
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    body();
+    return 0;
+  } catch (const Error& e) {
+    std::cerr << app.get_name() << ": error: " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << app.get_name() << ": internal error: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace floesim

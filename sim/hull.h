@@ -1,0 +1,66 @@
+// The vessel's hull: a parametric icebreaker generator (written as OBJ) and the loader any user hull goes through.
+#pragma once
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "pipeline/options.h"
+#include "sim/mesh.h"
+
+namespace floesim::sim {
+
+// Parametric icebreaker with Oden's main particulars by default. Frame: x forward, y to port, z up,
+// calm waterline at z = 0, origin at midship on the centreline.
+struct HullGeneratorOptions {
+  double length_m = 107.75;          // length over all (Oden ~108 m)
+  double beam_m = 25.0;              // moulded beam of the parallel body
+  double reamer_beam_m = 31.0;       // beam at the bow reamers
+  double draught_m = 8.0;            // design draught
+  double depth_m = 14.0;             // keel to deck
+  double stem_angle_deg = 22.0;      // bow stem angle to the waterline (Oden's broad bow is very flat)
+  int sections = 30;                 // convex parts along the length (20..40)
+  template <class V>
+  void visit(V& v) {
+    v.field("length_m", length_m, "m", "length over all", positive());
+    v.field("beam_m", beam_m, "m", "beam of the parallel body", positive());
+    v.field("reamer_beam_m", reamer_beam_m, "m", "beam at the bow reamers (>= beam_m)", positive());
+    v.field("draught_m", draught_m, "m", "design draught", positive());
+    v.field("depth_m", depth_m, "m", "keel to deck (> draught_m)", positive());
+    v.field("stem_angle_deg", stem_angle_deg, "deg", "stem angle to the waterline", in_range(5, 80));
+    v.field("sections", sections, "-", "number of convex parts", int_in_range(4, 64));
+    if (reamer_beam_m < beam_m) v.problem("reamer_beam_m", "must be >= beam_m");
+    if (depth_m <= draught_m) v.problem("depth_m", "must be > draught_m");
+  }
+};
+
+// Builds the hull as convex parts (one mesh each) and writes it as an OBJ with one object ("o part_k") per part.
+std::vector<TriMesh> generate_hull(const HullGeneratorOptions& o);
+void write_obj(const std::filesystem::path& file, const std::vector<TriMesh>& parts, const std::string& header);
+
+// How the loader treats a mesh that is not convex.
+struct HullLoadOptions {
+  std::string non_convex = "slice";  // "slice": cut into sections along x, convex hull of each; "refuse": error
+  int slices = 24;                   // sections per non-convex mesh when slicing
+  double max_volume_error = 0.05;    // refuse if the decomposition changes the volume by more than this fraction
+  template <class V>
+  void visit(V& v) {
+    v.field("non_convex", non_convex, "-", "what to do with a non-convex mesh: slice | refuse",
+            one_of({"slice", "refuse"}));
+    v.field("slices", slices, "-", "sections per non-convex mesh", int_in_range(2, 400));
+    v.field("max_volume_error", max_volume_error, "-", "largest accepted relative volume change", in_range(0, 1));
+  }
+};
+
+struct HullModel {
+  std::vector<TriMesh> parts;   // convex parts, in the OBJ's frame (metres)
+  TriMesh surface;              // all parts merged: used for buoyancy clipping and rendering
+  double mesh_volume_m3 = 0;    // volume enclosed by the input meshes (as read)
+  double parts_volume_m3 = 0;   // volume of the convex parts
+  std::string report;           // what the loader did, one line per mesh (convex kept / sliced into N, volume error)
+};
+
+// Loads any mesh file assimp reads (OBJ first of all); each mesh is one part. Convex meshes are kept as they are;
+// non-convex ones are sliced or refused per the options, never silently replaced by their convex hull.
+HullModel load_hull(const std::filesystem::path& file, const HullLoadOptions& o = {});
+
+}  // namespace floesim::sim
