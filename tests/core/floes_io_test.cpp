@@ -1,0 +1,71 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "pipeline/error.h"
+#include "pipeline/floes_io.h"
+#include "pipeline/options.h"
+
+using namespace floesim;
+namespace fs = std::filesystem;
+
+namespace {
+Json square_feature(int id, double x0, bool clockwise = false) {
+  Json ring = Json::array({{x0, 0}, {x0 + 10, 0}, {x0 + 10, 10}, {x0, 10}, {x0, 0}});
+  if (clockwise) ring = Json::array({{x0, 0}, {x0, 10}, {x0 + 10, 10}, {x0 + 10, 0}, {x0, 0}});
+  return {{"type", "Feature"},
+          {"properties", {{"id", id}, {"thickness_m", 1.0}}},
+          {"geometry", {{"type", "Polygon"}, {"coordinates", {ring}}}}};
+}
+Json collection(std::vector<Json> feats) { return {{"type", "FeatureCollection"}, {"features", feats}}; }
+std::string error_of(const Json& j) {
+  try {
+    floes_from_geojson(j, "floes.geojson");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(FloesIo, RoundTripKeepsGeometryAndIds) {
+  FloeField f;
+  f.width_m = 100;
+  f.height_m = 50;
+  f.floes.push_back({3, {{0, 0}, {4, 0}, {4, 2}, {0, 2}}, 8.0, 0.7});
+  const fs::path p = fs::temp_directory_path() / "floesim_floes_rt.geojson";
+  write_floes(p, f);
+  FloeField g = read_floes(p);
+  ASSERT_EQ(g.floes.size(), 1u);
+  EXPECT_EQ(g.floes[0].id, 3);
+  EXPECT_DOUBLE_EQ(g.floes[0].area_m2, 8.0);
+  EXPECT_DOUBLE_EQ(g.floes[0].thickness_m, 0.7);
+  EXPECT_EQ(g.width_m, 100);
+  fs::remove(p);
+}
+
+TEST(FloesIo, ClockwiseRingsAreStoredCounterClockwise) {
+  FloeField g = floes_from_geojson(collection({square_feature(1, 0, true)}), "f");
+  EXPECT_GT(signed_area(g.floes[0].outline), 0);
+  EXPECT_DOUBLE_EQ(g.floes[0].area_m2, 100.0);
+}
+
+TEST(FloesIo, RejectsSelfIntersectionNamingTheFloe) {
+  Json bow = square_feature(7, 0);
+  bow["geometry"]["coordinates"] = {Json::array({{0, 0}, {10, 10}, {10, 0}, {0, 10}, {0, 0}})};
+  const std::string e = error_of(collection({bow}));
+  EXPECT_NE(e.find("floe id 7"), std::string::npos) << e;
+  EXPECT_NE(e.find("intersects itself"), std::string::npos) << e;
+}
+
+TEST(FloesIo, RejectsHolesDuplicatesAndBadThickness) {
+  Json holed = square_feature(1, 0);
+  holed["geometry"]["coordinates"].push_back(Json::array({{2, 2}, {3, 2}, {3, 3}, {2, 2}}));
+  EXPECT_NE(error_of(collection({holed})).find("hole"), std::string::npos);
+  EXPECT_NE(error_of(collection({square_feature(2, 0), square_feature(2, 20)})).find("duplicate id"),
+            std::string::npos);
+  Json thin = square_feature(4, 0);
+  thin["properties"]["thickness_m"] = -1;
+  EXPECT_NE(error_of(collection({thin})).find("thickness_m must be > 0"), std::string::npos);
+  EXPECT_NE(error_of(Json::object()).find("not a GeoJSON FeatureCollection"), std::string::npos);
+}
