@@ -1,0 +1,165 @@
+// The runner on a tiny case: every artefact exists, reads back and agrees with the others; a rerun does
+// nothing; a changed parameter reruns exactly the stages downstream of it; a failed stage leaves nothing that
+// looks complete.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "pipeline/floes_io.h"
+#include "pipeline/options.h"
+#include "pipeline/results_io.h"
+
+namespace fs = std::filesystem;
+using namespace floesim;
+
+namespace {
+
+const fs::path kBin = FLOESIM_BIN_DIR;
+const fs::path kSource = FLOESIM_SOURCE_DIR;
+
+struct RunOutput {
+  int code;
+  std::string text;
+};
+
+RunOutput run_case(const fs::path& case_dir, const fs::path& run_dir) {
+  const fs::path log = run_dir.string() + ".log";
+  const std::string cmd = "'" + (kBin / "floesim").string() + "' run '" + case_dir.string() + "' --out '" +
+                          run_dir.string() + "' > '" + log.string() + "' 2>&1";
+  const int status = std::system(cmd.c_str());
+  std::ifstream in(log);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : 1, ss.str()};
+}
+
+fs::file_time_type mtime(const fs::path& p) { return fs::last_write_time(p); }
+
+// One fixture run shared by the tests: the tiny case copied to a temporary folder (so tests may edit it).
+class TinyCase : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    root_ = fs::temp_directory_path() / ("floesim_e2e_" + std::to_string(::getpid()));
+    fs::remove_all(root_);
+    fs::create_directories(root_);
+    case_ = root_ / "tiny";
+    fs::copy(kSource / "tests" / "e2e" / "tiny", case_, fs::copy_options::recursive);
+    run_ = root_ / "run";
+    first_ = run_case(case_, run_);
+  }
+  static void TearDownTestSuite() { fs::remove_all(root_); }
+  static Json case_json() { return load_json_file(case_ / "case.json"); }
+  static void write_case(const Json& j) { std::ofstream(case_ / "case.json") << j.dump(2); }
+
+  static fs::path root_, case_, run_;
+  static RunOutput first_;
+};
+fs::path TinyCase::root_, TinyCase::case_, TinyCase::run_;
+RunOutput TinyCase::first_;
+
+}  // namespace
+
+TEST_F(TinyCase, FirstRunProducesEveryArtefact) {
+  ASSERT_EQ(first_.code, 0) << first_.text;
+  for (const char* f : {"image/image.png", "image/truth.geojson", "floes/floes.geojson", "floes/labels.png",
+                        "floes/overlay.png", "floes/stats.json", "hull/hull.obj", "sim/results.h5",
+                        "sim/summary.json", "video/transit.mp4", "plots/surge_ice_load.png",
+                        "plots/surge_ice_load.svg"})
+    EXPECT_TRUE(fs::exists(run_ / f)) << f << " is missing\n" << first_.text;
+}
+
+TEST_F(TinyCase, FloeCountAgreesBetweenGeoJsonAndLabelImage) {
+  ASSERT_EQ(first_.code, 0) << first_.text;
+  const FloeField floes = read_floes(run_ / "floes" / "floes.geojson");
+  const cv::Mat labels = cv::imread((run_ / "floes" / "labels.png").string(), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(labels.type(), CV_16UC1);
+  const cv::Mat image = cv::imread((run_ / "image" / "image.png").string(), cv::IMREAD_UNCHANGED);
+  EXPECT_EQ(labels.size(), image.size()) << "labels must be on the input's pixel grid";
+  std::set<int> ids;
+  for (int r = 0; r < labels.rows; ++r)
+    for (int c = 0; c < labels.cols; ++c)
+      if (labels.at<uint16_t>(r, c)) ids.insert(labels.at<uint16_t>(r, c));
+  ASSERT_GT(floes.floes.size(), 3u) << "the tiny case should digitise several floes";
+  EXPECT_EQ(ids.size(), floes.floes.size());
+  for (const Floe& f : floes.floes) EXPECT_TRUE(ids.count(f.id)) << "floe " << f.id << " has no label pixels";
+  const Json stats = load_json_file(run_ / "floes" / "stats.json");
+  EXPECT_EQ(stats.dump().find("nan"), std::string::npos);
+}
+
+TEST_F(TinyCase, SeriesFramesAndVideoAgreeWithTheSettings) {
+  ASSERT_EQ(first_.code, 0) << first_.text;
+  const Json sim = case_json()["simulate"];
+  const double duration = sim["duration_s"], dt = sim.value("time_step_s", 0.01), out = sim["output_interval_s"];
+  const Results r = read_results(run_ / "sim" / "results.h5");
+  EXPECT_EQ(r.steps(), static_cast<size_t>(std::llround(duration / dt)));
+  EXPECT_EQ(r.frames(), static_cast<size_t>(std::llround(duration / out)));
+  EXPECT_NEAR(r.frame_time_s.back(), duration, 1e-9);
+
+  cv::VideoCapture video((run_ / "video" / "transit.mp4").string());
+  ASSERT_TRUE(video.isOpened());
+  int frames = 0;
+  cv::Mat frame;
+  while (video.read(frame)) ++frames;
+  EXPECT_EQ(frames, static_cast<int>(r.frames())) << "one video frame per stored results frame";
+
+  const Json summary = load_json_file(run_ / "sim" / "summary.json");
+  ASSERT_TRUE(summary.contains("mean_surge_ice_load_N"));
+  EXPECT_TRUE(std::isfinite(summary["mean_surge_ice_load_N"].get<double>()));
+}
+
+TEST_F(TinyCase, RerunWithNothingChangedDoesNothing) {
+  ASSERT_EQ(first_.code, 0) << first_.text;
+  const auto t_results = mtime(run_ / "sim" / "results.h5");
+  const auto t_video = mtime(run_ / "video" / "transit.mp4");
+  const RunOutput again = run_case(case_, run_);
+  ASSERT_EQ(again.code, 0) << again.text;
+  EXPECT_NE(again.text.find("no work to do"), std::string::npos) << again.text;
+  EXPECT_EQ(mtime(run_ / "sim" / "results.h5"), t_results);
+  EXPECT_EQ(mtime(run_ / "video" / "transit.mp4"), t_video);
+}
+
+TEST_F(TinyCase, ChangedRenderParameterRerunsOnlyRender) {
+  ASSERT_EQ(first_.code, 0) << first_.text;
+  const auto t_floes = mtime(run_ / "floes" / "floes.geojson");
+  const auto t_results = mtime(run_ / "sim" / "results.h5");
+  const auto t_plot = mtime(run_ / "plots" / "surge_ice_load.png");
+  const auto t_video = mtime(run_ / "video" / "transit.mp4");
+  Json c = case_json();
+  c["render"]["width_px"] = c["render"].value("width_px", 320) + 32;
+  write_case(c);
+  const RunOutput again = run_case(case_, run_);
+  ASSERT_EQ(again.code, 0) << again.text;
+  EXPECT_EQ(mtime(run_ / "floes" / "floes.geojson"), t_floes);
+  EXPECT_EQ(mtime(run_ / "sim" / "results.h5"), t_results);
+  EXPECT_EQ(mtime(run_ / "plots" / "surge_ice_load.png"), t_plot);
+  EXPECT_NE(mtime(run_ / "video" / "transit.mp4"), t_video);
+}
+
+TEST_F(TinyCase, FailedStageStopsAndLeavesNothingThatLooksComplete) {
+  ASSERT_EQ(first_.code, 0) << first_.text;
+  Json c = case_json();
+  const Json good = c;
+  c["simulate"]["duration_s"] = -1.0;
+  write_case(c);
+  const RunOutput bad = run_case(case_, run_);
+  write_case(good);
+  EXPECT_NE(bad.code, 0) << bad.text;
+  EXPECT_NE(bad.text.find("duration_s"), std::string::npos) << "the message names the key\n" << bad.text;
+  EXPECT_TRUE(fs::exists(run_ / "floes" / "floes.geojson")) << "upstream artefacts stay";
+  for (const char* f : {"sim/results.h5", "sim/summary.json", "video/transit.mp4", "plots/surge_ice_load.png"})
+    EXPECT_FALSE(fs::exists(run_ / f)) << f << " survived a failed simulate stage";
+  for (auto& e : fs::recursive_directory_iterator(run_))
+    EXPECT_EQ(e.path().filename().string().rfind(".tmp-", 0), std::string::npos) << e.path() << " left behind";
+}
