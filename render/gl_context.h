@@ -1,0 +1,55 @@
+// The off-screen OpenGL context (Mesa OSMesa + llvmpipe, no display needed) and the GL entry points the renderer
+// uses. Every GL function is loaded through OSMesaGetProcAddress instead of being linked by name: if another
+// library drags libGL (glvnd) into the process, calls linked by name can land in a dispatch table with no context
+// and silently draw nothing (black frames). Only this file and scene.cpp see GL.
+#pragma once
+#include <GL/gl.h>
+#include <GL/osmesa.h>
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace floesim::render {
+
+// Fixed-function GL 1.x (compatibility profile): client vertex arrays, lights, fog. The X-macro keeps the list of
+// names, the pointer declarations and the loader in one place; the types come from the prototypes in GL/gl.h
+// (decltype only: nothing is linked by name).
+#define FLOESIM_GL_FUNCTIONS(X)                                                                              \
+  X(Clear) X(ClearColor) X(Enable) X(Disable) X(Viewport) X(MatrixMode) X(LoadMatrixd) X(PushMatrix)         \
+  X(PopMatrix) X(MultMatrixd) X(EnableClientState) X(DisableClientState) X(VertexPointer) X(NormalPointer)   \
+  X(ColorPointer) X(DrawArrays) X(Color4f) X(Color4ub) X(Normal3f) X(Lightfv) X(LightModelfv) X(LightModeli)  \
+  X(ColorMaterial) X(Materialfv) X(Materialf) X(ShadeModel) X(Fogi) X(Fogf) X(Fogfv) X(PolygonOffset)        \
+  X(LineWidth) X(ReadPixels) X(PixelStorei) X(Finish) X(GetError) X(GetString) X(DepthFunc) X(DepthMask)      \
+  X(Hint) X(BlendFunc) X(CullFace) X(FrontFace)
+
+struct GlApi {
+#define FLOESIM_GL_DECLARE(name) decltype(&::gl##name) name = nullptr;
+  FLOESIM_GL_FUNCTIONS(FLOESIM_GL_DECLARE)
+#undef FLOESIM_GL_DECLARE
+};
+
+// One OSMesa RGBA context with a 24-bit depth buffer, rendering into memory we own. Made current on
+// construction (one context per thread at a time).
+class OffscreenContext {
+ public:
+  OffscreenContext(int width_px, int height_px);  // Error if OSMesa cannot create it (names the size)
+  ~OffscreenContext();
+  OffscreenContext(const OffscreenContext&) = delete;
+  OffscreenContext& operator=(const OffscreenContext&) = delete;
+
+  const GlApi& gl() const { return gl_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  // Finishes drawing and returns the frame as 8-bit BGR with the top row first (GL gives rows bottom-up).
+  void read_bgr(cv::Mat& out) const;
+  const char* renderer() const;
+
+ private:
+  OSMesaContext ctx_ = nullptr;
+  std::vector<unsigned char> buffer_;
+  int width_, height_;
+  GlApi gl_;
+};
+
+}  // namespace floesim::render

@@ -1,0 +1,289 @@
+#include "render/plot.h"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "pipeline/atomic_file.h"
+#include "pipeline/error.h"
+#include "pipeline/provenance.h"
+#include "render/signal.h"
+
+extern char** environ;
+
+namespace floesim::render {
+
+namespace fs = std::filesystem;
+
+#ifndef FLOESIM_GNUPLOT
+#error "FLOESIM_GNUPLOT (the gnuplot executable) must be defined by the build"
+#endif
+
+Check<Json> auto_or_number(bool strictly_positive) {
+  return [strictly_positive](const Json& j) {
+    if (j.is_string() && j.get<std::string>() == "auto") return std::string();
+    if (j.is_number() && std::isfinite(j.get<double>()) &&
+        (strictly_positive ? j.get<double>() > 0 : j.get<double>() >= 0))
+      return std::string();
+    return std::string("must be \"auto\" or a number ") + (strictly_positive ? "> 0" : ">= 0");
+  };
+}
+
+PlotOptions read_plot_options(const fs::path& config) {
+  return read_options<PlotOptions>(load_json_file(config), config.string());
+}
+
+namespace {
+
+std::string fmt(const char* f, double a) {
+  char b[64];
+  std::snprintf(b, sizeof b, f, a);
+  return b;
+}
+
+// Loads are read by people in kN: whole kN from 100 kN up, three significant digits below.
+std::string kN(double x) { return std::abs(x) >= 100 ? fmt("%.0f", x) : fmt("%.3g", x); }
+
+// gnuplot single-quoted string: only the quote itself needs escaping (doubled).
+std::string quoted(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("''") : std::string(1, c);
+  return out + "'";
+}
+
+// For the drawing only (the CSV keeps every sample): with far more samples than pixels, keep each bin's minimum
+// and maximum in time order, so that single-step spikes stay visible and files stay small.
+void write_decimated(std::ostream& os, const std::vector<double>& t, const std::vector<double>& x, size_t bins) {
+  const size_t n = t.size();
+  if (n <= 4 * bins) {
+    for (size_t i = 0; i < n; ++i) os << fmt("%.9g", t[i]) << ' ' << fmt("%.9g", x[i]) << '\n';
+    return;
+  }
+  for (size_t b = 0; b < bins; ++b) {
+    const size_t lo = b * n / bins, hi = (b + 1) * n / bins;
+    size_t imin = lo, imax = lo;
+    for (size_t i = lo; i < hi; ++i) {
+      if (x[i] < x[imin]) imin = i;
+      if (x[i] > x[imax]) imax = i;
+    }
+    const size_t a = std::min(imin, imax), c = std::max(imin, imax);
+    os << fmt("%.9g", t[a]) << ' ' << fmt("%.9g", x[a]) << '\n';
+    if (c != a) os << fmt("%.9g", t[c]) << ' ' << fmt("%.9g", x[c]) << '\n';
+  }
+}
+
+double quantile(std::vector<double> x, double q) {
+  const size_t k = static_cast<size_t>(q * static_cast<double>(x.size() - 1));
+  std::nth_element(x.begin(), x.begin() + static_cast<long>(k), x.end());
+  return x[k];
+}
+
+// Runs a program without a shell (no quoting pitfalls), stdout and stderr into `log`; returns its exit status.
+int run_program(const std::vector<std::string>& args, const fs::path& log) {
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
+  std::vector<char*> argv;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, args[0].c_str(), &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  FLOESIM_REQUIRE(rc == 0, "cannot start ", args[0], ": ", std::strerror(rc));
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0)
+    FLOESIM_REQUIRE(errno == EINTR, "waiting for ", args[0], " failed: ", std::strerror(errno));
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const fs::path& out_dir,
+                                 const nlohmann::json& provenance, const std::string& source) {
+  SurgeLoadSummary s;
+  // 1. The signal: ice resistance = -Fx (body x, surge) in kN.
+  const std::vector<double>& t = r.get("time_s");
+  const std::vector<double>& load = r.get("ice_load");
+  FLOESIM_REQUIRE(load.size() == 6 * t.size(), source, ": series ice_load does not have 6 columns per step");
+  std::vector<double> res(t.size());
+  for (size_t i = 0; i < t.size(); ++i) res[i] = -load[6 * i] / 1000.0;
+  for (size_t i = 0; i < t.size(); ++i)
+    FLOESIM_REQUIRE(std::isfinite(res[i]) && std::isfinite(t[i]), source, ": ice_load or time_s is not finite at step ",
+                    i, " (t = ", t[i], " s); the simulation blew up");
+  s.time_step_s = uniform_step(t, (source + ": series time_s").c_str());
+
+  // 2. The window: "auto" follows the contact model the simulator recorded (PHYSICS.md §5).
+  const Json& attrs = r.attributes;
+  s.contact_model = "rigid";
+  if (attrs.contains("contact_model")) {
+    FLOESIM_REQUIRE(attrs["contact_model"].is_string(), source, ": attribute contact_model must be a string");
+    s.contact_model = attrs["contact_model"].get<std::string>();
+    FLOESIM_REQUIRE(s.contact_model == "rigid" || s.contact_model == "compliant" || s.contact_model == "mixed",
+                    source, ": attribute contact_model is \"", s.contact_model,
+                    "\"; expected rigid, compliant or mixed");
+  }
+  s.window_s = o.moving_average_window_s.is_string() ? (s.contact_model == "rigid" ? 20.0 : 0.5)
+                                                     : o.moving_average_window_s.get<double>();
+  s.window_samples = window_samples(s.window_s, s.time_step_s);
+  const std::vector<double> ma = moving_average_centred(res, s.window_samples);
+
+  // 3. The steady part and its mean (of the unfiltered signal: the primary validation metric).
+  s.steady_start_s = 0;
+  if (o.steady_start_s.is_number()) {
+    s.steady_start_s = o.steady_start_s.get<double>();
+  } else if (attrs.contains("steady_start_s")) {
+    FLOESIM_REQUIRE(attrs["steady_start_s"].is_number(), source, ": attribute steady_start_s must be a number");
+    s.steady_start_s = attrs["steady_start_s"].get<double>();
+  }
+  const SteadyMean m = mean_from(t, res, s.steady_start_s);
+  s.mean_kN = m.mean;
+  s.steady_samples = m.samples;
+  {
+    double sum2 = 0, mx = -1e300;
+    size_t c = 0;
+    for (size_t i = 0; i < t.size(); ++i)
+      if (t[i] >= s.steady_start_s) {
+        const double d = ma[i] - m.mean;
+        sum2 += d * d, mx = std::max(mx, ma[i]), ++c;
+      }
+    s.moving_average_std_kN = std::sqrt(sum2 / static_cast<double>(c));
+    s.moving_average_max_kN = mx;
+  }
+  s.raw_max_kN = *std::max_element(res.begin(), res.end());
+
+  ensure_directory(out_dir);
+  AtomicFile png(out_dir / "surge_ice_load.png"), svg(out_dir / "surge_ice_load.svg"),
+      csv(out_dir / "surge_ice_load.csv"), side(out_dir / "plot.json");
+  // Working files: AtomicFiles never committed, so they are removed whatever happens.
+  AtomicFile data(out_dir / "surge_ice_load.plot-data.txt"), script(out_dir / "surge_ice_load.plot.gp"),
+      log(out_dir / "surge_ice_load.gnuplot.log");
+
+  // 4. CSV with every sample.
+  {
+    std::ofstream os(csv.tmp());
+    os << "time_s,ice_resistance_kN,moving_average_kN\n";
+    for (size_t i = 0; i < t.size(); ++i)
+      os << fmt("%.10g", t[i]) << ',' << fmt("%.10g", res[i]) << ',' << fmt("%.10g", ma[i]) << '\n';
+    FLOESIM_REQUIRE(os.flush(), csv.path().string(), ": write failed (disk full?)");
+  }
+
+  // 5. Plot data (decimated to ~2 points per pixel column) and the script.
+  const size_t bins = static_cast<size_t>(o.width_px);
+  {
+    std::ofstream os(data.tmp());
+    write_decimated(os, t, res, bins);
+    os << "\n\n";
+    write_decimated(os, t, ma, bins);
+    os << "\n\n";
+    const double t_mean0 = std::max(s.steady_start_s, t.front());
+    os << fmt("%.9g", t_mean0) << ' ' << fmt("%.9g", s.mean_kN) << '\n'
+       << fmt("%.9g", t.back()) << ' ' << fmt("%.9g", s.mean_kN) << '\n';
+    FLOESIM_REQUIRE(os.flush(), data.tmp().string(), ": write failed (disk full?)");
+  }
+  // Rigid contacts give single-step spikes far above the average; "auto" keeps the average readable and says
+  // how high the clipped spikes go.
+  const double ma_max = *std::max_element(ma.begin(), ma.end()), ma_min = *std::min_element(ma.begin(), ma.end());
+  double y_hi = o.y_max_kN.is_number() ? o.y_max_kN.get<double>()
+                                       : std::max({1.25 * ma_max, quantile(res, 0.995), 1.25 * s.mean_kN, 1e-3});
+  double y_lo = std::min({0.0, ma_min, quantile(res, 0.002)});
+  y_lo -= 0.03 * (y_hi - y_lo);
+  y_hi += o.y_max_kN.is_number() ? 0.0 : 0.05 * (y_hi - y_lo);
+  {
+    const bool clipped = s.raw_max_kN > y_hi;
+    std::ostringstream gp;
+    gp << "set encoding utf8\n"
+       << "set terminal pngcairo size " << o.width_px << "," << o.height_px
+       << " enhanced font 'DejaVu Sans,11' linewidth 1.0\n"
+       << "set output " << quoted(png.tmp().string()) << "\n";
+    if (!o.title.empty()) gp << "set title " << quoted(o.title) << " noenhanced font ',14'\n";
+    gp << "set xlabel 'Time (s)'\n"
+       << "set ylabel 'Ice resistance  −F_x  (kN)'\n"
+       << "set border lc rgb '#404040'\n"
+       << "set grid xtics ytics mxtics lc rgb '#d9d9d9' lw 1 dt 1\n"
+       << "set mxtics 2\n"
+       << "set key top left box lc rgb '#b0b0b0' opaque samplen 2.5 spacing 1.3 width 1\n"
+       << "set xrange [" << fmt("%.9g", t.front()) << ":" << fmt("%.9g", t.back()) << "]\n"
+       << "set yrange [" << fmt("%.9g", y_lo) << ":" << fmt("%.9g", y_hi) << "]\n"
+       << "set format y '%.0f'\n";
+    if (y_hi - y_lo < 10) gp << "set format y '%g'\n";
+    if (clipped)
+      gp << "set label 1 " << quoted("raw peaks up to " + kN(s.raw_max_kN) + " kN are cut off")
+         << " at graph 0.99, graph 0.97 right noenhanced font ',9' tc rgb '#606060' front\n";
+    const std::string mean_title =
+        (s.steady_start_s > t.front() ? "mean for t ≥ " + fmt("%g", s.steady_start_s) + " s: "
+                                      : std::string("mean: ")) +
+        kN(s.mean_kN) + " kN";
+    gp << "plot " << quoted(data.tmp().string())
+       << " index 0 using 1:2 with lines lc rgb '#9fb0c0' lw 0.8 title "
+       << quoted("ice resistance, every time step (Δt = " + fmt("%g", s.time_step_s) + " s)") << " noenhanced, \\\n"
+       << "  '' index 1 using 1:2 with lines lc rgb '#101010' lw 2 title "
+       << quoted("centred moving average, " + fmt("%g", s.window_s) + " s window") << " noenhanced, \\\n"
+       << "  '' index 2 using 1:2 with lines lc rgb '#d1232a' lw 2.5 dt (8,4) title " << quoted(mean_title)
+       << " noenhanced\n"
+       << "set terminal svg size " << o.width_px << "," << o.height_px
+       << " dynamic enhanced font 'DejaVu Sans,11' background rgb 'white'\n"
+       << "set output " << quoted(svg.tmp().string()) << "\n"
+       << "replot\n"
+       << "unset output\n";
+    std::ofstream os(script.tmp());
+    os << gp.str();
+    FLOESIM_REQUIRE(os.flush(), script.tmp().string(), ": write failed (disk full?)");
+  }
+
+  // 6. gnuplot, checked: exit status, and both images non-empty.
+  const int rc = run_program({FLOESIM_GNUPLOT, script.tmp().string()}, log.tmp());
+  FLOESIM_REQUIRE(rc == 0, "gnuplot (", FLOESIM_GNUPLOT, ") failed with exit status ", rc, " drawing ",
+                  png.path().string(), ":\n", read_text(log.tmp()));
+  std::error_code e1, e2;
+  FLOESIM_REQUIRE(fs::file_size(png.tmp(), e1) > 0 && !e1 && fs::file_size(svg.tmp(), e2) > 0 && !e2,
+                  "gnuplot wrote no image to ", out_dir.string(), ":\n", read_text(log.tmp()));
+
+  // 7. The numbers, then everything into place.
+  nlohmann::json j = {
+      {"series", "ice_load column 0 (Fx, surge, body x)"},
+      {"quantity", "ice resistance = -Fx"},
+      {"unit", "kN"},
+      {"contact_model", s.contact_model},
+      {"time_step_s", s.time_step_s},
+      {"moving_average", {{"kind", "centred"}, {"window_s", s.window_s}, {"window_samples", s.window_samples}}},
+      {"steady_start_s", s.steady_start_s},
+      {"steady_samples", s.steady_samples},
+      {"mean_kN", s.mean_kN},
+      {"moving_average_std_kN", s.moving_average_std_kN},
+      {"moving_average_max_kN", s.moving_average_max_kN},
+      {"raw_max_kN", s.raw_max_kN},
+      {"files", {"surge_ice_load.png", "surge_ice_load.svg", "surge_ice_load.csv"}},
+      {"provenance", provenance},
+  };
+  write_text_atomic(side.tmp(), j.dump(2) + "\n");
+  png.commit();
+  svg.commit();
+  csv.commit();
+  side.commit();
+  return s;
+}
+
+SurgeLoadSummary plot_surge_load(const fs::path& results, const fs::path& config, const fs::path& out_dir) {
+  const PlotOptions o = read_plot_options(config);
+  const Results r = read_results(results, /*with_states=*/false);
+  const auto prov = make_provenance("floesim-plot", {{"results", results}, {"config", config}}, options_to_json(o));
+  return plot_surge_load(r, o, out_dir, prov, results.string());
+}
+
+}  // namespace floesim::render

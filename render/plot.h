@@ -1,0 +1,63 @@
+// The plot stage: surge ice load against time, its centred moving average and the steady-state mean (like Fig. 5
+// of the SAMS paper), drawn by gnuplot to PNG and SVG, with the numbers in a CSV and a JSON sidecar.
+// floesim-plot is a thin main over plot_surge_load().
+#pragma once
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "pipeline/options.h"
+#include "pipeline/results_io.h"
+
+namespace floesim::render {
+
+// "auto" or a number >= 0 (> 0 if `strictly_positive`).
+Check<Json> auto_or_number(bool strictly_positive);
+
+struct PlotOptions {
+  Json moving_average_window_s = "auto";  // s; "auto": 20 s if the run used only rigid contacts, else 0.5 s
+  Json steady_start_s = "auto";           // s; "auto": the results attribute steady_start_s, 0 if absent
+  Json y_max_kN = "auto";                 // kN; "auto": fit the average and clip rare raw spikes (noted on the plot)
+  int width_px = 1400;                    // PNG size (the SVG has the same proportions)
+  int height_px = 650;
+  std::string title = "Surge ice load";   // "" for none
+
+  template <class V>
+  void visit(V& v) {
+    v.field("moving_average_window_s", moving_average_window_s, "s",
+            "centred moving-average window, or \"auto\": 20 s for rigid-contact runs, 0.5 s otherwise "
+            "(results attribute contact_model)",
+            auto_or_number(true));
+    v.field("steady_start_s", steady_start_s, "s",
+            "start of the steady part averaged for the mean, or \"auto\": results attribute steady_start_s (else 0)",
+            auto_or_number(false));
+    v.field("y_max_kN", y_max_kN, "kN", "top of the load axis, or \"auto\"", auto_or_number(true));
+    v.field("width_px", width_px, "px", "PNG width", int_in_range(320, 8000));
+    v.field("height_px", height_px, "px", "PNG height", int_in_range(200, 8000));
+    v.field("title", title, "-", "plot title (empty for none)");
+  }
+};
+
+PlotOptions read_plot_options(const std::filesystem::path& config);
+
+struct SurgeLoadSummary {
+  std::string contact_model;       // from the results attributes ("rigid" if absent)
+  double time_step_s = 0;          // sample step of the series
+  double window_s = 0;             // moving-average window used
+  size_t window_samples = 0;       // N = round(window_s / time_step_s)
+  double steady_start_s = 0;
+  size_t steady_samples = 0;
+  double mean_kN = 0;              // mean ice resistance (-Fx) over t >= steady_start_s, unfiltered
+  double moving_average_std_kN = 0;  // of the moving average over the steady part
+  double moving_average_max_kN = 0;
+  double raw_max_kN = 0;           // over the whole run
+};
+
+// Writes DIR/surge_ice_load.{png,svg,csv} and DIR/plot.json; each appears only when complete.
+SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const std::filesystem::path& out_dir,
+                                 const nlohmann::json& provenance, const std::string& source);
+SurgeLoadSummary plot_surge_load(const std::filesystem::path& results, const std::filesystem::path& config,
+                                 const std::filesystem::path& out_dir);
+
+}  // namespace floesim::render

@@ -1,0 +1,554 @@
+#include "render/scene.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+
+#include <Eigen/Geometry>
+#include <opencv2/imgproc.hpp>
+
+#include "pipeline/error.h"
+#include "render/gl_context.h"
+
+namespace floesim::render {
+
+namespace {
+
+using Mat4 = Eigen::Matrix4d;  // column-major, like GL
+using Vec3 = Eigen::Vector3d;
+using Vec2 = Eigen::Vector2d;
+
+constexpr double kPi = 3.14159265358979323846;
+
+// ---- small camera maths (no GLU: it would link libGL) ----
+
+Mat4 look_at(const Vec3& eye, const Vec3& target, const Vec3& up) {
+  const Vec3 f = (target - eye).normalized();
+  const Vec3 s = f.cross(up).normalized();
+  const Vec3 u = s.cross(f);
+  Mat4 m = Mat4::Identity();
+  m.block<1, 3>(0, 0) = s.transpose();
+  m.block<1, 3>(1, 0) = u.transpose();
+  m.block<1, 3>(2, 0) = -f.transpose();
+  m(0, 3) = -s.dot(eye);
+  m(1, 3) = -u.dot(eye);
+  m(2, 3) = f.dot(eye);
+  return m;
+}
+
+Mat4 perspective(double fovy_rad, double aspect, double near_m, double far_m) {
+  const double t = 1.0 / std::tan(fovy_rad / 2);
+  Mat4 m = Mat4::Zero();
+  m(0, 0) = t / aspect;
+  m(1, 1) = t;
+  m(2, 2) = (far_m + near_m) / (near_m - far_m);
+  m(2, 3) = 2 * far_m * near_m / (near_m - far_m);
+  m(3, 2) = -1;
+  return m;
+}
+
+Mat4 ortho(double half_w, double half_h, double near_m, double far_m) {
+  Mat4 m = Mat4::Identity();
+  m(0, 0) = 1 / half_w;
+  m(1, 1) = 1 / half_h;
+  m(2, 2) = -2 / (far_m - near_m);
+  m(2, 3) = -(far_m + near_m) / (far_m - near_m);
+  return m;
+}
+
+// The six planes of a view volume (Gribb & Hartmann), normalised so that plane . (x, 1) is a distance in metres.
+struct Frustum {
+  std::array<Eigen::Vector4d, 6> planes;
+  explicit Frustum(const Mat4& pv) {
+    for (int i = 0; i < 3; ++i) {
+      planes[2 * i] = pv.row(3).transpose() + pv.row(i).transpose();
+      planes[2 * i + 1] = pv.row(3).transpose() - pv.row(i).transpose();
+    }
+    for (auto& p : planes) p /= p.head<3>().norm();
+  }
+  bool outside(const Vec3& c, double radius) const {
+    for (const auto& p : planes)
+      if (p.head<3>().dot(c) + p[3] < -radius) return true;
+    return false;
+  }
+};
+
+Mat4 pose_matrix(const double* q_wxyz, const Vec3& p) {
+  Mat4 m = Mat4::Identity();
+  m.block<3, 3>(0, 0) = Eigen::Quaterniond(q_wxyz[0], q_wxyz[1], q_wxyz[2], q_wxyz[3]).normalized().toRotationMatrix();
+  m.block<3, 1>(0, 3) = p;
+  return m;
+}
+
+// Ear clipping of a simple CCW polygon; O(n^3) worst case is nothing for 10-60 vertices, and it runs once per
+// floe. Outlines from segmentation are often non-convex, so a fan would draw wrong triangles.
+std::vector<std::array<int, 3>> triangulate(const std::vector<Vec2>& p) {
+  std::vector<std::array<int, 3>> tris;
+  std::vector<int> idx(p.size());
+  for (size_t i = 0; i < p.size(); ++i) idx[i] = static_cast<int>(i);
+  auto cross = [&](int a, int b, int c) {
+    return (p[b] - p[a]).x() * (p[c] - p[a]).y() - (p[b] - p[a]).y() * (p[c] - p[a]).x();
+  };
+  while (idx.size() > 3) {
+    const size_t n = idx.size();
+    bool clipped = false;
+    for (size_t i = 0; i < n && !clipped; ++i) {
+      const int a = idx[(i + n - 1) % n], b = idx[i], c = idx[(i + 1) % n];
+      if (cross(a, b, c) <= 0) continue;  // reflex or degenerate corner: not an ear
+      bool empty = true;
+      for (int k : idx) {
+        if (k == a || k == b || k == c) continue;
+        if (cross(a, b, k) >= 0 && cross(b, c, k) >= 0 && cross(c, a, k) >= 0) {
+          empty = false;
+          break;
+        }
+      }
+      if (!empty) continue;
+      tris.push_back({a, b, c});
+      idx.erase(idx.begin() + static_cast<long>(i));
+      clipped = true;
+    }
+    if (!clipped) {
+      // Self-touching or collinear leftovers: close the rest as a fan rather than dropping area.
+      for (size_t i = 1; i + 1 < idx.size(); ++i) tris.push_back({idx[0], idx[i], idx[i + 1]});
+      return tris;
+    }
+  }
+  if (idx.size() == 3) tris.push_back({idx[0], idx[1], idx[2]});
+  return tris;
+}
+
+struct FloeDraw {
+  GLint first = 0, count = 0;            // triangles (top face + sides) in the vertex arrays
+  GLint ring_first = 0, ring_count = 0;  // outline of the top face (line loop)
+  double radius = 0;                     // bounding sphere about the centre of mass
+};
+
+std::string fmt(const char* f, double a) {
+  char b[64];
+  std::snprintf(b, sizeof b, f, a);
+  return b;
+}
+
+}  // namespace
+
+struct SceneRenderer::Impl {
+  const Results& r;
+  RenderOptions o;
+  std::string source;
+  OffscreenContext ctx;
+  const GlApi& gl;
+
+  // Interleaving is not needed: separate arrays keep the building code plain.
+  std::vector<float> pos, nrm;
+  std::vector<uint8_t> col;
+  std::vector<FloeDraw> floes;          // per geometry index
+  std::vector<int32_t> row_floe;        // per state row: geometry index, -1 for the vessel
+  std::vector<int64_t> vessel_row;      // per frame
+  GLint hull_first = 0, hull_count = 0;
+  double hull_radius = 0;
+  float sky[3], water[3], edge[3];
+  FrameStats stats;
+  std::vector<std::pair<size_t, Mat4>> visible;  // reused between frames
+  std::vector<float> water_grid;                  // unit square [-1, 1]^2 at z = 0 as triangles
+
+  Impl(const Results& res, const RenderOptions& opt, const std::string& src)
+      : r(res), o(opt), source(src), ctx(opt.width_px * opt.supersample, opt.height_px * opt.supersample),
+        gl(ctx.gl()) {
+    parse_hex_colour(o.sky_colour, sky);
+    parse_hex_colour(o.water_colour, water);
+    parse_hex_colour(o.edge_colour, edge);
+    check_states();
+    build_floes();
+    build_hull();
+    build_water_grid();
+    setup_gl();
+  }
+
+  void vertex(const Vec3& p, const Vec3& n, const float c[3]) {
+    pos.insert(pos.end(), {float(p.x()), float(p.y()), float(p.z())});
+    nrm.insert(nrm.end(), {float(n.x()), float(n.y()), float(n.z())});
+    col.insert(col.end(), {uint8_t(std::lround(255 * std::clamp(c[0], 0.f, 1.f))),
+                           uint8_t(std::lround(255 * std::clamp(c[1], 0.f, 1.f))),
+                           uint8_t(std::lround(255 * std::clamp(c[2], 0.f, 1.f))), 255});
+  }
+  GLint vertex_count() const { return static_cast<GLint>(pos.size() / 3); }
+
+  // Every state row must name the vessel or a floe with geometry, with a finite pose; every frame needs the vessel.
+  void check_states() {
+    const size_t frames = r.frames();
+    FLOESIM_REQUIRE(frames > 0, source, ": the results hold no frames (/frames/time_s is empty): nothing to render");
+    FLOESIM_REQUIRE(r.frame_offset.size() == frames + 1 && r.frame_offset.front() == 0 &&
+                        static_cast<size_t>(r.frame_offset.back()) == r.state_body_id.size(),
+                    source, ": /frames/offset does not match /states (run floesim-simulate again?)");
+    std::vector<std::pair<int32_t, int32_t>> ids;  // floe id -> geometry index, sorted for lookups
+    for (size_t g = 0; g < r.floe_id.size(); ++g) ids.push_back({r.floe_id[g], static_cast<int32_t>(g)});
+    std::sort(ids.begin(), ids.end());
+    for (size_t i = 1; i < ids.size(); ++i)
+      FLOESIM_REQUIRE(ids[i].first != ids[i - 1].first, source, ": floe id ", ids[i].first,
+                      " appears twice in /geometry/floe_id");
+    row_floe.assign(r.state_body_id.size(), -1);
+    vessel_row.assign(frames, -1);
+    for (size_t k = 0; k < frames; ++k) {
+      FLOESIM_REQUIRE(r.frame_offset[k] <= r.frame_offset[k + 1], source, ": /frames/offset decreases at frame ", k);
+      for (int64_t row = r.frame_offset[k]; row < r.frame_offset[k + 1]; ++row) {
+        const int32_t id = r.state_body_id[row];
+        const double* q = &r.state_quaternion[4 * row];
+        const double* p = &r.state_position_m[3 * row];
+        const double qn = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+        FLOESIM_REQUIRE(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]) && std::isfinite(qn) &&
+                            qn > 0.5 && qn < 2.0,
+                        source, ": body ", id, " in frame ", k, " (t = ", r.frame_time_s[k],
+                        " s) has a non-finite position or an invalid quaternion (did the simulation blow up?)");
+        if (id == 0) {
+          vessel_row[k] = row;
+          continue;
+        }
+        auto it = std::lower_bound(ids.begin(), ids.end(), std::make_pair(id, INT32_MIN));
+        FLOESIM_REQUIRE(it != ids.end() && it->first == id, source, ": frame ", k, " has a state for body ", id,
+                        ", which has no floe geometry in /geometry/floe_id");
+        row_floe[row] = it->second;
+      }
+      FLOESIM_REQUIRE(vessel_row[k] >= 0, source, ": frame ", k, " (t = ", r.frame_time_s[k],
+                      " s) has no vessel state (body_id 0)");
+    }
+  }
+
+  // Slabs in the body frame: top face at z = +h/2 (triangulated outline), sides as flat-shaded quads; no bottom
+  // (it is under water, never seen). The top colour varies a little per floe so that touching floes stay apart.
+  void build_floes() {
+    const size_t n = r.floe_id.size();
+    FLOESIM_REQUIRE(r.floe_vertex_offset.size() == n + 1 && r.floe_thickness_m.size() == n, source,
+                    ": /geometry floe arrays disagree in length");
+    float top[3], side[3];
+    parse_hex_colour(o.floe_top_colour, top);
+    parse_hex_colour(o.floe_side_colour, side);
+    floes.resize(n);
+    std::vector<Vec2> ring;
+    for (size_t g = 0; g < n; ++g) {
+      const int64_t a = r.floe_vertex_offset[g], b = r.floe_vertex_offset[g + 1];
+      FLOESIM_REQUIRE(a >= 0 && b >= a + 3 && static_cast<size_t>(2 * b) <= r.floe_vertices_m.size(), source,
+                      ": floe ", r.floe_id[g], " has an invalid outline (", b - a,
+                      " vertices; at least 3 are needed)");
+      const double h = r.floe_thickness_m[g];
+      FLOESIM_REQUIRE(std::isfinite(h) && h > 0, source, ": floe ", r.floe_id[g], " has thickness ", h,
+                      " m; it must be > 0");
+      ring.clear();
+      for (int64_t v = a; v < b; ++v) ring.emplace_back(r.floe_vertices_m[2 * v], r.floe_vertices_m[2 * v + 1]);
+      double area2 = 0;
+      for (size_t i = 0; i < ring.size(); ++i) {
+        const Vec2& p = ring[i];
+        const Vec2& q = ring[(i + 1) % ring.size()];
+        area2 += p.x() * q.y() - q.x() * p.y();
+      }
+      if (area2 < 0) std::reverse(ring.begin(), ring.end());  // the layout says CCW; be lenient, not wrong
+      // A deterministic shade per floe id (Knuth's multiplicative hash), 0.92 .. 1.0 of the top colour.
+      const float shade = 0.92f + 0.08f * float((uint32_t(r.floe_id[g]) * 2654435761u >> 16) & 255u) / 255.f;
+      const float t[3] = {top[0] * shade, top[1] * shade, top[2] * shade};
+      FloeDraw& f = floes[g];
+      f.first = vertex_count();
+      const double zt = h / 2, zb = -h / 2;
+      const Vec3 up(0, 0, 1);
+      for (const auto& tri : triangulate(ring))
+        for (int i : tri) vertex(Vec3(ring[i].x(), ring[i].y(), zt), up, t);
+      for (size_t i = 0; i < ring.size(); ++i) {
+        const Vec2& p = ring[i];
+        const Vec2& q = ring[(i + 1) % ring.size()];
+        const Vec2 e = q - p;
+        if (e.norm() <= 0) continue;
+        const Vec3 out(e.y() / e.norm(), -e.x() / e.norm(), 0);  // outward for a CCW ring
+        const Vec3 p0(p.x(), p.y(), zb), p1(q.x(), q.y(), zb), p2(q.x(), q.y(), zt), p3(p.x(), p.y(), zt);
+        for (const Vec3* v : {&p0, &p1, &p2, &p0, &p2, &p3}) vertex(*v, out, side);
+        f.radius = std::max(f.radius, std::hypot(p.norm(), h / 2));
+      }
+      f.count = vertex_count() - f.first;
+      f.ring_first = vertex_count();
+      for (const Vec2& p : ring) vertex(Vec3(p.x(), p.y(), zt), up, t);
+      f.ring_count = vertex_count() - f.ring_first;
+    }
+  }
+
+  // Flat-shaded hull; upward faces in the upper half are the deck. Winding is not trusted (meshes come from any
+  // tool): two-sided lighting turns every normal towards the viewer.
+  void build_hull() {
+    const auto& v = r.hull_vertices_m;
+    const auto& t = r.hull_triangles;
+    FLOESIM_REQUIRE(v.size() % 3 == 0 && t.size() % 3 == 0, source, ": /geometry hull arrays have bad shapes");
+    const size_t nv = v.size() / 3;
+    float hull[3], deck[3];
+    parse_hex_colour(o.hull_colour, hull);
+    parse_hex_colour(o.deck_colour, deck);
+    double zmin = 1e300, zmax = -1e300;
+    for (size_t i = 0; i < nv; ++i) {
+      zmin = std::min(zmin, v[3 * i + 2]);
+      zmax = std::max(zmax, v[3 * i + 2]);
+      hull_radius = std::max(hull_radius, Vec3(v[3 * i], v[3 * i + 1], v[3 * i + 2]).norm());
+    }
+    hull_first = vertex_count();
+    for (size_t k = 0; k < t.size() / 3; ++k) {
+      Vec3 p[3];
+      for (int j = 0; j < 3; ++j) {
+        const int32_t i = t[3 * k + j];
+        FLOESIM_REQUIRE(i >= 0 && static_cast<size_t>(i) < nv, source, ": hull triangle ", k, " uses vertex ", i,
+                        " of ", nv);
+        p[j] = Vec3(v[3 * i], v[3 * i + 1], v[3 * i + 2]);
+      }
+      Vec3 n = (p[1] - p[0]).cross(p[2] - p[0]);
+      if (n.norm() <= 0) continue;  // degenerate sliver: nothing to draw
+      n.normalize();
+      const bool is_deck = std::abs(n.z()) > 0.8 && (p[0].z() + p[1].z() + p[2].z()) / 3 > (zmin + zmax) / 2;
+      for (const Vec3& q : p) vertex(q, n, is_deck ? deck : hull);
+    }
+    hull_count = vertex_count() - hull_first;
+  }
+
+  void build_water_grid() {
+    const int n = 48;  // cells per side; fog is affine in position, so this only bounds its clamping error
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        const float x0 = -1 + 2.f * i / n, x1 = -1 + 2.f * (i + 1) / n, y0 = -1 + 2.f * j / n,
+                    y1 = -1 + 2.f * (j + 1) / n;
+        water_grid.insert(water_grid.end(), {x0, y0, 0, x1, y0, 0, x1, y1, 0, x0, y0, 0, x1, y1, 0, x0, y1, 0});
+      }
+  }
+
+  void setup_gl() {
+    gl.Enable(GL_DEPTH_TEST);
+    gl.DepthFunc(GL_LEQUAL);
+    gl.Enable(GL_LIGHTING);
+    gl.Enable(GL_LIGHT0);
+    gl.LightModeli(GL_LIGHT_MODEL_TWO_SIDE, 1);
+    // Overcast arctic light: a strong ambient term keeps shaded floe sides readable, the sun gives them relief.
+    const float ambient[4] = {0.42f, 0.43f, 0.45f, 1}, diffuse[4] = {0.62f, 0.61f, 0.58f, 1},
+                zero[4] = {0, 0, 0, 1};
+    gl.LightModelfv(GL_LIGHT_MODEL_AMBIENT, ambient);
+    gl.Lightfv(GL_LIGHT0, GL_AMBIENT, zero);
+    gl.Lightfv(GL_LIGHT0, GL_DIFFUSE, diffuse);
+    gl.Lightfv(GL_LIGHT0, GL_SPECULAR, zero);
+    gl.Enable(GL_COLOR_MATERIAL);
+    gl.ColorMaterial(GL_FRONT_AND_BACK, GL_AMBIENT_AND_DIFFUSE);
+    gl.ShadeModel(GL_FLAT);
+    gl.Fogi(GL_FOG_MODE, GL_LINEAR);
+    const float fogc[4] = {sky[0], sky[1], sky[2], 1};
+    gl.Fogfv(GL_FOG_COLOR, fogc);
+    gl.Fogf(GL_FOG_START, static_cast<float>(0.3 * o.view_distance_m));
+    gl.Fogf(GL_FOG_END, static_cast<float>(o.view_distance_m));
+    gl.Hint(GL_FOG_HINT, GL_NICEST);
+    gl.PolygonOffset(1.0f, 1.0f);  // faces slightly back so that outlines drawn at the same depth show
+    gl.LineWidth(static_cast<float>(std::max(1.0, 0.75 * o.supersample)));
+    gl.Viewport(0, 0, ctx.width(), ctx.height());
+  }
+
+  Vec3 vessel_position(size_t k) const { return Vec3(&r.state_position_m[3 * vessel_row[k]]); }
+  const double* vessel_quaternion(size_t k) const { return &r.state_quaternion[4 * vessel_row[k]]; }
+
+  // Camera matrices in camera-relative world coordinates (origin = vessel's horizontal position), so that floats
+  // in GL keep millimetres even kilometres from the world origin.
+  void camera(size_t k, Mat4& proj, Mat4& view, Vec3& eye) const {
+    const double aspect = double(o.width_px) / o.height_px;
+    if (o.view == "top") {
+      const double altitude = 1000;
+      eye = Vec3(0, 0, altitude);
+      view = look_at(eye, Vec3(0, 0, 0), Vec3(0, 1, 0));
+      proj = ortho(o.top_width_m / 2, o.top_width_m / 2 / aspect, 1, altitude + 500);
+      return;
+    }
+    const Mat4 m = pose_matrix(vessel_quaternion(k), Vec3::Zero());
+    Vec2 fwd(m(0, 0), m(1, 0));  // body x axis in the world, horizontal part
+    fwd = fwd.norm() > 1e-6 ? fwd.normalized() : Vec2(1, 0);
+    const Vec3 f(fwd.x(), fwd.y(), 0);
+    const double pitch = o.chase_pitch_deg * kPi / 180;
+    eye = -o.chase_distance_m * f + Vec3(0, 0, o.chase_height_m);
+    const Vec3 dir = std::cos(pitch) * f - std::sin(pitch) * Vec3::UnitZ();
+    const Vec3 up = o.chase_pitch_deg > 89.9 ? f : Vec3(0, 0, 1);
+    view = look_at(eye, eye + dir, up);
+    proj = perspective(o.fov_deg * kPi / 180, aspect, 0.5, o.view_distance_m);
+  }
+
+  void draw(size_t k) {
+    Mat4 proj, view;
+    Vec3 eye;
+    camera(k, proj, view, eye);
+    const Vec3 vp = vessel_position(k);
+    const Vec3 origin(vp.x(), vp.y(), 0);
+    const bool chase = o.view == "chase";
+
+    gl.ClearColor(sky[0], sky[1], sky[2], 1);
+    gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    gl.MatrixMode(GL_PROJECTION);
+    gl.LoadMatrixd(proj.data());
+    gl.MatrixMode(GL_MODELVIEW);
+    gl.LoadMatrixd(view.data());
+    // Sun from the south-west, 50 degrees up (a world direction: set while the modelview is the view matrix).
+    const float sun[4] = {-0.42f, -0.50f, 0.76f, 0};
+    gl.Lightfv(GL_LIGHT0, GL_POSITION, sun);
+    if (chase && o.fog) gl.Enable(GL_FOG);
+    else gl.Disable(GL_FOG);
+
+    // Water: an unlit grid under the camera. A grid, not one big quad: fixed-function fog is computed per vertex,
+    // and a quad whose corners all lie beyond the fog end would be fogged away entirely.
+    gl.Disable(GL_LIGHTING);
+    gl.EnableClientState(GL_VERTEX_ARRAY);
+    {
+      const double s = chase ? 1.5 * o.view_distance_m : o.top_width_m;
+      Mat4 t = Mat4::Identity();
+      t(0, 0) = t(1, 1) = s;
+      t(0, 3) = eye.x();
+      t(1, 3) = eye.y();
+      const Mat4 mv = view * t;
+      gl.LoadMatrixd(mv.data());
+      gl.VertexPointer(3, GL_FLOAT, 0, water_grid.data());
+      gl.Color4f(water[0], water[1], water[2], 1);
+      gl.DrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(water_grid.size() / 3));
+    }
+
+    // Floes: one draw per visible floe with its pose; the arrays never change.
+    gl.Enable(GL_LIGHTING);
+    gl.VertexPointer(3, GL_FLOAT, 0, pos.data());
+    gl.EnableClientState(GL_NORMAL_ARRAY);
+    gl.NormalPointer(GL_FLOAT, 0, nrm.data());
+    gl.EnableClientState(GL_COLOR_ARRAY);
+    gl.ColorPointer(4, GL_UNSIGNED_BYTE, 0, col.data());
+    gl.Enable(GL_POLYGON_OFFSET_FILL);
+    const Frustum frustum(proj * view);
+    stats = FrameStats{};
+    visible.clear();
+    for (int64_t row = r.frame_offset[k]; row < r.frame_offset[k + 1]; ++row) {
+      const int32_t g = row_floe[row];
+      if (g < 0) continue;
+      const Vec3 c = Vec3(&r.state_position_m[3 * row]) - origin;
+      if (frustum.outside(c, floes[g].radius)) {
+        ++stats.floes_culled;
+        continue;
+      }
+      ++stats.floes_drawn;
+      const Mat4 mv = view * pose_matrix(&r.state_quaternion[4 * row], c);
+      gl.LoadMatrixd(mv.data());
+      gl.DrawArrays(GL_TRIANGLES, floes[g].first, floes[g].count);
+      if (o.floe_edges) visible.push_back({static_cast<size_t>(g), mv});
+    }
+    gl.Disable(GL_POLYGON_OFFSET_FILL);
+
+    // Outlines: unlit lines over the top faces.
+    if (!visible.empty()) {
+      gl.Disable(GL_LIGHTING);
+      gl.DisableClientState(GL_NORMAL_ARRAY);
+      gl.DisableClientState(GL_COLOR_ARRAY);
+      gl.Color4f(edge[0], edge[1], edge[2], 1);
+      for (const auto& [g, mv] : visible) {
+        gl.LoadMatrixd(mv.data());
+        gl.DrawArrays(GL_LINE_LOOP, floes[g].ring_first, floes[g].ring_count);
+      }
+      gl.Enable(GL_LIGHTING);
+      gl.EnableClientState(GL_NORMAL_ARRAY);
+      gl.EnableClientState(GL_COLOR_ARRAY);
+    }
+
+    // Hull.
+    if (hull_count > 0) {
+      const Mat4 mv = view * pose_matrix(vessel_quaternion(k), vp - origin);
+      gl.LoadMatrixd(mv.data());
+      gl.DrawArrays(GL_TRIANGLES, hull_first, hull_count);
+    }
+    gl.DisableClientState(GL_COLOR_ARRAY);
+    gl.DisableClientState(GL_NORMAL_ARRAY);
+    gl.DisableClientState(GL_VERTEX_ARRAY);
+    const GLenum err = gl.GetError();
+    FLOESIM_REQUIRE(err == GL_NO_ERROR, "OpenGL error 0x", std::hex, err, " while drawing frame ", std::dec, k);
+  }
+
+  // Vessel speed over ground from the stored frames (centred difference where possible).
+  double speed(size_t k) const {
+    if (r.frames() < 2) return std::nan("");
+    const size_t a = k == 0 ? 0 : k - 1, b = std::min(k + 1, r.frames() - 1);
+    const double dt = r.frame_time_s[b] - r.frame_time_s[a];
+    if (!(dt > 0)) return std::nan("");
+    const Vec3 d = vessel_position(b) - vessel_position(a);
+    return std::hypot(d.x(), d.y()) / dt;
+  }
+
+  void overlay(size_t k, cv::Mat& img) const {
+    const double s = img.rows / 720.0;  // text scales with the frame
+    const int font = cv::FONT_HERSHEY_SIMPLEX;
+    const int thick = std::max(1, int(std::lround(1.6 * s)));
+    std::vector<std::string> lines = {"t = " + fmt("%.2f s", r.frame_time_s[k]),
+                                      "frame " + std::to_string(k + 1) + " / " + std::to_string(r.frames())};
+    const double v = speed(k);
+    if (std::isfinite(v)) lines.push_back("speed " + fmt("%.2f m/s", v) + " (" + fmt("%.1f kn", v * 3600 / 1852) + ")");
+    const double scales[3] = {0.9 * s, 0.6 * s, 0.6 * s};
+    int w = 0, h = int(12 * s);
+    std::vector<int> heights;
+    for (size_t i = 0; i < lines.size(); ++i) {
+      int base = 0;
+      const cv::Size sz = cv::getTextSize(lines[i], font, scales[i], thick, &base);
+      w = std::max(w, sz.width);
+      heights.push_back(sz.height);
+      h += sz.height + int(12 * s);
+    }
+    const cv::Rect box(int(16 * s), int(16 * s), w + int(28 * s), h);
+    cv::Mat roi = img(box & cv::Rect(0, 0, img.cols, img.rows));
+    roi *= 0.45;  // darken: translucent panel, readable on ice and on water
+    int y = box.y + int(12 * s);
+    for (size_t i = 0; i < lines.size(); ++i) {
+      y += heights[i];
+      cv::putText(img, lines[i], {box.x + int(14 * s), y}, font, scales[i], cv::Scalar(255, 255, 255), thick,
+                  cv::LINE_AA);
+      y += int(12 * s);
+    }
+    if (o.view == "top") {
+      // Scale bar of a round length near 15 % of the width, and a north arrow.
+      const double px_per_m = img.cols / o.top_width_m;
+      const double target = 0.15 * img.cols / px_per_m;
+      double len = std::pow(10.0, std::floor(std::log10(target)));
+      for (double m : {5.0, 2.0})
+        if (len * m <= target) {
+          len *= m;
+          break;
+        }
+      const int x0 = int(24 * s), y0 = img.rows - int(28 * s), x1 = x0 + int(std::lround(len * px_per_m));
+      cv::rectangle(img, {x0 - int(8 * s), y0 - int(34 * s)}, {x1 + int(8 * s), y0 + int(12 * s)},
+                    cv::Scalar(20, 20, 20), cv::FILLED);
+      cv::rectangle(img, {x0, y0 - int(4 * s)}, {x1, y0 + int(4 * s)}, cv::Scalar(255, 255, 255), cv::FILLED);
+      cv::putText(img, fmt("%g m", len), {x0, y0 - int(12 * s)}, font, 0.6 * s, cv::Scalar(255, 255, 255), thick,
+                  cv::LINE_AA);
+      const cv::Point n0(img.cols - int(40 * s), int(80 * s)), n1(img.cols - int(40 * s), int(30 * s));
+      cv::arrowedLine(img, n0, n1, cv::Scalar(255, 255, 255), std::max(2, thick), cv::LINE_AA, 0, 0.35);
+      cv::putText(img, "N", {n0.x - int(9 * s), n0.y + int(24 * s)}, font, 0.6 * s, cv::Scalar(255, 255, 255), thick,
+                  cv::LINE_AA);
+    }
+  }
+};
+
+SceneRenderer::SceneRenderer(const Results& r, const RenderOptions& o, const std::string& source)
+    : impl_(std::make_unique<Impl>(r, o, source)) {}
+
+SceneRenderer::~SceneRenderer() = default;
+
+void SceneRenderer::render(size_t frame, cv::Mat& out) {
+  FLOESIM_REQUIRE(frame < impl_->r.frames(), "internal: frame ", frame, " of ", impl_->r.frames());
+  impl_->draw(frame);
+  cv::Mat big;
+  impl_->ctx.read_bgr(big);
+  if (impl_->o.supersample > 1)
+    cv::resize(big, out, cv::Size(impl_->o.width_px, impl_->o.height_px), 0, 0, cv::INTER_AREA);
+  else
+    out = big;
+  if (impl_->o.overlay) impl_->overlay(frame, out);
+}
+
+const FrameStats& SceneRenderer::last_stats() const { return impl_->stats; }
+
+std::string SceneRenderer::gl_renderer() const { return impl_->ctx.renderer(); }
+
+cv::Point2d top_view_pixel(const Results& r, const RenderOptions& o, size_t frame, double x_m, double y_m) {
+  FLOESIM_REQUIRE(frame < r.frames(), "internal: frame ", frame, " of ", r.frames());
+  double vx = 0, vy = 0;
+  for (int64_t row = r.frame_offset[frame]; row < r.frame_offset[frame + 1]; ++row)
+    if (r.state_body_id[row] == 0) vx = r.state_position_m[3 * row], vy = r.state_position_m[3 * row + 1];
+  const double px_per_m = o.width_px / o.top_width_m;
+  return {o.width_px / 2.0 + (x_m - vx) * px_per_m, o.height_px / 2.0 - (y_m - vy) * px_per_m};
+}
+
+}  // namespace floesim::render

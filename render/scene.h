@@ -1,0 +1,43 @@
+// Draws one results frame: water, floe slabs, the hull, seen from a camera that follows the vessel. All geometry
+// comes from the results file; the floe slabs and the hull are built once, in their body frames, and each body is
+// drawn with its pose for the frame (a matrix per floe, no per-frame geometry work).
+#pragma once
+#include <memory>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "pipeline/results_io.h"
+#include "render/render_options.h"
+
+namespace floesim::render {
+
+struct FrameStats {
+  size_t floes_drawn = 0;   // passed the frustum test
+  size_t floes_culled = 0;  // outside the view, not drawn
+};
+
+class SceneRenderer {
+ public:
+  // Checks the geometry and the states (errors name `source`, the results file), builds the vertex arrays and
+  // creates the off-screen context. `r` must outlive the renderer.
+  SceneRenderer(const Results& r, const RenderOptions& o, const std::string& source);
+  ~SceneRenderer();
+  SceneRenderer(const SceneRenderer&) = delete;
+  SceneRenderer& operator=(const SceneRenderer&) = delete;
+
+  // Renders results frame k into `out` (8-bit BGR, width_px x height_px, overlay included).
+  void render(size_t frame, cv::Mat& out);
+  const FrameStats& last_stats() const;
+  std::string gl_renderer() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// The pixel at which the top view shows world point (x, y) in results frame `frame` (for tests and overlays):
+// the view is centred on the vessel, north up, top_width_m across.
+cv::Point2d top_view_pixel(const Results& r, const RenderOptions& o, size_t frame, double x_m, double y_m);
+
+}  // namespace floesim::render

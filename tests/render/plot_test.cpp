@@ -1,0 +1,119 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "pipeline/error.h"
+#include "pipeline/results_io.h"
+#include "render/plot.h"
+#include "synthetic_results.h"
+
+using namespace floesim;
+using namespace floesim::render;
+using namespace floesim::render::testing;
+namespace fs = std::filesystem;
+
+namespace {
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+fs::path write_config(const fs::path& dir, const std::string& text) {
+  const fs::path p = dir / "plot.config.json";
+  std::ofstream(p) << text;
+  return p;
+}
+}  // namespace
+
+TEST(Plot, WritesPngSvgCsvAndTheSteadyMean) {
+  const fs::path dir = fresh_dir("plot_ok");
+  Results r = make_results(default_synthetic());
+  r.attributes["contact_model"] = "compliant";
+  r.attributes["steady_start_s"] = 5.025;
+  write_results(dir / "results.h5", r);
+  const fs::path cfg = write_config(dir, "{}");
+
+  const SurgeLoadSummary s = plot_surge_load(dir / "results.h5", cfg, dir / "plots");
+  // Resistance is -Fx in kN; the alternation cancels over the 300 steady steps.
+  EXPECT_NEAR(s.mean_kN, 1000.0, 1e-9);
+  EXPECT_EQ(s.steady_samples, 300u);
+  EXPECT_DOUBLE_EQ(s.steady_start_s, 5.025);
+  EXPECT_EQ(s.contact_model, "compliant");
+  EXPECT_DOUBLE_EQ(s.window_s, 0.5);  // "auto" for compliant contacts
+  EXPECT_EQ(s.window_samples, 10u);
+  EXPECT_NEAR(s.time_step_s, 0.05, 1e-12);
+  // The even window cancels the +-300 kN alternation: the steady moving average is flat at 1000 kN, except within
+  // half a window of the end (cut window) -- so its maximum is close to 1000 and its spread small.
+  EXPECT_NEAR(s.moving_average_max_kN, 1000.0, 60.0);
+  EXPECT_LT(s.moving_average_std_kN, 60.0);  // the 200 -> 1000 kN step smears into the first samples
+  EXPECT_NEAR(s.raw_max_kN, 1300.0, 1e-9);
+
+  const cv::Mat png = cv::imread((dir / "plots" / "surge_ice_load.png").string());
+  ASSERT_FALSE(png.empty());
+  EXPECT_EQ(png.cols, 1400);
+  EXPECT_EQ(png.rows, 650);
+  cv::Scalar mean, sd;
+  cv::meanStdDev(png, mean, sd);
+  EXPECT_GT(sd[0], 10.0) << "the PNG is blank";
+  const std::string svg = slurp(dir / "plots" / "surge_ice_load.svg");
+  EXPECT_GT(svg.size(), 5000u);
+  EXPECT_NE(svg.find("<svg"), std::string::npos);
+  EXPECT_NE(svg.find("1000 kN"), std::string::npos) << "the legend states the mean";
+
+  const std::string csv = slurp(dir / "plots" / "surge_ice_load.csv");
+  EXPECT_EQ(csv.rfind("time_s,ice_resistance_kN,moving_average_kN\n", 0), 0u);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 401);
+
+  const auto j = nlohmann::json::parse(slurp(dir / "plots" / "plot.json"));
+  EXPECT_NEAR(j["mean_kN"].get<double>(), 1000.0, 1e-9);
+  EXPECT_EQ(j["moving_average"]["window_samples"], 10);
+  EXPECT_EQ(j["provenance"]["program"], "floesim-plot");
+  // Only the artefacts are left: no working files.
+  EXPECT_EQ(listing(dir / "plots"), (std::vector<std::string>{"plot.json", "surge_ice_load.csv",
+                                                               "surge_ice_load.png", "surge_ice_load.svg"}));
+  fs::remove_all(dir);
+}
+
+TEST(Plot, AutoWindowIsTwentySecondsForRigidOrUnknownContactsAndOptionsOverride) {
+  const fs::path dir = fresh_dir("plot_auto");
+  write_results(dir / "results.h5", make_results(default_synthetic()));  // no contact_model, no steady_start_s
+  const SurgeLoadSummary s = plot_surge_load(dir / "results.h5", write_config(dir, "{}"), dir / "a");
+  EXPECT_DOUBLE_EQ(s.window_s, 20.0);
+  EXPECT_EQ(s.window_samples, 400u);
+  EXPECT_DOUBLE_EQ(s.steady_start_s, 0.0);
+  EXPECT_EQ(s.steady_samples, 400u);
+  EXPECT_NEAR(s.mean_kN, (100 * 200.0 + 300 * 1000.0) / 400.0, 1e-9);
+
+  const SurgeLoadSummary o = plot_surge_load(
+      dir / "results.h5", write_config(dir, R"({"moving_average_window_s": 1.0, "steady_start_s": 5.025})"),
+      dir / "b");
+  EXPECT_EQ(o.window_samples, 20u);
+  EXPECT_NEAR(o.mean_kN, 1000.0, 1e-9);
+  fs::remove_all(dir);
+}
+
+TEST(Plot, BadInputNamesTheProblemAndLeavesNothing) {
+  const fs::path dir = fresh_dir("plot_bad");
+  write_results(dir / "results.h5", make_results(default_synthetic()));
+  auto expect_error = [&](const fs::path& results, const fs::path& cfg, const std::string& needle) {
+    try {
+      plot_surge_load(results, cfg, dir / "out");
+      ADD_FAILURE() << "no error; expected one mentioning " << needle;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(dir / "out")) << "a failed run left output behind";
+  };
+  expect_error(dir / "missing.h5", write_config(dir, "{}"), "missing.h5");
+  expect_error(dir / "results.h5", write_config(dir, R"({"window_s": 2})"), "window_s");
+  expect_error(dir / "results.h5", write_config(dir, R"({"moving_average_window_s": "long"})"),
+               "moving_average_window_s");
+  expect_error(dir / "results.h5", write_config(dir, R"({"steady_start_s": 1e6})"), "steady");
+  fs::remove_all(dir);
+}

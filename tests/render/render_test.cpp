@@ -1,0 +1,202 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "pipeline/error.h"
+#include "pipeline/results_io.h"
+#include "render/scene.h"
+#include "render/video.h"
+#include "synthetic_results.h"
+
+using namespace floesim;
+using namespace floesim::render;
+using namespace floesim::render::testing;
+namespace fs = std::filesystem;
+
+namespace {
+
+RenderOptions small_top_view() {
+  RenderOptions o;
+  o.width_px = 320;
+  o.height_px = 180;
+  o.view = "top";
+  o.top_width_m = 200;  // 1.6 px/m
+  o.overlay = false;    // pixel checks below must not hit the text panel
+  return o;
+}
+
+fs::path write_json(const fs::path& p, const nlohmann::json& j) {
+  std::ofstream(p) << j.dump(2);
+  return p;
+}
+
+// Mean BGR over a 5 x 5 patch (robust to the encoder's chroma subsampling and edges).
+cv::Vec3d patch(const cv::Mat& img, cv::Point2d c) {
+  const cv::Rect r(int(std::lround(c.x)) - 2, int(std::lround(c.y)) - 2, 5, 5);
+  const cv::Scalar m = cv::mean(img(r & cv::Rect(0, 0, img.cols, img.rows)));
+  return {m[0], m[1], m[2]};
+}
+bool bright(const cv::Vec3d& c) { return c[0] > 170 && c[1] > 170 && c[2] > 170; }
+bool dark(const cv::Vec3d& c) { return c[0] < 90 && c[1] < 90 && c[2] < 90; }
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+TEST(Render, TopViewShowsFloesWhereTheyAreAndWaterElsewhere) {
+  const Results r = make_results(default_synthetic());
+  const RenderOptions o = small_top_view();
+  SceneRenderer scene(r, o, "synthetic");
+  cv::Mat img;
+  scene.render(0, img);
+  ASSERT_EQ(img.cols, 320);
+  ASSERT_EQ(img.rows, 180);
+  ASSERT_EQ(img.type(), CV_8UC3);
+  const auto px = [&](double x, double y) { return top_view_pixel(r, o, 0, x, y); };
+  EXPECT_TRUE(bright(patch(img, px(60, 0)))) << "floe 1 centre: " << patch(img, px(60, 0));
+  EXPECT_TRUE(bright(patch(img, px(60, 40)))) << "floe 2 centre: " << patch(img, px(60, 40));
+  EXPECT_TRUE(dark(patch(img, px(30, -40)))) << "open water: " << patch(img, px(30, -40));
+  EXPECT_TRUE(dark(patch(img, px(80, 20)))) << "water between floes: " << patch(img, px(80, 20));
+  // The U-shaped floe (non-convex, at 100, -45): ice in its arms, water in its notch (a triangle fan would fill it).
+  EXPECT_TRUE(bright(patch(img, px(100 - 10, -45)))) << "left arm: " << patch(img, px(90, -45));
+  EXPECT_TRUE(bright(patch(img, px(100, -45 - 10)))) << "base: " << patch(img, px(100, -55));
+  EXPECT_TRUE(dark(patch(img, px(100, -45 + 7)))) << "notch: " << patch(img, px(100, -38));
+  // The hull (deck, grey) at the centre: neither water nor ice.
+  const cv::Vec3d deck = patch(img, px(0, 0));
+  EXPECT_FALSE(dark(deck)) << deck;
+  EXPECT_FALSE(bright(deck)) << deck;
+  EXPECT_EQ(scene.last_stats().floes_drawn + scene.last_stats().floes_culled, 5u);
+  EXPECT_EQ(scene.last_stats().floes_culled, 1u) << "the floe at x = 150 m lies outside the 200 m wide view";
+}
+
+TEST(Render, ChaseViewShowsSkyWaterIceAndTheRedHull) {
+  const Results r = make_results(default_synthetic());
+  RenderOptions o;
+  o.width_px = 320;
+  o.height_px = 180;
+  o.supersample = 1;
+  SceneRenderer scene(r, o, "synthetic");
+  cv::Mat img;
+  scene.render(3, img);
+  cv::Scalar mean, sd;
+  cv::meanStdDev(img, mean, sd);
+  EXPECT_GT(sd[0] + sd[1] + sd[2], 40.0) << "frame is uniform (black?)";
+  size_t red = 0, ice = 0, water = 0;
+  for (int y = 0; y < img.rows; ++y)
+    for (int x = 0; x < img.cols; ++x) {
+      const cv::Vec3b c = img.at<cv::Vec3b>(y, x);  // BGR
+      if (c[2] > c[1] + 50 && c[2] > c[0] + 50) ++red;
+      if (c[0] > 200 && c[1] > 200 && c[2] > 200) ++ice;
+      if (c[0] < 80 && c[1] < 80 && c[2] < 80) ++water;
+    }
+  EXPECT_GT(red, 30u) << "the hull is not visible";
+  EXPECT_GT(ice, 100u) << "no floe is visible";
+  EXPECT_GT(water, 1000u) << "no water is visible";
+}
+
+TEST(Render, VideoHasOneFramePerResultsFrameAndShowsTheScene) {
+  const fs::path dir = fresh_dir("video");
+  const Results r = make_results(default_synthetic());
+  write_results(dir / "results.h5", r);
+  RenderOptions o = small_top_view();
+  const auto cfg = write_json(dir / "render.json", options_to_json(o));
+  const RenderStats st = render_video(dir / "results.h5", cfg, dir / "out" / "transit.mp4");
+  EXPECT_EQ(st.frames, 12u);
+
+  cv::VideoCapture cap((dir / "out" / "transit.mp4").string(), cv::CAP_FFMPEG);
+  ASSERT_TRUE(cap.isOpened());
+  EXPECT_EQ(cap.get(cv::CAP_PROP_FRAME_WIDTH), 320);
+  EXPECT_EQ(cap.get(cv::CAP_PROP_FRAME_HEIGHT), 180);
+  EXPECT_EQ(cap.get(cv::CAP_PROP_FRAME_COUNT), 12);
+  std::vector<cv::Mat> frames;
+  for (cv::Mat f; cap.read(f);) frames.push_back(f.clone());
+  ASSERT_EQ(frames.size(), r.frames()) << "one video frame per results frame";
+
+  // Floe 1 (x = 60 m) is under its expected pixel in the first and the last frame although the camera moved
+  // with the vessel (22 m in 11 s); water is where no floe is.
+  for (size_t k : {size_t(0), frames.size() - 1}) {
+    EXPECT_TRUE(bright(patch(frames[k], top_view_pixel(r, o, k, 60, 0)))) << "frame " << k;
+    EXPECT_TRUE(dark(patch(frames[k], top_view_pixel(r, o, k, 30, -40)))) << "frame " << k;
+  }
+  // The vessel moved, so the picture did.
+  cv::Mat diff;
+  cv::absdiff(frames.front(), frames.back(), diff);
+  EXPECT_GT(cv::mean(diff)[0] + cv::mean(diff)[1] + cv::mean(diff)[2], 5.0);
+  cv::absdiff(frames[0], frames[1], diff);
+  EXPECT_GT(cv::norm(diff, cv::NORM_L1), 0.0) << "consecutive frames are identical although the vessel moves";
+
+  const auto side = nlohmann::json::parse(slurp(dir / "out" / "transit.json"));
+  EXPECT_EQ(side["frames"], 12);
+  EXPECT_EQ(side["provenance"]["program"], "floesim-render");
+  EXPECT_EQ(listing(dir / "out"), (std::vector<std::string>{"transit.json", "transit.mp4"}));
+  fs::remove_all(dir);
+}
+
+TEST(Render, MaxFramesLimitsTheVideoAndStillFrameWritesAnImage) {
+  const fs::path dir = fresh_dir("maxframes");
+  write_results(dir / "results.h5", make_results(default_synthetic()));
+  const auto cfg = write_json(dir / "render.json", {{"width_px", 160}, {"height_px", 90}, {"max_frames", 5}});
+  EXPECT_EQ(render_video(dir / "results.h5", cfg, dir / "v.mp4").frames, 5u);
+  cv::VideoCapture cap((dir / "v.mp4").string(), cv::CAP_FFMPEG);
+  int n = 0;
+  for (cv::Mat f; cap.read(f);) ++n;
+  EXPECT_EQ(n, 5);
+
+  render_still(dir / "results.h5", cfg, 7, dir / "still.png");
+  const cv::Mat still = cv::imread((dir / "still.png").string());
+  ASSERT_FALSE(still.empty());
+  EXPECT_EQ(still.size(), cv::Size(160, 90));
+  EXPECT_THROW(render_still(dir / "results.h5", cfg, 12, dir / "bad.png"), Error);
+  EXPECT_FALSE(fs::exists(dir / "bad.png"));
+  fs::remove_all(dir);
+}
+
+TEST(Render, BadInputNamesTheFileOrKeyAndLeavesNothing) {
+  const fs::path dir = fresh_dir("bad");
+  write_results(dir / "results.h5", make_results(default_synthetic()));
+  std::ofstream(dir / "not_hdf5.h5") << "this is not an HDF5 file\n";
+  const auto good = write_json(dir / "good.json", {{"width_px", 160}, {"height_px", 90}});
+  const fs::path out = dir / "out";  // must not even be created by a failed run
+  auto expect_error = [&](const fs::path& results, const fs::path& cfg, const fs::path& video,
+                          const std::vector<std::string>& needles) {
+    try {
+      render_video(results, cfg, video);
+      ADD_FAILURE() << "no error; expected one mentioning " << needles.front();
+    } catch (const Error& e) {
+      for (const auto& n : needles) EXPECT_NE(std::string(e.what()).find(n), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(out)) << "a failed run left output behind";
+  };
+  expect_error(dir / "missing.h5", good, out / "v.mp4", {"missing.h5"});
+  expect_error(dir / "not_hdf5.h5", good, out / "v.mp4", {"not_hdf5.h5", "HDF5"});
+  expect_error(dir / "results.h5", write_json(dir / "typo.json", {{"widht_px", 640}}), out / "v.mp4",
+               {"typo.json", "widht_px"});
+  expect_error(dir / "results.h5", write_json(dir / "fps.json", {{"fps", 0}}), out / "v.mp4", {"fps.json", "fps"});
+  expect_error(dir / "results.h5", write_json(dir / "odd.json", {{"width_px", 321}}), out / "v.mp4",
+               {"width_px", "even"});
+  expect_error(dir / "results.h5", good, out / "v.avi", {"v.avi", ".mp4"});
+  expect_error(dir / "results.h5", dir / "no_config.json", out / "v.mp4", {"no_config.json"});
+  fs::remove_all(dir);
+}
+
+TEST(Render, InconsistentResultsAreRefusedWithTheBodyNamed) {
+  Results r = make_results(default_synthetic());
+  r.state_body_id[3] = 99;  // a floe with no geometry
+  try {
+    SceneRenderer scene(r, small_top_view(), "runs/x/results.h5");
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("99"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("runs/x/results.h5"), std::string::npos) << e.what();
+  }
+}

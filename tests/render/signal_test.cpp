@@ -1,0 +1,87 @@
+#include <gtest/gtest.h>
+
+#include "pipeline/error.h"
+#include "render/signal.h"
+
+using namespace floesim;
+using namespace floesim::render;
+
+namespace {
+std::vector<double> ramp(size_t n, double a, double b) {
+  std::vector<double> x(n);
+  for (size_t i = 0; i < n; ++i) x[i] = a + b * static_cast<double>(i);
+  return x;
+}
+}  // namespace
+
+TEST(Signal, WindowSamplesRoundsAndIsAtLeastOne) {
+  EXPECT_EQ(window_samples(20.0, 0.01), 2000u);
+  EXPECT_EQ(window_samples(0.5, 0.05), 10u);
+  EXPECT_EQ(window_samples(0.5, 0.3), 2u);    // 1.67 rounds to 2
+  EXPECT_EQ(window_samples(0.001, 0.01), 1u);
+  EXPECT_EQ(window_samples(0.0, 0.01), 1u);
+  EXPECT_THROW(window_samples(1.0, 0.0), Error);
+}
+
+TEST(Signal, MovingAverageOfAConstantIsTheConstantEverywhere) {
+  const std::vector<double> x(101, 973.25);
+  for (size_t n : {1u, 2u, 7u, 10u, 50u, 101u, 500u}) {
+    for (const auto& y : {moving_average_centred(x, n), moving_average_causal(x, n)}) {
+      ASSERT_EQ(y.size(), x.size());
+      for (double v : y) EXPECT_NEAR(v, 973.25, 1e-9) << "window " << n;
+    }
+  }
+}
+
+TEST(Signal, WindowOneIsTheIdentity) {
+  const std::vector<double> x = {3, -1, 4, 1, -5, 9, 2, 6};
+  EXPECT_EQ(moving_average_centred(x, 1), x);
+  EXPECT_EQ(moving_average_causal(x, 1), x);
+}
+
+TEST(Signal, CentredAverageOfARampIsTheRampInTheInterior) {
+  const auto x = ramp(200, -3.0, 0.25);
+  for (size_t n : {3u, 4u, 9u, 10u, 51u}) {  // odd and even windows: both centred, no lag
+    const auto y = moving_average_centred(x, n);
+    for (size_t i = n / 2; i + n / 2 < x.size(); ++i) EXPECT_NEAR(y[i], x[i], 1e-9) << "window " << n << " i " << i;
+    // At the ends the window is cut short on one side, so the average is pulled inwards.
+    EXPECT_GT(y.front(), x.front());
+    EXPECT_LT(y.back(), x.back());
+  }
+}
+
+TEST(Signal, CausalAverageOfARampLagsByHalfTheWindow) {
+  const auto x = ramp(100, 0.0, 2.0);
+  const size_t n = 10;
+  const auto y = moving_average_causal(x, n);
+  for (size_t i = n - 1; i < x.size(); ++i) EXPECT_NEAR(y[i], x[i] - 2.0 * (n - 1) / 2.0, 1e-9);
+  EXPECT_DOUBLE_EQ(y[0], x[0]);
+  EXPECT_NEAR(y[3], (0 + 2 + 4 + 6) / 4.0, 1e-12);  // first samples: mean of what exists
+}
+
+TEST(Signal, EvenCentredWindowRemovesAnAlternationExactly) {
+  // +-1 alternation: the half-weighted end samples make an even window cancel it (an odd one leaves 1/N).
+  std::vector<double> x(60);
+  for (size_t i = 0; i < x.size(); ++i) x[i] = 5.0 + (i % 2 ? 1.0 : -1.0);
+  const auto y = moving_average_centred(x, 10);
+  for (size_t i = 5; i + 5 < x.size(); ++i) EXPECT_NEAR(y[i], 5.0, 1e-12);
+  const auto z = moving_average_centred(x, 9);
+  for (size_t i = 4; i + 4 < x.size(); ++i) EXPECT_NEAR(std::abs(z[i] - 5.0), 1.0 / 9.0, 1e-12);
+}
+
+TEST(Signal, MeanOverTheSteadyPart) {
+  std::vector<double> t, x;
+  for (int i = 0; i < 10; ++i) t.push_back(i), x.push_back(i * i);
+  const SteadyMean m = mean_from(t, x, 6.0);  // 36, 49, 64, 81
+  EXPECT_EQ(m.samples, 4u);
+  EXPECT_DOUBLE_EQ(m.mean, (36 + 49 + 64 + 81) / 4.0);
+  EXPECT_DOUBLE_EQ(mean_from(t, x, 0.0).mean, 28.5);
+  EXPECT_THROW(mean_from(t, x, 10.5), Error);
+}
+
+TEST(Signal, UniformStepChecksTheTimeColumn) {
+  EXPECT_NEAR(uniform_step({0.01, 0.02, 0.03, 0.04}, "t"), 0.01, 1e-15);
+  EXPECT_THROW(uniform_step({0.0}, "t"), Error);
+  EXPECT_THROW(uniform_step({0.0, 0.1, 0.3}, "t"), Error);
+  EXPECT_THROW(uniform_step({0.3, 0.2, 0.1}, "t"), Error);
+}

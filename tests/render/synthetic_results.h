@@ -1,0 +1,118 @@
+// A small synthetic results set with known geometry and motion, for the render and plot tests.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include "pipeline/results_io.h"
+
+namespace floesim::render::testing {
+
+struct SyntheticFloe {
+  int32_t id;
+  std::vector<double> outline;  // x0 y0 x1 y1 ... CCW, body frame
+  double thickness_m;
+  double x, y;                  // fixed world position of the centre of mass
+};
+
+inline std::vector<double> square(double half) { return {-half, -half, half, -half, half, half, -half, half}; }
+
+// A U-shaped (non-convex) outline: 30 x 30 m with a 10 m wide notch open to +y, centred on the origin.
+inline std::vector<double> u_shape() {
+  std::vector<double> v = {0, 0, 30, 0, 30, 30, 20, 30, 20, 10, 10, 10, 10, 30, 0, 30};
+  for (double& c : v) c -= 15;
+  return v;
+}
+
+struct Synthetic {
+  std::vector<SyntheticFloe> floes;
+  double vessel_speed_mps = 2.0;  // along +x (east), heading east
+  double time_step_s = 0.05;
+  int steps = 400;                // 20 s
+  int frames = 12;                // one per second
+  double frame_interval_s = 1.0;
+};
+
+inline Synthetic default_synthetic() {
+  Synthetic s;
+  s.floes = {{1, square(10), 1.0, 60, 0},
+             {2, square(8), 0.8, 60, 40},
+             {3, square(10), 1.2, -40, -50},
+             {4, u_shape(), 1.0, 100, -45},
+             {5, square(12), 1.5, 150, 10}};
+  return s;
+}
+
+// Vessel: a 50 x 12 x 8 m box hull centred on its centre of mass at z = 0, moving east at constant speed.
+// Surge ice load Fx = -200 kN for steps 0..99 (t <= 5.0 s) and -1000 kN from step 100 (t = 5.05 s) on, plus a
+// +-300 kN alternation that cancels over every pair of steps: the mean over t >= 5.025 s (300 steps) is exactly
+// 1000 kN of resistance.
+inline Results make_results(const Synthetic& s) {
+  Results r;
+  for (int k = 0; k < s.steps; ++k) {
+    const double t = (k + 1) * s.time_step_s;
+    for (const auto& f : series_fields()) {
+      std::vector<double> row(f.cols, 0.0);
+      const std::string name = f.name;
+      if (name == "time_s") row[0] = t;
+      if (name == "vessel_position_m") row[0] = s.vessel_speed_mps * t;
+      if (name == "vessel_quaternion_wxyz") row[0] = 1;
+      if (name == "vessel_velocity_mps") row[0] = s.vessel_speed_mps;
+      if (name == "ice_load") row[0] = (k >= 100 ? -1.0e6 : -2.0e5) + (k % 2 == 0 ? 3e5 : -3e5);
+      auto& v = r.series[f.name];
+      v.insert(v.end(), row.begin(), row.end());
+    }
+  }
+  r.frame_offset = {0};
+  for (int k = 0; k < s.frames; ++k) {
+    const double t = k * s.frame_interval_s;
+    r.frame_time_s.push_back(t);
+    r.state_body_id.push_back(0);
+    r.state_position_m.insert(r.state_position_m.end(), {s.vessel_speed_mps * t, 0.0, 0.0});
+    r.state_quaternion.insert(r.state_quaternion.end(), {1, 0, 0, 0});
+    for (const auto& f : s.floes) {
+      r.state_body_id.push_back(f.id);
+      r.state_position_m.insert(r.state_position_m.end(), {f.x, f.y, 0.1 * f.thickness_m});
+      r.state_quaternion.insert(r.state_quaternion.end(), {1, 0, 0, 0});
+    }
+    r.frame_offset.push_back(static_cast<int64_t>(r.state_body_id.size()));
+  }
+  r.floe_vertex_offset = {0};
+  for (const auto& f : s.floes) {
+    r.floe_id.push_back(f.id);
+    r.floe_thickness_m.push_back(f.thickness_m);
+    r.floe_vertices_m.insert(r.floe_vertices_m.end(), f.outline.begin(), f.outline.end());
+    r.floe_vertex_offset.push_back(static_cast<int64_t>(r.floe_vertices_m.size() / 2));
+  }
+  // Box hull, 8 corners, 12 triangles (outward winding).
+  const double L = 25, B = 6, H = 4;
+  r.hull_vertices_m = {-L, -B, -H, L, -B, -H, L, B, -H, -L, B, -H, -L, -B, H, L, -B, H, L, B, H, -L, B, H};
+  r.hull_triangles = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+                      1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
+  r.attributes = {{"time_step_s", s.time_step_s}, {"output_interval_s", s.frame_interval_s},
+                  {"duration_s", s.steps * s.time_step_s}};
+  return r;
+}
+
+// A fresh, empty directory per test.
+inline std::filesystem::path fresh_dir(const std::string& name) {
+  const auto d = std::filesystem::temp_directory_path() /
+                 ("floesim_render_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+// Names of the files in a directory (sorted), to check that failures leave nothing behind.
+inline std::vector<std::string> listing(const std::filesystem::path& d) {
+  std::vector<std::string> names;
+  for (const auto& e : std::filesystem::directory_iterator(d)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+}  // namespace floesim::render::testing
