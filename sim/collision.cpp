@@ -1,0 +1,335 @@
+#include "sim/collision.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
+#include <fcl/geometry/shape/convex.h>
+#include <fcl/narrowphase/collision.h>
+#include <fcl/narrowphase/collision_object.h>
+
+#include "sim/parallel.h"
+
+namespace floesim::sim {
+
+namespace {
+
+// FCL's CollisionObject boxes a rotated object by its bounding sphere, which for flat slabs is a cube that overlaps
+// many neighbours. We set the exact box of the transformed vertices instead.
+class PartObject : public fcl::CollisionObjectd {
+ public:
+  PartObject(const std::shared_ptr<fcl::CollisionGeometryd>& g, int part) : fcl::CollisionObjectd(g), part(part) {}
+  void set_aabb(const Vec3& lo, const Vec3& hi) {
+    aabb.min_ = lo;
+    aabb.max_ = hi;
+  }
+  int part;
+};
+
+// A part in world coordinates (refreshed when its body moves).
+struct PartWorld {
+  std::vector<Vec3> v;        // vertices
+  std::vector<Vec3> n;        // face normals
+  std::vector<double> d;      // face plane offsets n.x
+};
+
+struct PairCandidate {
+  int body_a, part_a, body_b, part_b;
+  bool operator<(const PairCandidate& o) const {
+    if (body_a != o.body_a) return body_a < o.body_a;
+    if (part_a != o.part_a) return part_a < o.part_a;
+    if (body_b != o.body_b) return body_b < o.body_b;
+    return part_b < o.part_b;
+  }
+};
+
+// Scratch of one worker.
+struct Scratch {
+  std::vector<Vec3> poly, tmp;
+  std::vector<Contact> contacts;      // contacts of this worker's pairs, in pair order
+  long hits = 0, edges = 0;
+};
+
+}  // namespace
+
+struct CollisionWorld::Impl {
+  const Model& model;
+  std::vector<std::shared_ptr<fcl::Convexd>> shapes;
+  std::vector<std::unique_ptr<PartObject>> objects;
+  std::vector<PartWorld> world;
+  fcl::DynamicAABBTreeCollisionManagerd manager;
+  std::vector<PairCandidate> pairs;
+  const State* state = nullptr;  // during find_contacts (the broad-phase callback reads the awake flags)
+  ThreadPool& pool;
+  std::vector<Scratch> scratch;
+  std::vector<fcl::CollisionObjectd*> moved_objects;
+
+  Impl(const Model& m, ThreadPool& p) : model(m), pool(p), scratch(p.threads()) {}
+
+  void place_part(int p, const Vec3& x, const Quat& q) {
+    const ConvexPart& cp = model.parts[p];
+    PartWorld& w = world[p];
+    const Mat3 R = q.toRotationMatrix();
+    Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+    for (size_t i = 0; i < cp.vertices.size(); ++i) {
+      w.v[i] = x + R * cp.vertices[i];
+      lo = lo.cwiseMin(w.v[i]);
+      hi = hi.cwiseMax(w.v[i]);
+    }
+    for (size_t f = 0; f < cp.faces.size(); ++f) {
+      w.n[f] = R * cp.face_normal[f];
+      w.d[f] = w.n[f].dot(w.v[cp.faces[f][0]]);
+    }
+    objects[p]->setTransform(R, x);
+    objects[p]->set_aabb(lo, hi);
+  }
+
+  static bool broadphase_callback(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) {
+    auto* self = static_cast<Impl*>(data);
+    const int p1 = static_cast<PartObject*>(o1)->part, p2 = static_cast<PartObject*>(o2)->part;
+    int b1 = self->model.parts[p1].body, b2 = self->model.parts[p2].body;
+    if (b1 == b2) return false;
+    if (!self->state->awake[b1] && !self->state->awake[b2]) return false;
+    PairCandidate c = b1 < b2 ? PairCandidate{b1, p1, b2, p2} : PairCandidate{b2, p2, b1, p1};
+    self->pairs.push_back(c);
+    return false;  // keep going
+  }
+
+  // Separation of the deepest vertex of `other` below each face of `ref`; returns the face of largest separation.
+  static int best_face(const ConvexPart& ref, const PartWorld& rw, const PartWorld& other, double& sep) {
+    int best = -1;
+    sep = -1e300;
+    for (size_t f = 0; f < ref.faces.size(); ++f) {
+      double s = 1e300;
+      for (const Vec3& v : other.v) s = std::min(s, rw.n[f].dot(v) - rw.d[f]);
+      if (s > sep) {
+        sep = s;
+        best = static_cast<int>(f);
+      }
+    }
+    return best;
+  }
+
+  // Builds the contacts of one touching pair (a < b by body) into out. Returns true for an edge contact.
+  bool manifold(const PairCandidate& pc, const fcl::Contactd& hint, Scratch& sc, std::vector<Contact>& out) {
+    const ConvexPart& A = model.parts[pc.part_a];
+    const ConvexPart& B = model.parts[pc.part_b];
+    const PartWorld& wa = world[pc.part_a];
+    const PartWorld& wb = world[pc.part_b];
+    const double spec = model.options.solver.speculative_m;
+    const bool structure = pc.body_a == model.vessel || pc.body_b == model.vessel;
+    const double mu = structure ? model.options.ice.mu_ice_structure : model.options.ice.mu_ice_ice;
+    auto emit = [&](const Vec3& p, const Vec3& n, double gap) {
+      Contact c;
+      c.body_a = pc.body_a;
+      c.part_a = pc.part_a;
+      c.body_b = pc.body_b;
+      c.part_b = pc.part_b;
+      c.point = p;
+      c.normal = n;
+      c.gap = gap;
+      c.mu = mu;
+      out.push_back(c);
+    };
+
+    // 1. Face axes of least overlap on both parts (SAT over face normals).
+    double sa, sb;
+    const int fa = best_face(A, wa, wb, sa);
+    const int fb = best_face(B, wb, wa, sb);
+    const double face_overlap = -std::max(sa, sb);
+
+    // 2. FCL's normal, oriented from a to b by the smaller support overlap.
+    Vec3 nh = hint.normal;
+    if (!(nh.squaredNorm() > 0.5)) nh = Vec3::UnitZ();
+    {
+      double amax = -1e300, amin = 1e300, bmax = -1e300, bmin = 1e300;
+      for (const Vec3& v : wa.v) {
+        const double t = nh.dot(v);
+        amax = std::max(amax, t);
+        amin = std::min(amin, t);
+      }
+      for (const Vec3& v : wb.v) {
+        const double t = nh.dot(v);
+        bmax = std::max(bmax, t);
+        bmin = std::min(bmin, t);
+      }
+      if (bmax - amin < amax - bmin) nh = -nh;
+    }
+
+    // 3. Edge-on-edge: every face axis overlaps clearly more than FCL's penetration. Keep FCL's single point.
+    const double depth = std::max(0.0, hint.penetration_depth);
+    if (depth < 0.6 * face_overlap - 1e-3) {
+      emit(hint.pos, nh, -depth);
+      return true;
+    }
+
+    // 4. Reference face (prefer a unless b's face is clearly better) and the incident face most against it.
+    const bool flip = sb > sa + 1e-4;
+    const ConvexPart& R = flip ? B : A;
+    const PartWorld& rw = flip ? wb : wa;
+    const ConvexPart& I = flip ? A : B;
+    const PartWorld& iw = flip ? wa : wb;
+    const int rf = flip ? fb : fa;
+    const Vec3 nr = rw.n[rf];
+    int inc = 0;
+    double most = 1e300;
+    for (size_t f = 0; f < I.faces.size(); ++f) {
+      const double d = iw.n[f].dot(nr);
+      if (d < most) {
+        most = d;
+        inc = static_cast<int>(f);
+      }
+    }
+
+    // 5. Clip the incident face by the side planes of the reference face.
+    sc.poly.clear();
+    for (int i : I.faces[inc]) sc.poly.push_back(iw.v[i]);
+    const std::vector<int>& rface = R.faces[rf];
+    const size_t m = rface.size();
+    for (size_t e = 0; e < m && !sc.poly.empty(); ++e) {
+      const Vec3& r0 = rw.v[rface[e]];
+      const Vec3& r1 = rw.v[rface[(e + 1) % m]];
+      const Vec3 side = (r1 - r0).cross(nr);  // outward side-plane normal for a CCW face
+      sc.tmp.swap(sc.poly);
+      sc.poly.clear();
+      const size_t k = sc.tmp.size();
+      for (size_t i = 0; i < k; ++i) {
+        const Vec3& p = sc.tmp[i];
+        const Vec3& q = sc.tmp[(i + 1) % k];
+        const double dp = side.dot(p - r0), dq = side.dot(q - r0);
+        if (dp <= 0) sc.poly.push_back(p);
+        if ((dp <= 0) != (dq <= 0)) sc.poly.push_back(p + (dp / (dp - dq)) * (q - p));
+      }
+    }
+
+    // 6. Points within the speculative distance of the reference plane; at most 4 kept (deepest, then the widest
+    // spread), so that a flat contact resists tilting about any axis.
+    const size_t first = out.size();
+    const Vec3 n_ab = flip ? Vec3(-nr) : nr;
+    for (const Vec3& p : sc.poly) {
+      const double s = nr.dot(p) - rw.d[rf];
+      if (s <= spec) emit(p - 0.5 * s * nr, n_ab, s);
+    }
+    const size_t cnt = out.size() - first;
+    if (cnt == 0) {
+      emit(hint.pos, nh, -depth);
+      return true;
+    }
+    if (cnt > 4) {
+      Contact* c = &out[first];
+      std::vector<Contact> keep;
+      keep.reserve(4);
+      size_t i1 = 0;
+      for (size_t i = 1; i < cnt; ++i)
+        if (c[i].gap < c[i1].gap) i1 = i;
+      size_t i2 = i1;
+      double best = -1;
+      for (size_t i = 0; i < cnt; ++i) {
+        const double d = (c[i].point - c[i1].point).squaredNorm();
+        if (d > best) best = d, i2 = i;
+      }
+      auto area = [&](size_t i) { return (c[i2].point - c[i1].point).cross(c[i].point - c[i1].point).dot(nr); };
+      size_t i3 = i1;
+      best = -1;
+      for (size_t i = 0; i < cnt; ++i)
+        if (std::abs(area(i)) > best) best = std::abs(area(i)), i3 = i;
+      const double side3 = area(i3) >= 0 ? 1.0 : -1.0;
+      size_t i4 = i1;
+      best = 0;
+      for (size_t i = 0; i < cnt; ++i)
+        if (-side3 * area(i) > best) best = -side3 * area(i), i4 = i;
+      size_t chosen[4] = {i1, i2, i3, i4};
+      for (int k = 0; k < 4; ++k)
+        if (std::find(chosen, chosen + k, chosen[k]) == chosen + k) keep.push_back(c[chosen[k]]);
+      out.resize(first);
+      out.insert(out.end(), keep.begin(), keep.end());
+    }
+    return false;
+  }
+};
+
+CollisionWorld::CollisionWorld(const Model& model, const State& state, ThreadPool& pool)
+    : impl_(std::make_unique<Impl>(model, pool)) {
+  Impl& m = *impl_;
+  const size_t np = model.parts.size();
+  m.shapes.resize(np);
+  m.objects.resize(np);
+  m.world.resize(np);
+  std::vector<fcl::CollisionObjectd*> all;
+  for (size_t p = 0; p < np; ++p) {
+    const ConvexPart& cp = model.parts[p];
+    auto verts = std::make_shared<std::vector<Vec3>>(cp.vertices);
+    auto faces = std::make_shared<std::vector<int>>();
+    for (const auto& f : cp.faces) {
+      faces->push_back(static_cast<int>(f.size()));
+      faces->insert(faces->end(), f.begin(), f.end());
+    }
+    m.shapes[p] = std::make_shared<fcl::Convexd>(verts, static_cast<int>(cp.faces.size()), faces);
+    m.shapes[p]->computeLocalAABB();
+    m.objects[p] = std::make_unique<PartObject>(m.shapes[p], static_cast<int>(p));
+    m.world[p].v.resize(cp.vertices.size());
+    m.world[p].n.resize(cp.faces.size());
+    m.world[p].d.resize(cp.faces.size());
+    m.place_part(static_cast<int>(p), state.position[cp.body], state.orientation[cp.body]);
+    all.push_back(m.objects[p].get());
+  }
+  m.manager.registerObjects(all);
+  m.manager.setup();
+}
+
+CollisionWorld::~CollisionWorld() = default;
+
+void CollisionWorld::update_bodies(const State& state, const std::vector<int>& moved) {
+  Impl& m = *impl_;
+  m.moved_objects.clear();
+  for (int b : moved) {
+    const Body& body = m.model.bodies[b];
+    for (int p = body.first_part; p < body.first_part + body.part_count; ++p) {
+      m.place_part(p, state.position[b], state.orientation[b]);
+      m.moved_objects.push_back(m.objects[p].get());
+    }
+  }
+  if (!m.moved_objects.empty()) m.manager.update(m.moved_objects);
+}
+
+void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out) {
+  Impl& m = *impl_;
+  out.clear();
+  // Broad phase: candidate part pairs, then a fixed order so that runs are deterministic.
+  m.pairs.clear();
+  m.state = &state;
+  m.manager.collide(&m, &Impl::broadphase_callback);
+  std::sort(m.pairs.begin(), m.pairs.end());
+  stats_ = CollisionStats{};
+  stats_.broadphase_pairs = static_cast<long>(m.pairs.size());
+
+  // Narrow phase per pair (parallel over contiguous chunks; each worker keeps its pairs' contacts in order).
+  const int npairs = static_cast<int>(m.pairs.size());
+  for (auto& sc : m.scratch) {
+    sc.contacts.clear();
+    sc.hits = sc.edges = 0;
+  }
+  m.pool.parallel_for(npairs, [&](int begin, int end, int w) {
+    Scratch& sc = m.scratch[w];
+    fcl::CollisionRequestd req(1, true);
+    req.gjk_solver_type = fcl::GST_LIBCCD;
+    for (int i = begin; i < end; ++i) {
+      const PairCandidate& pc = m.pairs[i];
+      fcl::CollisionResultd res;
+      fcl::collide(m.objects[pc.part_a].get(), m.objects[pc.part_b].get(), req, res);
+      if (!res.isCollision() || res.numContacts() == 0) continue;
+      ++sc.hits;
+      // FCL's normal points from its first object to its second: part_a to part_b here.
+      if (m.manifold(pc, res.getContact(0), sc, sc.contacts)) ++sc.edges;
+    }
+  }, 8);
+  // Workers hold contiguous, increasing ranges of pairs: concatenating in worker order keeps the sorted order.
+  for (auto& sc : m.scratch) {
+    out.insert(out.end(), sc.contacts.begin(), sc.contacts.end());
+    stats_.narrowphase_hits += sc.hits;
+    stats_.edge_contacts += sc.edges;
+  }
+  m.state = nullptr;
+}
+
+}  // namespace floesim::sim

@@ -1,0 +1,203 @@
+#include "sim/forces.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sim/geometry.h"
+
+namespace floesim::sim {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+}
+
+double heading_of(const Mat3& R) { return std::atan2(R(1, 0), R(0, 0)); }
+
+Wrench gravity_force(const Model& m, const Body& b) {
+  Wrench w;
+  w.force = b.mass_kg * m.gravity;
+  return w;
+}
+
+Wrench buoyancy_force(const Model& m, const Body& b, const BodyKinematics& k, ForceScratch& s) {
+  Wrench w;
+  const auto& mv = b.buoyancy_mesh.vertices;
+  s.vertices.resize(mv.size());
+  bool any_below = false;
+  for (size_t i = 0; i < mv.size(); ++i) {
+    s.vertices[i] = k.x + k.R * mv[i];
+    any_below = any_below || s.vertices[i].z() < 0;
+  }
+  if (!any_below) return w;
+  const Submerged sub = submerged_part(s.vertices, b.buoyancy_mesh.triangles, 0.0);
+  if (sub.volume <= 0) return w;
+  const double g = -m.gravity.z();
+  w.add_at(Vec3(0, 0, m.options.water.density_kg_m3 * g * sub.volume), sub.centroid - k.x);
+  return w;
+}
+
+Wrench hydrostatic_damping(const Model& m, const Body& b, const BodyKinematics& k) {
+  Wrench w;
+  w.force.z() = -b.heave_damping * k.v.z();
+  const Vec3 wb = k.R.transpose() * k.w;  // body axes
+  const Vec3 tb(-b.roll_damping * wb.x(), -b.pitch_damping * wb.y(), 0);
+  w.torque = k.R * tb;
+  return w;
+}
+
+Wrench floe_water_drag(const Model& m, const Body& b, const BodyKinematics& k, ForceScratch& s) {
+  Wrench w;
+  const double cd = m.options.water.form_drag_cd, cf = m.options.water.skin_friction_cf;
+  const double half_rho = 0.5 * m.options.water.density_kg_m3;
+  s.vertices.resize(b.drag_vertices.size());
+  for (size_t i = 0; i < b.drag_vertices.size(); ++i) s.vertices[i] = k.x + k.R * b.drag_vertices[i];
+  Vec3 poly[64];
+  for (const DragFace& f : b.drag_faces) {
+    // Submerged part of the face (full, none, or clipped at the water plane).
+    bool all_below = true, any_below = false;
+    for (int i = 0; i < f.count; ++i) {
+      const double z = s.vertices[b.drag_face_index[f.first + i]].z();
+      all_below = all_below && z <= 0;
+      any_below = any_below || z < 0;
+    }
+    if (!any_below) continue;
+    AreaCentroid ac;
+    if (all_below && f.count <= 64) {
+      for (int i = 0; i < f.count; ++i) poly[i] = s.vertices[b.drag_face_index[f.first + i]];
+      ac = polygon_area_centroid(poly, f.count);
+    } else {
+      // Gather the face's vertices, then clip (the top/bottom faces of large floes can have many vertices).
+      s.face.clear();
+      for (int i = 0; i < f.count; ++i) s.face.push_back(s.vertices[b.drag_face_index[f.first + i]]);
+      clip_polygon_z(s.face.data(), f.count, 0.0, true, s.cut);
+      ac = polygon_area_centroid(s.cut.data(), static_cast<int>(s.cut.size()));
+    }
+    if (ac.area <= 0) continue;
+    const Vec3 n = k.R * f.normal;
+    const Vec3 r = ac.centroid - k.x;
+    const Vec3 vrel = k.v + k.w.cross(r) - m.current;
+    const double vn = vrel.dot(n);
+    Vec3 force = Vec3::Zero();
+    if (vn > 0) force -= half_rho * cd * ac.area * vn * vn * n;  // face advancing into the water
+    const Vec3 vt = vrel - vn * n;
+    force -= half_rho * cf * ac.area * vt.norm() * vt;
+    w.add_at(force, r);
+  }
+  return w;
+}
+
+Wrench floe_wind_drag(const Model& m, const Body& b, const BodyKinematics& k, ForceScratch& s) {
+  Wrench w;
+  if (m.wind.squaredNorm() == 0 || b.top_face < 0) return w;
+  const DragFace& f = b.drag_faces[b.top_face];
+  s.face.clear();
+  for (int i = 0; i < f.count; ++i) s.face.push_back(k.x + k.R * b.drag_vertices[b.drag_face_index[f.first + i]]);
+  clip_polygon_z(s.face.data(), f.count, 0.0, false, s.cut);
+  const AreaCentroid ac = polygon_area_centroid(s.cut.data(), static_cast<int>(s.cut.size()));
+  if (ac.area <= 0) return w;
+  const Vec3 n = k.R * f.normal;
+  const Vec3 r = ac.centroid - k.x;
+  const Vec3 arel = m.wind - (k.v + k.w.cross(r));
+  const Vec3 at = arel - arel.dot(n) * n;
+  w.add_at(0.5 * m.options.wind.air_density_kg_m3 * m.options.ice.air_drag_ca * ac.area * at.norm() * at, r);
+  return w;
+}
+
+Wrench vessel_resistance(const Model& m, const BodyKinematics& k) {
+  Wrench w;
+  const Vec3 ex = k.R.col(0);
+  const double u = (k.v - m.current).dot(ex);
+  w.force = -ittc57_resistance(u, m.vessel_info, m.options) * ex;
+  return w;
+}
+
+Wrench vessel_cross_flow(const Model& m, const BodyKinematics& k) {
+  Wrench w;
+  const VesselParticulars& vp = m.vessel_info;
+  const Vec3 ey = k.R.col(1), ez = k.R.col(2);
+  const double v = (k.v - m.current).dot(ey);  // sway velocity relative to the water
+  const double r = k.w.dot(ez);               // yaw rate
+  const double c = 0.5 * m.options.water.density_kg_m3 * m.options.vessel.sway_drag_cd * vp.draught_m *
+                   vp.strip_length_m;
+  double fy = 0, mz = 0;
+  for (double x : vp.strip_x_m) {
+    const double vl = v + r * x;  // local sway velocity of the strip
+    const double f = -c * vl * std::abs(vl);
+    fy += f;
+    mz += x * f;
+  }
+  w.force = fy * ey;
+  w.torque = mz * ez;
+  return w;
+}
+
+Wrench vessel_wind(const Model& m, const BodyKinematics& k) {
+  Wrench w;
+  const WindOptions& o = m.options.wind;
+  if (m.wind.squaredNorm() == 0) return w;
+  const Vec3 a = k.R.transpose() * (m.wind - k.v);  // air velocity relative to the vessel, body axes
+  const double ah2 = a.x() * a.x() + a.y() * a.y();
+  if (ah2 == 0) return w;
+  // gamma: angle the relative wind comes from, 0 = head wind, positive from port (y to port, z up).
+  const double gamma = std::atan2(-a.y(), -a.x());
+  const double q = 0.5 * o.air_density_kg_m3 * ah2;
+  const double fx = -q * o.cx * std::cos(gamma) * o.frontal_area_m2;  // head wind pushes astern
+  const double fy = -q * o.cy * std::sin(gamma) * o.lateral_area_m2;  // wind from port pushes to starboard
+  // Wind on the bow quarter turns the bow away from the wind (Fossen's C_N ~ sin 2 gamma).
+  const double mz = -q * o.cn * std::sin(2 * gamma) * o.lateral_area_m2 * m.vessel_info.length_oa_m;
+  w.force = k.R * Vec3(fx, fy, 0);
+  w.torque = k.R * Vec3(0, 0, mz);
+  return w;
+}
+
+Wrench vessel_propulsion(const Model& m, const BodyKinematics& k, double time_s, double dt, double& integral,
+                         double& thrust_n) {
+  const PropulsionOptions& p = m.options.vessel.propulsion;
+  const Vec3 ex = k.R.col(0);
+  double thrust = 0;
+  if (p.mode == "constant_thrust") {
+    thrust = p.thrust_n;
+  } else if (p.mode == "thrust_series") {
+    const auto& t = m.thrust_time_s;
+    const auto& f = m.thrust_n;
+    if (time_s <= t.front()) {
+      thrust = f.front();
+    } else if (time_s >= t.back()) {
+      thrust = f.back();
+    } else {
+      const size_t i = std::upper_bound(t.begin(), t.end(), time_s) - t.begin();
+      const double s = (time_s - t[i - 1]) / (t[i] - t[i - 1]);
+      thrust = f[i - 1] + s * (f[i] - f[i - 1]);
+    }
+  } else {
+    // PI on the speed through the water, with the open-water resistance at the target speed as feed-forward;
+    // the integral is frozen while the thrust saturates (anti-windup).
+    const double u = (k.v - m.current).dot(ex);
+    const double e = p.speed_mps - u;
+    const double ff = ittc57_resistance(p.speed_mps, m.vessel_info, m.options);
+    const double trial = ff + p.kp_n_per_mps * e + p.ki_n_per_m * (integral + e * dt);
+    if (trial > p.min_thrust_n && trial < p.max_thrust_n) integral += e * dt;
+    thrust = std::clamp(ff + p.kp_n_per_mps * e + p.ki_n_per_m * integral, p.min_thrust_n, p.max_thrust_n);
+  }
+  thrust_n = thrust;
+  Wrench w;
+  w.force = thrust * ex;
+  return w;
+}
+
+Wrench vessel_autopilot(const Model& m, const Body& b, const BodyKinematics& k, double heading_ref) {
+  Wrench w;
+  const AutopilotOptions& a = m.options.vessel.autopilot;
+  if (!a.enabled) return w;
+  double e = heading_of(k.R) - heading_ref;
+  e = std::remainder(e, 2 * kPi);
+  const double wn = 2 * kPi / a.natural_period_s;
+  const Vec3 ez = k.R.col(2);
+  const double r = k.w.dot(ez);
+  const double izz = b.inertia(2, 2);
+  const double mz = std::clamp(-izz * (wn * wn * e + 2 * a.damping_ratio * wn * r), -a.max_moment_nm, a.max_moment_nm);
+  w.torque = mz * ez;
+  return w;
+}
+
+}  // namespace floesim::sim

@@ -1,0 +1,109 @@
+// Small geometric kernels of the simulation core: planar polygons in 3D (area, clipping at a horizontal plane)
+// and convex polygons in 2D (hull, intersection). Header-only, allocation-free when given scratch buffers.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "pipeline/geometry2d.h"
+
+namespace floesim::sim {
+
+using Vec3 = Eigen::Vector3d;
+
+// Area and centroid of a planar polygon in 3D (any orientation).
+struct AreaCentroid {
+  double area = 0;
+  Vec3 centroid = Vec3::Zero();
+};
+
+inline AreaCentroid polygon_area_centroid(const Vec3* p, int n) {
+  AreaCentroid r;
+  if (n < 3) return r;
+  // Fan from p[0]: the vector area of each triangle, projected on the total normal, gives signed weights that
+  // handle any (planar, simple) polygon.
+  Vec3 total = Vec3::Zero();
+  for (int i = 1; i + 1 < n; ++i) total += (p[i] - p[0]).cross(p[i + 1] - p[0]);
+  const double twice = total.norm();
+  if (twice <= 0) return r;
+  const Vec3 nrm = total / twice;
+  Vec3 c = Vec3::Zero();
+  for (int i = 1; i + 1 < n; ++i) {
+    const double w = (p[i] - p[0]).cross(p[i + 1] - p[0]).dot(nrm);
+    c += w * (p[0] + p[i] + p[i + 1]) / 3.0;
+  }
+  r.area = 0.5 * twice;
+  r.centroid = c / twice;
+  return r;
+}
+
+// Part of the polygon p[0..n) with z <= z0 (below = true) or z >= z0 (below = false), written to out.
+inline void clip_polygon_z(const Vec3* p, int n, double z0, bool below, std::vector<Vec3>& out) {
+  out.clear();
+  auto inside = [&](const Vec3& v) { return below ? v.z() <= z0 : v.z() >= z0; };
+  for (int i = 0; i < n; ++i) {
+    const Vec3& a = p[i];
+    const Vec3& b = p[(i + 1) % n];
+    const bool ia = inside(a), ib = inside(b);
+    if (ia) out.push_back(a);
+    if (ia != ib) {
+      const double t = (z0 - a.z()) / (b.z() - a.z());
+      out.push_back(a + t * (b - a));
+    }
+  }
+}
+
+// 2D cross product of (b - a) and (c - a).
+inline double cross2(const Vec2& a, const Vec2& b, const Vec2& c) {
+  return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
+}
+
+// Convex hull (Andrew's monotone chain), counter-clockwise, collinear points dropped.
+inline Polygon convex_hull_2d(std::vector<Vec2> pts) {
+  std::sort(pts.begin(), pts.end(), [](const Vec2& a, const Vec2& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  if (pts.size() < 3) return pts;
+  Polygon h(2 * pts.size());
+  size_t k = 0;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    while (k >= 2 && cross2(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
+    h[k++] = pts[i];
+  }
+  for (size_t i = pts.size() - 1, t = k + 1; i > 0; --i) {
+    while (k >= t && cross2(h[k - 2], h[k - 1], pts[i - 1]) <= 0) --k;
+    h[k++] = pts[i - 1];
+  }
+  h.resize(k - 1);
+  return h;
+}
+
+// Intersection of two convex CCW polygons (Sutherland-Hodgman: clip a by each edge of b).
+inline Polygon clip_convex_2d(const Polygon& a, const Polygon& b) {
+  Polygon out = a, in;
+  const size_t m = b.size();
+  for (size_t j = 0; j < m && !out.empty(); ++j) {
+    const Vec2& e0 = b[j];
+    const Vec2& e1 = b[(j + 1) % m];
+    in.swap(out);
+    out.clear();
+    for (size_t i = 0; i < in.size(); ++i) {
+      const Vec2& p = in[i];
+      const Vec2& q = in[(i + 1) % in.size()];
+      const double sp = cross2(e0, e1, p), sq = cross2(e0, e1, q);
+      if (sp >= 0) out.push_back(p);
+      if ((sp >= 0) != (sq >= 0)) out.push_back(p + (sp / (sp - sq)) * (q - p));
+    }
+  }
+  return out;
+}
+
+inline double convex_intersection_area(const Polygon& a, const Polygon& b) {
+  const Polygon c = clip_convex_2d(a, b);
+  return c.size() >= 3 ? std::max(0.0, signed_area(c)) : 0.0;
+}
+
+}  // namespace floesim::sim

@@ -1,0 +1,504 @@
+#include "sim/model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <numeric>
+#include <sstream>
+
+#include "pipeline/error.h"
+#include "sim/geometry.h"
+
+namespace floesim::sim {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Buoyancy of a body-frame mesh placed at (position, orientation): submerged volume and centre of buoyancy.
+Submerged submerged_at(const TriMesh& mesh, const Vec3& position, const Quat& orientation) {
+  std::vector<Vec3> w(mesh.vertices.size());
+  const Mat3 R = orientation.toRotationMatrix();
+  for (size_t i = 0; i < w.size(); ++i) w[i] = position + R * mesh.vertices[i];
+  return submerged_part(w, mesh.triangles, 0.0);
+}
+
+// Hydrostatic restoring stiffness about the body axis `axis` (body frame) at the given pose, by central
+// differences of the buoyancy moment about the centre of mass (gravity acts at the centre of mass: no moment).
+double rotational_stiffness(const TriMesh& mesh, const Vec3& position, const Quat& orientation, const Vec3& axis,
+                            double rho_g) {
+  const double eps = 1e-3;
+  const Vec3 world_axis = orientation * axis;
+  double m[2];
+  for (int s = 0; s < 2; ++s) {
+    const double a = s == 0 ? eps : -eps;
+    const Quat q = (orientation * Quat(Eigen::AngleAxisd(a, axis))).normalized();
+    const Submerged sub = submerged_at(mesh, position, q);
+    const Vec3 f(0, 0, rho_g * sub.volume);
+    m[s] = sub.volume > 0 ? (sub.centroid - position).cross(f).dot(world_axis) : 0.0;
+  }
+  return -(m[0] - m[1]) / (2 * eps);
+}
+
+// Fills the linear damping coefficients of a body floating at its initial pose.
+void set_damping(Body& b, const SimulateOptions& o, double zeta_heave, double zeta_roll, double zeta_pitch) {
+  const double rho_g = o.water.density_kg_m3 * o.water.gravity_mps2;
+  const Submerged sub = submerged_at(b.buoyancy_mesh, b.initial_position, b.initial_orientation);
+  const double c33 = rho_g * sub.waterplane_area;
+  const double c44 = std::max(0.0, rotational_stiffness(b.buoyancy_mesh, b.initial_position, b.initial_orientation,
+                                                        Vec3::UnitX(), rho_g));
+  const double c55 = std::max(0.0, rotational_stiffness(b.buoyancy_mesh, b.initial_position, b.initial_orientation,
+                                                        Vec3::UnitY(), rho_g));
+  b.heave_damping = 2 * zeta_heave * std::sqrt(c33 * b.mass_kg);
+  b.roll_damping = 2 * zeta_roll * std::sqrt(c44 * b.inertia(0, 0));
+  b.pitch_damping = 2 * zeta_pitch * std::sqrt(c55 * b.inertia(1, 1));
+}
+
+struct Aabb2 {
+  Vec2 lo, hi;
+  bool overlaps(const Aabb2& o) const {
+    return lo.x() <= o.hi.x() && o.lo.x() <= hi.x() && lo.y() <= o.hi.y() && o.lo.y() <= hi.y();
+  }
+};
+Aabb2 bounds(const Polygon& p) {
+  Aabb2 b{p[0], p[0]};
+  for (const Vec2& v : p) {
+    b.lo = b.lo.cwiseMin(v);
+    b.hi = b.hi.cwiseMax(v);
+  }
+  return b;
+}
+
+// A floe during building: world outline, convex pieces (world) and their boxes.
+struct FloeGeometry {
+  const Floe* floe = nullptr;
+  Polygon outline;              // cleaned, CCW, world
+  std::vector<Polygon> pieces;  // convex, world
+  std::vector<Aabb2> piece_box;
+  Aabb2 box;
+  double area = 0;
+};
+
+double overlap_area(const FloeGeometry& a, const FloeGeometry& b) {
+  double area = 0;
+  for (size_t i = 0; i < a.pieces.size(); ++i)
+    for (size_t j = 0; j < b.pieces.size(); ++j)
+      if (a.piece_box[i].overlaps(b.piece_box[j])) area += convex_intersection_area(a.pieces[i], b.pieces[j]);
+  return area;
+}
+
+// Section of a convex mesh between two horizontal planes, projected on the xy plane (convex).
+Polygon band_footprint(const std::vector<Vec3>& v, const std::vector<std::array<int, 3>>& tris, double zlo,
+                       double zhi) {
+  std::vector<Vec2> pts;
+  for (const Vec3& p : v)
+    if (p.z() >= zlo && p.z() <= zhi) pts.emplace_back(p.x(), p.y());
+  for (const auto& t : tris)
+    for (int e = 0; e < 3; ++e) {
+      const Vec3& a = v[t[e]];
+      const Vec3& b = v[t[(e + 1) % 3]];
+      for (double z : {zlo, zhi})
+        if ((a.z() - z) * (b.z() - z) < 0) {
+          const Vec3 p = a + (z - a.z()) / (b.z() - a.z()) * (b - a);
+          pts.emplace_back(p.x(), p.y());
+        }
+    }
+  return pts.size() >= 3 ? convex_hull_2d(pts) : Polygon{};
+}
+
+// Length, beam, draught and strip stations at the waterline z = 0 of a mesh already placed in its floating position (hull frame + sinkage).
+void waterline_particulars(const TriMesh& m, VesselParticulars& p) {
+  double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300, zmin = 1e300;
+  double lx0 = 1e300, lx1 = -1e300;
+  for (const Vec3& v : m.vertices) {
+    xmin = std::min(xmin, v.x());
+    xmax = std::max(xmax, v.x());
+    zmin = std::min(zmin, v.z());
+  }
+  for (const auto& t : m.triangles) {
+    const Vec3 tri[3] = {m.vertices[t[0]], m.vertices[t[1]], m.vertices[t[2]]};
+    for (int e = 0; e < 3; ++e) {
+      const Vec3& a = tri[e];
+      const Vec3& b = tri[(e + 1) % 3];
+      if ((a.z() <= 0) != (b.z() <= 0)) {
+        const Vec3 q = a + (0 - a.z()) / (b.z() - a.z()) * (b - a);
+        lx0 = std::min(lx0, q.x());
+        lx1 = std::max(lx1, q.x());
+        ymin = std::min(ymin, q.y());
+        ymax = std::max(ymax, q.y());
+      }
+    }
+  }
+  FLOESIM_REQUIRE(lx1 > lx0 && ymax > ymin, "hull: the mesh does not cross the waterline z = 0 (is the hull frame's "
+                  "waterline at z = 0, z up?)");
+  p.length_oa_m = xmax - xmin;
+  p.length_wl_m = lx1 - lx0;
+  p.beam_wl_m = ymax - ymin;
+  p.draught_m = -zmin;
+  p.strip_x_m.clear();
+  const int strips = 20;
+  p.strip_length_m = p.length_wl_m / strips;
+  for (int i = 0; i < strips; ++i) p.strip_x_m.push_back(lx0 + (i + 0.5) * p.strip_length_m);
+}
+
+TriMesh shifted(const TriMesh& m, const Vec3& d) {
+  TriMesh r = m;
+  for (Vec3& v : r.vertices) v += d;
+  return r;
+}
+
+}  // namespace
+
+ConvexPart make_convex_part(const TriMesh& mesh, int body) {
+  ConvexPart part;
+  part.body = body;
+  part.vertices = mesh.vertices;
+  double scale = 0;
+  for (const Vec3& v : mesh.vertices) scale = std::max(scale, v.norm());
+  part.bounding_radius = scale;
+  // Group triangles by plane (a convex mesh has one face per outward normal).
+  std::vector<Vec3> normals;
+  std::vector<double> offsets;
+  std::vector<std::vector<int>> groups;
+  for (const auto& t : mesh.triangles) {
+    const Vec3& a = mesh.vertices[t[0]];
+    const Vec3 n = (mesh.vertices[t[1]] - a).cross(mesh.vertices[t[2]] - a);
+    const double len = n.norm();
+    if (len <= 1e-12 * std::max(1.0, scale * scale)) continue;  // degenerate sliver
+    const Vec3 u = n / len;
+    const double d = u.dot(a);
+    size_t g = 0;
+    for (; g < normals.size(); ++g)
+      if (normals[g].dot(u) > 1 - 1e-7 && std::abs(offsets[g] - d) < 1e-6 * std::max(1.0, scale)) break;
+    if (g == normals.size()) {
+      normals.push_back(u);
+      offsets.push_back(d);
+      groups.emplace_back();
+    }
+    for (int k = 0; k < 3; ++k) groups[g].push_back(t[k]);
+  }
+  for (size_t g = 0; g < groups.size(); ++g) {
+    std::vector<int> idx = groups[g];
+    std::sort(idx.begin(), idx.end());
+    idx.erase(std::unique(idx.begin(), idx.end()), idx.end());
+    // Remove vertices at the same place (meshes with split vertices).
+    std::vector<int> uniq;
+    for (int i : idx) {
+      bool dup = false;
+      for (int j : uniq) dup = dup || (mesh.vertices[i] - mesh.vertices[j]).norm() < 1e-9 * std::max(1.0, scale);
+      if (!dup) uniq.push_back(i);
+    }
+    if (uniq.size() < 3) continue;
+    const Vec3 n = normals[g];
+    Vec3 c = Vec3::Zero();
+    for (int i : uniq) c += mesh.vertices[i];
+    c /= static_cast<double>(uniq.size());
+    const Vec3 u = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
+    const Vec3 w = n.cross(u);
+    std::vector<std::pair<double, int>> ang;
+    for (int i : uniq) {
+      const Vec3 d = mesh.vertices[i] - c;
+      ang.emplace_back(std::atan2(d.dot(w), d.dot(u)), i);
+    }
+    std::sort(ang.begin(), ang.end());  // counter-clockwise about n (u x w = n)
+    std::vector<int> face;
+    for (auto& a : ang) face.push_back(a.second);
+    part.faces.push_back(face);
+    part.face_normal.push_back(n);
+  }
+  FLOESIM_REQUIRE(part.faces.size() >= 4, "internal: convex part with fewer than 4 faces");
+  return part;
+}
+
+void read_thrust_series(const std::string& file, std::vector<double>& time_s, std::vector<double>& thrust_n) {
+  std::ifstream in(file);
+  FLOESIM_REQUIRE(in, file, ": cannot open the thrust series (vessel.propulsion.thrust_file)");
+  time_s.clear();
+  thrust_n.clear();
+  std::string line;
+  int lineno = 0;
+  bool header = false;
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (!header) {
+      std::string h = line;
+      h.erase(std::remove_if(h.begin(), h.end(), [](char c) { return c == ' ' || c == '\t'; }), h.end());
+      FLOESIM_REQUIRE(h == "time_s,thrust_N", file, ":", lineno, ": expected the header 'time_s,thrust_N', got '",
+                      line, "'");
+      header = true;
+      continue;
+    }
+    FLOESIM_REQUIRE(!line.empty(), file, ":", lineno, ": empty line (gaps are not allowed)");
+    const size_t comma = line.find(',');
+    FLOESIM_REQUIRE(comma != std::string::npos && line.find(',', comma + 1) == std::string::npos, file, ":", lineno,
+                    ": expected two comma-separated numbers 'time_s,thrust_N', got '", line, "'");
+    double v[2];
+    const std::string cell[2] = {line.substr(0, comma), line.substr(comma + 1)};
+    for (int k = 0; k < 2; ++k) {
+      size_t used = 0;
+      bool ok = true;
+      try {
+        v[k] = std::stod(cell[k], &used);
+      } catch (const std::exception&) {
+        ok = false;
+      }
+      if (ok)
+        for (size_t i = used; i < cell[k].size(); ++i) ok = ok && (cell[k][i] == ' ' || cell[k][i] == '\t');
+      FLOESIM_REQUIRE(ok && std::isfinite(v[k]), file, ":", lineno, ": column ", k == 0 ? "time_s" : "thrust_N",
+                      " is not a finite number: '", cell[k], "'");
+    }
+    FLOESIM_REQUIRE(time_s.empty() || v[0] > time_s.back(), file, ":", lineno, ": time ", v[0],
+                    " s is not after the previous time ", time_s.empty() ? 0.0 : time_s.back(),
+                    " s (times must increase strictly)");
+    time_s.push_back(v[0]);
+    thrust_n.push_back(v[1]);
+  }
+  FLOESIM_REQUIRE(header, file, ": empty file (expected the header 'time_s,thrust_N' and rows)");
+  FLOESIM_REQUIRE(!time_s.empty(), file, ": no data rows after the header");
+}
+
+double ittc57_resistance(double u, const VesselParticulars& v, const SimulateOptions& o) {
+  const double au = std::abs(u);
+  if (au == 0 || v.wetted_surface_m2 <= 0) return 0.0;
+  // The ITTC line is undefined as Re -> 0; below Re = 1e5 the friction coefficient is held (tiny forces anyway).
+  const double re = std::max(1e5, au * v.length_wl_m / o.water.kinematic_viscosity_m2ps);
+  const double lg = std::log10(re) - 2.0;
+  const double cf = 0.075 / (lg * lg);
+  const double ct = (1 + o.vessel.form_factor_k) * cf + o.vessel.roughness_ca;
+  return 0.5 * o.water.density_kg_m3 * v.wetted_surface_m2 * ct * u * au;
+}
+
+Model build_model(const FloeField& field, const HullModel* hull, const SimulateOptions& o) {
+  Model model;
+  model.options = o;
+  const double rho_w = o.water.density_kg_m3, rho_i = o.ice.density_kg_m3, g = o.water.gravity_mps2;
+  model.gravity = Vec3(0, 0, -g);
+  const double cdir = o.water.current_direction_deg * kPi / 180, wdir = o.wind.direction_deg * kPi / 180;
+  model.current = o.water.current_speed_mps * Vec3(std::cos(cdir), std::sin(cdir), 0);
+  model.wind = o.wind.speed_mps * Vec3(std::cos(wdir), std::sin(wdir), 0);
+  // Floes float at hydrostatic equilibrium; without water they are placed with their base at z = -draught anyway.
+  const double draught_ratio = rho_i / rho_w;
+
+  // 1. Floe geometry in the world: cleaned outline and convex pieces.
+  std::vector<FloeGeometry> geo(field.floes.size());
+  for (size_t k = 0; k < field.floes.size(); ++k) {
+    const Floe& f = field.floes[k];
+    FLOESIM_REQUIRE(std::isfinite(f.thickness_m) && f.thickness_m > 0, "floe ", f.id, ": thickness_m must be > 0, got ",
+                    f.thickness_m);
+    FloeGeometry& fg = geo[k];
+    fg.floe = &f;
+    fg.outline = clean_polygon(f.outline, 1e-9);
+    make_ccw(fg.outline);
+    FLOESIM_REQUIRE(fg.outline.size() >= 3 && signed_area(fg.outline) > 0, "floe ", f.id,
+                    ": degenerate outline (zero area)");
+    const auto si = find_self_intersection(fg.outline);
+    FLOESIM_REQUIRE(si.first < 0, "floe ", f.id, ": the outline intersects itself (edges ", si.first, " and ",
+                    si.second, ")");
+    fg.area = signed_area(fg.outline);
+    fg.pieces = convex_decompose(fg.outline);
+    for (const Polygon& p : fg.pieces) fg.piece_box.push_back(bounds(p));
+    fg.box = bounds(fg.outline);
+  }
+
+  // 2. Floes must not overlap each other (sweep over x-sorted boxes; pairs reported by id).
+  {
+    std::vector<size_t> order(geo.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+      return geo[a].box.lo.x() < geo[b].box.lo.x() || (geo[a].box.lo.x() == geo[b].box.lo.x() && a < b);
+    });
+    std::ostringstream bad;
+    int nbad = 0;
+    for (size_t i = 0; i < order.size(); ++i) {
+      const FloeGeometry& a = geo[order[i]];
+      for (size_t j = i + 1; j < order.size(); ++j) {
+        const FloeGeometry& b = geo[order[j]];
+        if (b.box.lo.x() > a.box.hi.x()) break;
+        if (!a.box.overlaps(b.box)) continue;
+        const double area = overlap_area(a, b);
+        if (area <= 1e-9) continue;
+        const double smaller = std::min(a.area, b.area);
+        if (area > o.ice.max_overlap_fraction * smaller) {
+          if (nbad < 10)
+            bad << "\n  - floes " << std::min(a.floe->id, b.floe->id) << " and " << std::max(a.floe->id, b.floe->id)
+                << " overlap by " << area << " m^2 (" << 100 * area / smaller << " % of the smaller)";
+          ++nbad;
+        } else {
+          ++model.small_overlaps;
+        }
+      }
+    }
+    FLOESIM_REQUIRE(nbad == 0, "the floes file has ", nbad, " pair(s) of overlapping floes (above ",
+                    100 * o.ice.max_overlap_fraction, " % of the smaller floe, ice.max_overlap_fraction):", bad.str(),
+                    nbad > 10 ? "\n  - ..." : "", "\n  fix the digitisation, or raise ice.max_overlap_fraction");
+  }
+
+  // 3. The vessel: floating position, mass, inertia, particulars, convex parts.
+  std::vector<Polygon> footprint;
+  if (hull) {
+    FLOESIM_REQUIRE(!hull->parts.empty(), "hull: no convex parts");
+    const TriMesh& surf = hull->surface;
+    const double m0 = rho_w * submerged_part(surf.vertices, surf.triangles, 0.0).volume;
+    FLOESIM_REQUIRE(m0 > 0, "hull: no volume below the waterline z = 0 (is z up and the waterline at z = 0?)");
+    const double mass = o.vessel.mass_kg > 0 ? o.vessel.mass_kg : m0;
+    // Sinkage dz (hull frame raised by dz) so that rho_w V_sub = mass; 0 when the mass comes from the hull.
+    double dz = 0;
+    if (o.vessel.mass_kg > 0) {
+      double zmin = 1e300, zmax = -1e300;
+      for (const Vec3& v : surf.vertices) {
+        zmin = std::min(zmin, v.z());
+        zmax = std::max(zmax, v.z());
+      }
+      double lo = -zmax, hi = -zmin;  // raised by -zmax: fully submerged; by -zmin: out of the water
+      const double full = rho_w * mass_properties(surf).volume;
+      FLOESIM_REQUIRE(mass < full, "vessel.mass_kg = ", mass, " is more than the hull can carry (", full,
+                      " kg fully submerged)");
+      for (int it = 0; it < 200; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        const double mm = rho_w * submerged_part(shifted(surf, Vec3(0, 0, mid)).vertices, surf.triangles, 0).volume;
+        (mm > mass ? lo : hi) = mid;
+      }
+      dz = 0.5 * (lo + hi);
+    }
+    const TriMesh floating = shifted(surf, Vec3(0, 0, dz));
+    const Submerged sub = submerged_part(floating.vertices, floating.triangles, 0.0);
+    VesselParticulars& vp = model.vessel_info;
+    waterline_particulars(floating, vp);
+    // The merged surface holds the faces shared by adjacent parts: the hull module's hydrostatics excludes them
+    // from the wetted surface (they cancel in volumes, so clipping the merged surface is right for buoyancy).
+    vp.wetted_surface_m2 = hydrostatics(hull->parts, rho_w, -dz).wetted_surface_m2;
+    vp.displacement_m3 = sub.volume;
+    vp.waterplane_area_m2 = sub.waterplane_area;
+    vp.mass_kg = mass;
+    vp.centre_of_mass_hull = Vec3(sub.centroid.x(), sub.centroid.y(), o.vessel.vcg_m);
+    const Vec3 com = vp.centre_of_mass_hull;  // hull frame
+    vp.radii_of_gyration_m = Vec3(o.vessel.kxx_m > 0 ? o.vessel.kxx_m : 0.38 * vp.beam_wl_m,
+                                  o.vessel.kyy_m > 0 ? o.vessel.kyy_m : 0.25 * vp.length_oa_m,
+                                  o.vessel.kzz_m > 0 ? o.vessel.kzz_m : 0.25 * vp.length_oa_m);
+    for (double& x : vp.strip_x_m) x -= com.x();
+
+    Body b;
+    b.kind = BodyKind::vessel;
+    b.id = 0;
+    b.mass_kg = mass;
+    b.inv_mass = 1 / mass;
+    b.inertia = mass * vp.radii_of_gyration_m.cwiseProduct(vp.radii_of_gyration_m).asDiagonal();
+    b.inv_inertia = b.inertia.inverse();
+    b.buoyancy_mesh = shifted(surf, -com);
+    const double heading = o.vessel.heading_deg * kPi / 180;
+    b.initial_orientation = Quat(Eigen::AngleAxisd(heading, Vec3::UnitZ()));
+    b.initial_position = Vec3(o.vessel.x_m, o.vessel.y_m, com.z() + dz);
+    b.first_part = 0;
+    b.part_count = static_cast<int>(hull->parts.size());
+    model.vessel = 0;
+    for (const TriMesh& p : hull->parts) model.parts.push_back(make_convex_part(shifted(p, -com), 0));
+    // Metacentric heights from the clipped hull (the same buoyancy the simulation applies).
+    const double rho_g = rho_w * g > 0 ? rho_w * g : rho_w * 9.81;
+    const double k44 =
+        rotational_stiffness(b.buoyancy_mesh, b.initial_position, b.initial_orientation, Vec3::UnitX(), rho_g);
+    const double k55 =
+        rotational_stiffness(b.buoyancy_mesh, b.initial_position, b.initial_orientation, Vec3::UnitY(), rho_g);
+    vp.gm_transverse_m = k44 / (rho_g * sub.volume);
+    vp.gm_longitudinal_m = k55 / (rho_g * sub.volume);
+    FLOESIM_REQUIRE(vp.gm_transverse_m > 0, "vessel.vcg_m = ", o.vessel.vcg_m,
+                    " m makes the vessel unstable in roll (GM_T = ", vp.gm_transverse_m,
+                    " m): lower the centre of mass");
+    if (o.water.enabled)
+      set_damping(b, o, o.water.vessel_heave_damping_ratio, o.water.vessel_roll_damping_ratio,
+                  o.water.vessel_pitch_damping_ratio);
+    model.bodies.push_back(std::move(b));
+
+    // Footprint of the hull parts in the band of z the floes occupy, at the initial pose.
+    double zlo = 0, zhi = 0;
+    for (const Floe& f : field.floes) {
+      zlo = std::min(zlo, -draught_ratio * f.thickness_m);
+      zhi = std::max(zhi, (1 - draught_ratio) * f.thickness_m);
+    }
+    const Body& vb = model.bodies[0];
+    const Mat3 R = vb.initial_orientation.toRotationMatrix();
+    for (int p = 0; p < vb.part_count; ++p) {
+      const TriMesh& tm = hull->parts[p];
+      std::vector<Vec3> w(tm.vertices.size());
+      for (size_t i = 0; i < w.size(); ++i) w[i] = vb.initial_position + R * (tm.vertices[i] - com);
+      Polygon fp = band_footprint(w, tm.triangles, zlo, zhi);
+      if (fp.size() >= 3) footprint.push_back(std::move(fp));
+    }
+  }
+
+  // 4. Floe bodies: slab of the floe's thickness, body frame at the centre of mass, at hydrostatic equilibrium.
+  std::vector<Aabb2> fp_box;
+  for (const Polygon& p : footprint) fp_box.push_back(bounds(p));
+  for (const FloeGeometry& fg : geo) {
+    const Floe& f = *fg.floe;
+    bool hit = false;
+    for (size_t i = 0; i < footprint.size() && !hit; ++i) {
+      if (!fp_box[i].overlaps(fg.box)) continue;
+      for (size_t j = 0; j < fg.pieces.size() && !hit; ++j)
+        hit = fp_box[i].overlaps(fg.piece_box[j]) && convex_intersection_area(footprint[i], fg.pieces[j]) > 1e-9;
+    }
+    if (hit) {
+      model.removed_floe_ids.push_back(f.id);
+      continue;
+    }
+    const double h = f.thickness_m;
+    const Vec2 c = centroid(fg.outline);
+    Body b;
+    b.kind = BodyKind::floe;
+    b.id = f.id;
+    b.thickness_m = h;
+    for (const Vec2& v : fg.outline) b.outline.push_back(v - c);
+    b.buoyancy_mesh = extrude_polygon(b.outline, -h / 2, h);
+    const MassProperties mp = mass_properties(b.buoyancy_mesh);
+    FLOESIM_REQUIRE(mp.volume > 0, "floe ", f.id, ": internal: non-positive slab volume");
+    b.mass_kg = rho_i * mp.volume;
+    b.inv_mass = 1 / b.mass_kg;
+    b.inertia = rho_i * mp.inertia;
+    b.inv_inertia = b.inertia.inverse();
+    b.initial_position = Vec3(c.x(), c.y(), h / 2 - draught_ratio * h);
+    b.initial_orientation = Quat::Identity();
+    const int body_index = static_cast<int>(model.bodies.size());
+    b.first_part = static_cast<int>(model.parts.size());
+    for (const Polygon& piece : fg.pieces) {
+      Polygon local;
+      for (const Vec2& v : piece) local.push_back(v - c);
+      model.parts.push_back(make_convex_part(extrude_polygon(local, -h / 2, h), body_index));
+    }
+    b.part_count = static_cast<int>(fg.pieces.size());
+    // Drag faces: vertices 0..n-1 the bottom ring, n..2n-1 the top ring.
+    const int n = static_cast<int>(b.outline.size());
+    for (int i = 0; i < n; ++i) b.drag_vertices.emplace_back(b.outline[i].x(), b.outline[i].y(), -h / 2);
+    for (int i = 0; i < n; ++i) b.drag_vertices.emplace_back(b.outline[i].x(), b.outline[i].y(), h / 2);
+    auto add_face = [&](std::vector<int> idx, const Vec3& nrm) {
+      DragFace df;
+      df.first = static_cast<int>(b.drag_face_index.size());
+      df.count = static_cast<int>(idx.size());
+      df.normal = nrm;
+      b.drag_face_index.insert(b.drag_face_index.end(), idx.begin(), idx.end());
+      b.drag_faces.push_back(df);
+    };
+    std::vector<int> bottom, top;
+    for (int i = n - 1; i >= 0; --i) bottom.push_back(i);  // clockwise seen from above = CCW from below
+    for (int i = 0; i < n; ++i) top.push_back(n + i);
+    add_face(bottom, -Vec3::UnitZ());
+    b.top_face = static_cast<int>(b.drag_faces.size());
+    add_face(top, Vec3::UnitZ());
+    for (int i = 0; i < n; ++i) {
+      const int j = (i + 1) % n;
+      const Vec2 e = b.outline[j] - b.outline[i];
+      const Vec3 nrm = Vec3(e.y(), -e.x(), 0).normalized();  // outward for a CCW ring
+      add_face({i, j, n + j, n + i}, nrm);
+    }
+    if (o.water.enabled)
+      set_damping(b, o, o.water.floe_heave_damping_ratio, o.water.floe_roll_pitch_damping_ratio,
+                  o.water.floe_roll_pitch_damping_ratio);
+    model.bodies.push_back(std::move(b));
+  }
+
+  // 5. Thrust series (the caller resolved the path relative to the config file).
+  if (hull && o.vessel.propulsion.mode == "thrust_series")
+    read_thrust_series(o.vessel.propulsion.thrust_file, model.thrust_time_s, model.thrust_n);
+  return model;
+}
+
+}  // namespace floesim::sim

@@ -1,0 +1,102 @@
+// The immutable model of a simulation (MuJoCo's mjModel idea): bodies addressed by integer index, their convex
+// collision parts, mass properties, hydrostatic data and the vessel's particulars. Everything that changes in time
+// lives in State (sim/state.h). Built once from the floes artefact, the hull and the options.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "pipeline/floes_io.h"
+#include "sim/hull.h"
+#include "sim/mesh.h"
+#include "sim/simulate_options.h"
+
+namespace floesim::sim {
+
+using Quat = Eigen::Quaterniond;
+
+// A convex polyhedron in its body's frame (origin = body centre of mass): the unit of collision.
+struct ConvexPart {
+  int body = -1;
+  std::vector<Vec3> vertices;
+  std::vector<std::vector<int>> faces;  // planar faces, counter-clockwise seen from outside (coplanar triangles merged)
+  std::vector<Vec3> face_normal;        // outward unit normals
+  double bounding_radius = 0;           // about the body origin (for cheap rejection tests)
+};
+
+enum class BodyKind : uint8_t { vessel, floe };
+
+// One planar face of a floe slab for the drag model: indices into Body::drag_vertices.
+struct DragFace {
+  int first = 0, count = 0;  // into Body::drag_face_index
+  Vec3 normal = Vec3::Zero();  // outward, body frame
+};
+
+struct Body {
+  BodyKind kind = BodyKind::floe;
+  int id = 0;              // 0 = vessel, else the floe id of the input file
+  double mass_kg = 0, inv_mass = 0;
+  Mat3 inertia = Mat3::Zero();      // body frame, about the centre of mass, kg m^2
+  Mat3 inv_inertia = Mat3::Zero();
+  int first_part = 0, part_count = 0;  // into Model::parts
+  TriMesh buoyancy_mesh;               // closed surface in the body frame, clipped at z = 0 for buoyancy
+  // Drag model of floes: the slab's faces (top, bottom, sides) over a ring of vertices in the body frame.
+  std::vector<Vec3> drag_vertices;
+  std::vector<int> drag_face_index;
+  std::vector<DragFace> drag_faces;
+  int top_face = -1;                   // index into drag_faces of the top face (wind on floes)
+  double thickness_m = 0;              // floes
+  Polygon outline;                     // floes: CCW outline in the body frame (x, y)
+  // Linear damping coefficients from the hydrostatic stiffness at equilibrium and the damping ratios.
+  double heave_damping = 0;            // N s/m, along world z
+  double roll_damping = 0;             // N m s/rad, about body x
+  double pitch_damping = 0;            // N m s/rad, about body y
+  Vec3 initial_position = Vec3::Zero();
+  Quat initial_orientation = Quat::Identity();
+};
+
+// What the vessel model needs of the hull, computed from the mesh at the design waterline (z = 0).
+struct VesselParticulars {
+  double length_oa_m = 0, length_wl_m = 0, beam_wl_m = 0, draught_m = 0;
+  double displacement_m3 = 0, wetted_surface_m2 = 0, waterplane_area_m2 = 0;
+  double mass_kg = 0;
+  Vec3 centre_of_mass_hull = Vec3::Zero();  // in the hull (OBJ) frame
+  Vec3 radii_of_gyration_m = Vec3::Zero();
+  double gm_transverse_m = 0, gm_longitudinal_m = 0;  // metacentric heights from the clipped hull
+  std::vector<double> strip_x_m;      // stations of the cross-flow (sway/yaw) damping strips, body frame
+  double strip_length_m = 0;          // length of one strip
+};
+
+struct Model {
+  SimulateOptions options;
+  std::vector<Body> bodies;   // vessel first (if any), then the floes in input order
+  std::vector<ConvexPart> parts;
+  int vessel = -1;            // index of the vessel body, -1 if none (tests of floes alone)
+  VesselParticulars vessel_info;
+  std::vector<int> removed_floe_ids;  // floes that overlapped the vessel's initial footprint
+  int small_overlaps = 0;             // floe pairs overlapping below the error threshold (digitisation noise)
+  Vec3 gravity = Vec3::Zero();
+  Vec3 current = Vec3::Zero();        // water velocity, world
+  Vec3 wind = Vec3::Zero();           // air velocity, world
+  std::vector<double> thrust_time_s, thrust_n;  // thrust_series mode
+
+  int floe_count() const { return static_cast<int>(bodies.size()) - (vessel >= 0 ? 1 : 0); }
+};
+
+// Builds the model. `hull` may be null (floes only). Checks the inputs (thickness, overlaps) and throws
+// floesim::Error naming the floe ids. Floes overlapping the vessel's initial footprint are removed.
+Model build_model(const FloeField& floes, const HullModel* hull, const SimulateOptions& options);
+
+// Reads a thrust series CSV ("time_s,thrust_N" header, strictly increasing times); errors name the line.
+void read_thrust_series(const std::string& file, std::vector<double>& time_s, std::vector<double>& thrust_n);
+
+// Thrust of an ITTC-57 resistance curve: R(u) = 1/2 rho S u|u| ((1 + k) C_F(Re) + C_A), the force opposing u.
+double ittc57_resistance(double u_mps, const VesselParticulars& v, const SimulateOptions& o);
+
+// Convex part from a closed convex triangle mesh (body frame): merges coplanar triangles into faces.
+ConvexPart make_convex_part(const TriMesh& mesh, int body);
+
+}  // namespace floesim::sim

@@ -1,0 +1,322 @@
+#include "sim/simulate.h"
+
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "pipeline/atomic_file.h"
+#include "pipeline/error.h"
+#include "pipeline/floes_io.h"
+#include "pipeline/provenance.h"
+#include "sim/world.h"
+
+namespace floesim::sim {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The load windows of the seed paper (§5): 0.5 s for compliant contacts, 20 s for rigid ones.
+constexpr double kCompliantWindowS = 0.5;
+constexpr double kRigidWindowS = 20.0;
+
+// A wrench in body axes as the 6 columns Fx Fy Fz Mx My Mz.
+void push_body_wrench(std::vector<double>& col, const Mat3& R, const Wrench& w) {
+  const Vec3 f = R.transpose() * w.force, m = R.transpose() * w.torque;
+  col.insert(col.end(), {f.x(), f.y(), f.z(), m.x(), m.y(), m.z()});
+}
+
+}  // namespace
+
+std::vector<double> moving_average(const std::vector<double>& x, size_t n) {
+  std::vector<double> y;
+  if (n == 0 || x.size() < n) return y;
+  y.reserve(x.size() - n + 1);
+  // Running sum, re-summed exactly every window to keep rounding from accumulating over long series.
+  double s = 0;
+  for (size_t i = 0; i < n; ++i) s += x[i];
+  y.push_back(s / n);
+  for (size_t i = n; i < x.size(); ++i) {
+    if ((i - n + 1) % n == 0) {
+      s = 0;
+      for (size_t k = i - n + 1; k <= i; ++k) s += x[k];
+    } else {
+      s += x[i] - x[i - n];
+    }
+    y.push_back(s / n);
+  }
+  return y;
+}
+
+Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
+  FLOESIM_REQUIRE(model.vessel >= 0, "simulate: the model has no vessel");
+  const SimulateOptions& o = model.options;
+  const long steps = o.steps(), every = o.output_every();
+  World world(model);
+  Results r;
+  // Direct references to the series columns: no map look-up per step, one reservation up front.
+  std::map<std::string, std::vector<double>*> col;
+  for (const FieldSpec& f : series_fields()) {
+    auto& v = r.series[f.name];
+    v.reserve(static_cast<size_t>(steps) * f.cols);
+    col[f.name] = &v;
+  }
+  auto& c_time = *col["time_s"];
+  auto& c_pos = *col["vessel_position_m"];
+  auto& c_quat = *col["vessel_quaternion_wxyz"];
+  auto& c_vel = *col["vessel_velocity_mps"];
+  auto& c_omega = *col["vessel_angular_velocity_radps"];
+  auto& c_ice = *col["ice_load"];
+  auto& c_ice_rigid = *col["ice_load_rigid"];
+  auto& c_ice_compliant = *col["ice_load_compliant"];
+  auto& c_hydro = *col["hydro_load"];
+  auto& c_wind = *col["wind_load"];
+  auto& c_prop = *col["propulsion_load"];
+  auto& c_contacts = *col["contact_count"];
+  auto& c_vcontacts = *col["vessel_contact_count"];
+  auto& c_iter = *col["solver_iterations"];
+  auto& c_res = *col["solver_residual"];
+  auto& c_awake = *col["awake_floes"];
+  FLOESIM_REQUIRE(col.size() == 16, "internal: the results table has ", col.size(),
+                  " series; the recorder writes 16 (update simulate.cpp)");
+
+  const size_t nb = model.bodies.size();
+  const size_t frames = static_cast<size_t>(steps / every);
+  r.frame_offset.push_back(0);
+  r.frame_time_s.reserve(frames);
+  r.state_body_id.reserve(frames * nb);
+  r.state_position_m.reserve(frames * nb * 3);
+  r.state_quaternion.reserve(frames * nb * 4);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  double record_s = 0, awake_sum = 0, contact_sum = 0, iter_sum = 0;
+  const int v = model.vessel;
+  for (long k = 1; k <= steps; ++k) {
+    world.step();
+    const auto tr = std::chrono::steady_clock::now();
+    const State& s = world.state();
+    const StepReport& rep = world.report();
+    const Mat3 R = s.orientation[v].toRotationMatrix();
+    const Quat& q = s.orientation[v];
+    const Vec3 vb = R.transpose() * s.velocity[v], wb = R.transpose() * s.angular_velocity[v];
+    c_time.push_back(s.time_s);
+    c_pos.insert(c_pos.end(), {s.position[v].x(), s.position[v].y(), s.position[v].z()});
+    c_quat.insert(c_quat.end(), {q.w(), q.x(), q.y(), q.z()});
+    c_vel.insert(c_vel.end(), {vb.x(), vb.y(), vb.z()});
+    c_omega.insert(c_omega.end(), {wb.x(), wb.y(), wb.z()});
+    push_body_wrench(c_ice, R, rep.ice_load);
+    push_body_wrench(c_ice_rigid, R, rep.ice_load_rigid);
+    push_body_wrench(c_ice_compliant, R, rep.ice_load_compliant);
+    push_body_wrench(c_hydro, R, rep.hydro_load);
+    push_body_wrench(c_wind, R, rep.wind_load);
+    push_body_wrench(c_prop, R, rep.propulsion_load);
+    c_contacts.push_back(rep.contacts);
+    c_vcontacts.push_back(rep.vessel_contacts);
+    c_iter.push_back(rep.solve.iterations);
+    c_res.push_back(rep.solve.residual);
+    c_awake.push_back(rep.awake_floes);
+    awake_sum += rep.awake_floes;
+    contact_sum += rep.contacts;
+    iter_sum += rep.solve.iterations;
+    // Frames at t = k * output_interval (k >= 1): all bodies, vessel first (body id 0).
+    if (k % every == 0) {
+      r.frame_time_s.push_back(s.time_s);
+      for (size_t b = 0; b < nb; ++b) {
+        const Body& body = model.bodies[b];
+        r.state_body_id.push_back(body.kind == BodyKind::vessel ? 0 : body.id);
+        const Vec3& x = s.position[b];
+        const Quat& qb = s.orientation[b];
+        r.state_position_m.insert(r.state_position_m.end(), {x.x(), x.y(), x.z()});
+        r.state_quaternion.insert(r.state_quaternion.end(), {qb.w(), qb.x(), qb.y(), qb.z()});
+      }
+      r.frame_offset.push_back(static_cast<int64_t>(r.state_body_id.size()));
+    }
+    record_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - tr).count();
+    if (progress && (k * 10) % steps < 10 && k != steps) {
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      *progress << "  t = " << std::fixed << std::setprecision(1) << s.time_s << " s  (" << (k * 100) / steps
+                << " %, " << std::setprecision(1) << wall << " s wall, awake floes " << rep.awake_floes
+                << ", contacts " << rep.contacts << ")" << std::defaultfloat << std::endl;
+    }
+  }
+  stats.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  for (int i = 0; i < kStageCount; ++i) stats.stage_s[i] = world.stage_seconds()[i];
+  stats.stage_s[kStageCount] = record_s;
+  stats.steps = steps;
+  stats.mean_awake_floes = awake_sum / steps;
+  stats.mean_contacts = contact_sum / steps;
+  stats.mean_iterations = iter_sum / steps;
+
+  // Geometry: floe outlines in the body frame with their thickness; the hull surface in the vessel body frame.
+  r.floe_vertex_offset.push_back(0);
+  for (const Body& b : model.bodies) {
+    if (b.kind != BodyKind::floe) continue;
+    r.floe_id.push_back(b.id);
+    r.floe_thickness_m.push_back(b.thickness_m);
+    for (const Vec2& p : b.outline) r.floe_vertices_m.insert(r.floe_vertices_m.end(), {p.x(), p.y()});
+    r.floe_vertex_offset.push_back(static_cast<int64_t>(r.floe_vertices_m.size() / 2));
+  }
+  const TriMesh& hull = model.bodies[v].buoyancy_mesh;
+  for (const Vec3& p : hull.vertices) r.hull_vertices_m.insert(r.hull_vertices_m.end(), {p.x(), p.y(), p.z()});
+  for (const auto& t : hull.triangles) r.hull_triangles.insert(r.hull_triangles.end(), {t[0], t[1], t[2]});
+
+  r.attributes["time_step_s"] = o.time_step_s;
+  r.attributes["duration_s"] = o.duration_s;
+  r.attributes["output_interval_s"] = o.output_interval_s;
+  r.attributes["steady_start_s"] = o.steady_start_s;
+  r.attributes["contact_model"] = "rigid";
+  r.attributes["frames_at"] = "t = k * output_interval_s, k = 1 .. duration_s / output_interval_s";
+  return r;
+}
+
+nlohmann::json summarize(const Model& model, const Results& r) {
+  const SimulateOptions& o = model.options;
+  const auto& t = r.get("time_s");
+  const auto& ice = r.get("ice_load");
+  const auto& vel = r.get("vessel_velocity_mps");
+  const auto& prop = r.get("propulsion_load");
+  const auto& awake = r.get("awake_floes");
+  const auto& contacts = r.get("contact_count");
+  const auto& iters = r.get("solver_iterations");
+  const auto& resid = r.get("solver_residual");
+  const auto& vcont = r.get("vessel_contact_count");
+  // Steady part: rows with t >= steady_start_s (within half a step).
+  size_t first = 0;
+  while (first < t.size() && t[first] < o.steady_start_s - 0.5 * o.time_step_s) ++first;
+  std::vector<double> fx;
+  double speed = 0, thrust = 0, aw = 0, co = 0, it = 0, vc = 0, rmax = 0;
+  for (size_t i = first; i < t.size(); ++i) {
+    fx.push_back(ice[6 * i]);
+    speed += vel[3 * i];
+    thrust += prop[6 * i];
+    aw += awake[i];
+    co += contacts[i];
+    vc += vcont[i];
+    it += iters[i];
+    rmax = std::max(rmax, resid[i]);
+  }
+  const double n = static_cast<double>(fx.size());
+  FLOESIM_REQUIRE(n > 0, "internal: no steady samples");
+  double mean = 0;
+  for (double x : fx) mean += x;
+  mean /= n;
+  double var = 0;
+  for (double x : fx) var += (x - mean) * (x - mean);
+  const double sd = std::sqrt(var / n);
+
+  nlohmann::json s;
+  s["mean_surge_ice_load_N"] = mean;
+  s["mean_surge_ice_resistance_N"] = -mean;
+  s["std_surge_ice_load_N"] = sd;
+  s["steady_part"] = {{"from_s", o.steady_start_s}, {"to_s", o.duration_s}, {"samples", fx.size()}};
+  nlohmann::json windows = nlohmann::json::array();
+  for (double w : {kCompliantWindowS, kRigidWindowS}) {
+    const size_t nw = static_cast<size_t>(std::lround(w / o.time_step_s));
+    const std::vector<double> ma = moving_average(fx, nw);
+    nlohmann::json j = {{"window_s", w}, {"samples", nw}, {"kind", w == kRigidWindowS ? "rigid" : "compliant"}};
+    if (ma.empty()) {
+      j["note"] = "the steady part is shorter than the window";
+      j["max_N"] = nullptr;
+      j["min_N"] = nullptr;
+      j["max_resistance_N"] = nullptr;
+    } else {
+      const auto [lo, hi] = std::minmax_element(ma.begin(), ma.end());
+      j["max_N"] = *hi;
+      j["min_N"] = *lo;
+      j["max_resistance_N"] = -*lo;  // the largest filtered resistance (most negative surge load)
+    }
+    windows.push_back(j);
+  }
+  s["moving_average_surge_ice_load"] = windows;
+  s["contact_model"] = "rigid";
+  s["mean_vessel_speed_mps"] = speed / n;
+  s["mean_thrust_N"] = thrust / n;
+  s["mean_awake_floes"] = aw / n;
+  s["mean_contacts"] = co / n;
+  s["mean_vessel_contacts"] = vc / n;
+  s["mean_solver_iterations"] = it / n;
+  s["max_solver_residual_mps"] = rmax;
+  s["steps"] = r.steps();
+  s["frames"] = r.frames();
+  s["floes"] = model.floe_count();
+  s["removed_floes"] = model.removed_floe_ids.size();
+  s["removed_floe_ids"] = model.removed_floe_ids;
+  s["small_floe_overlaps"] = model.small_overlaps;
+  const VesselParticulars& vp = model.vessel_info;
+  s["vessel"] = {{"mass_kg", vp.mass_kg},
+                 {"length_oa_m", vp.length_oa_m},
+                 {"length_wl_m", vp.length_wl_m},
+                 {"beam_wl_m", vp.beam_wl_m},
+                 {"draught_m", vp.draught_m},
+                 {"displacement_m3", vp.displacement_m3},
+                 {"wetted_surface_m2", vp.wetted_surface_m2},
+                 {"gm_transverse_m", vp.gm_transverse_m},
+                 {"gm_longitudinal_m", vp.gm_longitudinal_m},
+                 {"radii_of_gyration_m", {vp.radii_of_gyration_m.x(), vp.radii_of_gyration_m.y(),
+                                          vp.radii_of_gyration_m.z()}},
+                 {"open_water_resistance_at_target_N",
+                  ittc57_resistance(o.vessel.propulsion.speed_mps, vp, o)}};
+  return s;
+}
+
+std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, const fs::path& config_file,
+                         const fs::path& out_dir) {
+  // 1. Inputs: options (strict), thrust series path relative to the config file, floes, hull.
+  const Json cfg = load_json_file(config_file);
+  SimulateOptions o = read_options<SimulateOptions>(cfg, config_file.string());
+  std::vector<NamedInput> inputs = {{"floes", floes_file}, {"hull", hull_file}, {"config", config_file}};
+  if (o.vessel.propulsion.mode == "thrust_series") {
+    fs::path tf = o.vessel.propulsion.thrust_file;
+    if (tf.is_relative()) tf = config_file.parent_path() / tf;
+    o.vessel.propulsion.thrust_file = tf.string();
+    inputs.push_back({"thrust_series", tf});
+  }
+  const FloeField field = read_floes(floes_file);
+  const HullModel hull = load_hull(hull_file, o.hull);
+  const Model model = build_model(field, &hull, o);
+
+  std::ostringstream out;
+  out << "floesim-simulate: " << model.floe_count() << " floes (" << model.removed_floe_ids.size()
+      << " removed: they overlapped the vessel's initial footprint";
+  if (model.small_overlaps) out << "; " << model.small_overlaps << " small floe-floe overlaps left to the solver";
+  out << "), vessel " << model.vessel_info.mass_kg / 1e3 << " t, L_wl " << model.vessel_info.length_wl_m
+      << " m, GM_T " << model.vessel_info.gm_transverse_m << " m\n";
+  std::cout << out.str() << std::flush;
+
+  // 2. Simulate (throws on numerical failure: nothing is written).
+  RunStats stats;
+  Results results = simulate(model, stats, &std::cout);
+  const Json prov = make_provenance("floesim-simulate", inputs, options_to_json(o));
+  results.attributes["provenance"] = prov;
+  nlohmann::json summary = summarize(model, results);
+  summary["settings"] = options_to_json(o);
+  summary["provenance"] = prov;
+
+  // 3. Artefacts, atomically.
+  ensure_directory(out_dir);
+  write_results(out_dir / "results.h5", results);
+  write_text_atomic(out_dir / "summary.json", summary.dump(2) + "\n");
+
+  // 4. The report (wall time lives here, not in the artefacts).
+  std::ostringstream rep;
+  const double ms = 1e3 * stats.wall_s / stats.steps;
+  rep << std::fixed << std::setprecision(2);
+  rep << "floes " << model.floe_count() << ", steps " << stats.steps << ", wall " << stats.wall_s << " s, "
+      << ms << " ms/step, " << o.duration_s / stats.wall_s << " simulated s per wall s\n";
+  rep << "mean awake floes " << stats.mean_awake_floes << ", mean contacts " << stats.mean_contacts
+      << ", mean solver sweeps " << stats.mean_iterations << "\n";
+  rep << "stage times (ms/step):";
+  for (int i = 0; i <= kStageCount; ++i)
+    rep << " " << (i < kStageCount ? stage_name(i) : "record") << " " << std::setprecision(3)
+        << 1e3 * stats.stage_s[i] / stats.steps;
+  rep << "\n" << std::setprecision(1);
+  rep << "mean surge ice load " << summary["mean_surge_ice_load_N"].get<double>() / 1e3 << " kN (resistance "
+      << summary["mean_surge_ice_resistance_N"].get<double>() / 1e3 << " kN) from t = " << o.steady_start_s
+      << " s, mean speed " << std::setprecision(3) << summary["mean_vessel_speed_mps"].get<double>() << " m/s\n";
+  rep << "wrote " << (out_dir / "results.h5").string() << " and " << (out_dir / "summary.json").string() << "\n";
+  return rep.str();
+}
+
+}  // namespace floesim::sim

@@ -1,0 +1,38 @@
+// The simulate stage: floes + hull + options -> results.h5 (pipeline/results_io.h layout) and summary.json.
+#pragma once
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "pipeline/results_io.h"
+#include "sim/model.h"
+
+namespace floesim::sim {
+
+// Run statistics that are not artefacts (wall time is not deterministic): printed by the stage.
+struct RunStats {
+  double wall_s = 0;
+  double stage_s[8] = {};     // per World stage, then the recorder
+  double mean_awake_floes = 0, mean_contacts = 0, mean_iterations = 0;
+  long steps = 0;
+};
+
+// Simulates the model for options.duration_s and records every series per step, the body states at
+// t = k * output_interval_s (k = 1..N, exactly duration / output_interval frames) and the geometry.
+// `progress` (may be null) receives a line every 10 % of the run. Needs a vessel in the model.
+Results simulate(const Model& model, RunStats& stats, std::ostream* progress = nullptr);
+
+// Summary statistics of the results (steady part from options.steady_start_s).
+nlohmann::json summarize(const Model& model, const Results& results);
+
+// The stage: reads the inputs, builds the model, simulates, writes out_dir/results.h5 and out_dir/summary.json
+// atomically (nothing is written on error) and returns the report printed on stdout.
+std::string run_simulate(const std::filesystem::path& floes_file, const std::filesystem::path& hull_file,
+                         const std::filesystem::path& config_file, const std::filesystem::path& out_dir);
+
+// Centred moving average of x with a window of n samples (n odd or even: n samples ending n/2 after the centre);
+// only the positions where the window fits are returned.
+std::vector<double> moving_average(const std::vector<double>& x, size_t n);
+
+}  // namespace floesim::sim

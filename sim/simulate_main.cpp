@@ -1,0 +1,30 @@
+// floesim-simulate: a vessel transit through a floe field -> DIR/results.h5 and DIR/summary.json.
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "pipeline/options.h"
+#include "pipeline/stage_main.h"
+#include "sim/simulate.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"Simulates a vessel transit through a floe field (rigid non-smooth contacts, buoyancy by clipping, "
+               "drag, ITTC-57 resistance, propulsion) and writes DIR/results.h5 and DIR/summary.json.",
+               "floesim-simulate"};
+  std::string floes, hull, config, out;
+  bool help_config = false;
+  app.add_option("--floes", floes, "floe field GeoJSON (floesim-digitise output)");
+  app.add_option("--hull", hull, "hull mesh (OBJ of convex parts, e.g. floesim-hull output)");
+  app.add_option("--config", config, "JSON object of simulate options (see --help-config)");
+  app.add_option("--out", out, "output directory");
+  app.add_flag("--help-config", help_config, "print the simulate options as a Markdown table and exit");
+  return floesim::run_stage(app, argc, argv, [&] {
+    if (help_config) {
+      std::cout << floesim::options_doc(floesim::sim::SimulateOptions{});
+      return;
+    }
+    if (floes.empty() || hull.empty() || config.empty() || out.empty())
+      throw floesim::Error("--floes, --hull, --config and --out are all required (see --help)");
+    std::cout << floesim::sim::run_simulate(floes, hull, config, out);
+  });
+}

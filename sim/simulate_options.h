@@ -1,0 +1,293 @@
+// The options of the simulate stage: one strict struct with sections, every field with default, unit and doc.
+// Angles are measured counter-clockwise from the world x axis (east), in degrees; "direction" of a current or of
+// the wind is the direction it flows TO (oceanographic convention for both, so that a current of direction 0 and a
+// wind of direction 0 push a floe the same way).
+#pragma once
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "pipeline/options.h"
+#include "sim/hull.h"
+
+namespace floesim::sim {
+
+struct IceOptions {
+  double density_kg_m3 = 900.0;        // rho_i; the thickness comes from the floes file
+  double mu_ice_ice = 0.15;            // friction coefficient between floes
+  double mu_ice_structure = 0.15;      // friction coefficient between floe and hull
+  double crushing_strength_pa = 2e6;   // sigma_c (recorded; used by the compliant contacts of a later issue)
+  double air_drag_ca = 0.0012;         // air-ice skin drag coefficient on the exposed top face (wind on floes)
+  double max_overlap_fraction = 0.02;  // floes overlapping more than this fraction of the smaller floe are an error
+  template <class V>
+  void visit(V& v) {
+    v.field("density_kg_m3", density_kg_m3, "kg/m^3", "ice density", positive());
+    v.field("mu_ice_ice", mu_ice_ice, "-", "ice-ice friction coefficient", in_range(0, 2));
+    v.field("mu_ice_structure", mu_ice_structure, "-", "ice-hull friction coefficient", in_range(0, 2));
+    v.field("crushing_strength_pa", crushing_strength_pa, "Pa",
+            "ice crushing strength (recorded now; the compliant contact law of a later issue uses it)", positive());
+    v.field("air_drag_ca", air_drag_ca, "-", "air-ice skin drag coefficient (wind on the floes' top faces)",
+            non_negative());
+    v.field("max_overlap_fraction", max_overlap_fraction, "-",
+            "two input floes overlapping by more than this fraction of the smaller one's area are an error; smaller "
+            "overlaps (digitisation noise) are pushed apart by the contact solver",
+            in_range(0, 1));
+  }
+};
+
+struct WaterOptions {
+  bool enabled = true;                   // false: no buoyancy, drag, damping or resistance (gravity still acts)
+  double density_kg_m3 = 1025.0;         // rho_w
+  double gravity_mps2 = 9.81;            // g, downwards along -z
+  double skin_friction_cf = 0.005;       // C_f on submerged floe faces (tangential drag)
+  double form_drag_cd = 0.5;             // C_d on submerged floe faces advancing into the water
+  double current_speed_mps = 0.0;        // uniform current speed
+  double current_direction_deg = 0.0;    // direction the current flows to
+  double floe_heave_damping_ratio = 0.2;  // linear heave damping, fraction of critical
+  double floe_roll_pitch_damping_ratio = 0.2;
+  double vessel_heave_damping_ratio = 0.2;
+  double vessel_roll_damping_ratio = 0.08;
+  double vessel_pitch_damping_ratio = 0.2;
+  double kinematic_viscosity_m2ps = 1.83e-6;  // sea water at 0 degC (ITTC-57 Reynolds number)
+  template <class V>
+  void visit(V& v) {
+    v.field("enabled", enabled, "-", "buoyancy, drag, damping and open-water resistance on (false: vacuum)");
+    v.field("density_kg_m3", density_kg_m3, "kg/m^3", "sea water density", positive());
+    v.field("gravity_mps2", gravity_mps2, "m/s^2", "gravitational acceleration (0 allowed for tests)",
+            non_negative());
+    v.field("skin_friction_cf", skin_friction_cf, "-", "skin friction coefficient C_f on submerged floe faces",
+            non_negative());
+    v.field("form_drag_cd", form_drag_cd, "-", "form drag coefficient C_d on submerged floe faces", non_negative());
+    v.field("current_speed_mps", current_speed_mps, "m/s", "uniform current speed", non_negative());
+    v.field("current_direction_deg", current_direction_deg, "deg", "direction the current flows to (CCW from +x)",
+            in_range(-360, 360));
+    v.field("floe_heave_damping_ratio", floe_heave_damping_ratio, "-", "floe heave damping, fraction of critical",
+            in_range(0, 2));
+    v.field("floe_roll_pitch_damping_ratio", floe_roll_pitch_damping_ratio, "-",
+            "floe roll and pitch damping, fraction of critical", in_range(0, 2));
+    v.field("vessel_heave_damping_ratio", vessel_heave_damping_ratio, "-", "vessel heave damping, fraction of critical",
+            in_range(0, 2));
+    v.field("vessel_roll_damping_ratio", vessel_roll_damping_ratio, "-", "vessel roll damping, fraction of critical",
+            in_range(0, 2));
+    v.field("vessel_pitch_damping_ratio", vessel_pitch_damping_ratio, "-", "vessel pitch damping, fraction of critical",
+            in_range(0, 2));
+    v.field("kinematic_viscosity_m2ps", kinematic_viscosity_m2ps, "m^2/s", "water kinematic viscosity (ITTC-57)",
+            positive());
+  }
+};
+
+// How the vessel is driven.
+struct PropulsionOptions {
+  std::string mode = "speed";        // constant_thrust | thrust_series | speed
+  double thrust_n = 0.0;             // constant_thrust: thrust along the body x axis
+  std::string thrust_file;           // thrust_series: CSV "time_s,thrust_N" (relative to the config file)
+  double speed_mps = 2.0;            // speed: prescribed forward speed through the water
+  double kp_n_per_mps = 2e6;         // speed: proportional gain
+  double ki_n_per_m = 2e5;           // speed: integral gain
+  double min_thrust_n = 0.0;         // speed: thrust limits (anti-windup clamps the integral)
+  double max_thrust_n = 4e6;
+  template <class V>
+  void visit(V& v) {
+    v.field("mode", mode, "-", "constant_thrust | thrust_series | speed (PI controller on thrust)",
+            one_of({"constant_thrust", "thrust_series", "speed"}));
+    v.field("thrust_n", thrust_n, "N", "constant_thrust: thrust along the vessel's x axis");
+    v.field("thrust_file", thrust_file, "-",
+            "thrust_series: CSV with header time_s,thrust_N (path relative to the config file); linear "
+            "interpolation, held constant outside");
+    v.field("speed_mps", speed_mps, "m/s", "speed: prescribed forward speed through the water", non_negative());
+    v.field("kp_n_per_mps", kp_n_per_mps, "N/(m/s)", "speed: proportional gain of the thrust controller",
+            non_negative());
+    v.field("ki_n_per_m", ki_n_per_m, "N/m", "speed: integral gain of the thrust controller", non_negative());
+    v.field("min_thrust_n", min_thrust_n, "N", "speed: smallest thrust (negative = astern allowed)");
+    v.field("max_thrust_n", max_thrust_n, "N", "speed: largest thrust", positive());
+    if (min_thrust_n > max_thrust_n) v.problem("min_thrust_n", "must be <= max_thrust_n");
+    if (mode == "thrust_series" && thrust_file.empty()) v.problem("thrust_file", "must be set for mode thrust_series");
+  }
+};
+
+// Heading hold: a PD yaw moment (rudder/azimuth thrusters lumped) that keeps the initial course.
+struct AutopilotOptions {
+  bool enabled = true;
+  double natural_period_s = 40.0;  // closed-loop yaw natural period
+  double damping_ratio = 1.0;      // closed-loop yaw damping ratio
+  double max_moment_nm = 5e8;      // limit of the steering moment
+  template <class V>
+  void visit(V& v) {
+    v.field("enabled", enabled, "-", "hold the initial heading with a PD yaw moment");
+    v.field("natural_period_s", natural_period_s, "s", "closed-loop yaw natural period", positive());
+    v.field("damping_ratio", damping_ratio, "-", "closed-loop yaw damping ratio", positive());
+    v.field("max_moment_nm", max_moment_nm, "N m", "largest steering moment", positive());
+  }
+};
+
+struct VesselOptions {
+  double x_m = 0.0;               // initial centre of mass, world x
+  double y_m = 0.0;               // initial centre of mass, world y
+  double heading_deg = 0.0;       // course: direction of the bow (CCW from +x)
+  double initial_speed_mps = 2.0;  // initial forward speed
+  double mass_kg = 0.0;           // 0: rho_w times the hull volume below z = 0
+  double vcg_m = -0.5;            // z of the centre of mass in the hull frame (waterline z = 0)
+  double kxx_m = 0.0;             // radii of gyration; 0: 0.38 B, 0.25 L, 0.25 L
+  double kyy_m = 0.0;
+  double kzz_m = 0.0;
+  double form_factor_k = 0.3;     // ITTC-57 form factor
+  double roughness_ca = 0.0004;   // ITTC roughness allowance C_A
+  double sway_drag_cd = 0.8;      // cross-flow drag coefficient (sway and yaw damping), on L_wl x draught
+  PropulsionOptions propulsion;
+  AutopilotOptions autopilot;
+  template <class V>
+  void visit(V& v) {
+    v.field("x_m", x_m, "m", "initial centre of mass, world x");
+    v.field("y_m", y_m, "m", "initial centre of mass, world y");
+    v.field("heading_deg", heading_deg, "deg", "course: direction of the bow, CCW from +x", in_range(-360, 360));
+    v.field("initial_speed_mps", initial_speed_mps, "m/s", "initial forward speed", non_negative());
+    v.field("mass_kg", mass_kg, "kg", "vessel mass; 0 = rho_w x hull volume below the waterline", non_negative());
+    v.field("vcg_m", vcg_m, "m", "height of the centre of mass in the hull frame (waterline at z = 0)");
+    v.field("kxx_m", kxx_m, "m", "roll radius of gyration; 0 = 0.38 x waterline beam", non_negative());
+    v.field("kyy_m", kyy_m, "m", "pitch radius of gyration; 0 = 0.25 x length over all", non_negative());
+    v.field("kzz_m", kzz_m, "m", "yaw radius of gyration; 0 = 0.25 x length over all", non_negative());
+    v.field("form_factor_k", form_factor_k, "-", "ITTC-57 form factor (1 + k) C_F", in_range(0, 2));
+    v.field("roughness_ca", roughness_ca, "-", "ITTC roughness allowance C_A", in_range(0, 0.01));
+    v.field("sway_drag_cd", sway_drag_cd, "-", "cross-flow drag coefficient for sway and yaw damping",
+            non_negative());
+    v.section("propulsion", propulsion, "how the vessel is driven");
+    v.section("autopilot", autopilot, "heading hold");
+  }
+};
+
+// Wind on the vessel (Fossen's coefficients) and on the floes' top faces (air skin drag).
+struct WindOptions {
+  double speed_mps = 0.0;
+  double direction_deg = 0.0;        // direction the wind blows to
+  double air_density_kg_m3 = 1.3;
+  double frontal_area_m2 = 400.0;    // vessel projected area above water, seen from ahead
+  double lateral_area_m2 = 900.0;    // vessel projected area above water, seen from the side
+  double cx = 0.7;                   // C_X = -cx cos(gamma), gamma = relative wind angle, 0 = head wind
+  double cy = 0.8;                   // C_Y = cy sin(gamma)
+  double cn = 0.1;                   // C_N = cn sin(2 gamma)
+  template <class V>
+  void visit(V& v) {
+    v.field("speed_mps", speed_mps, "m/s", "wind speed (0 = no wind)", non_negative());
+    v.field("direction_deg", direction_deg, "deg", "direction the wind blows to (CCW from +x)", in_range(-360, 360));
+    v.field("air_density_kg_m3", air_density_kg_m3, "kg/m^3", "air density", positive());
+    v.field("frontal_area_m2", frontal_area_m2, "m^2", "vessel frontal wind area", non_negative());
+    v.field("lateral_area_m2", lateral_area_m2, "m^2", "vessel lateral wind area", non_negative());
+    v.field("cx", cx, "-", "Fossen surge wind coefficient amplitude", non_negative());
+    v.field("cy", cy, "-", "Fossen sway wind coefficient amplitude", non_negative());
+    v.field("cn", cn, "-", "Fossen yaw wind coefficient amplitude", non_negative());
+  }
+};
+
+struct SolverOptions {
+  int iterations = 60;             // largest number of projected Gauss-Seidel sweeps per step
+  int relax_iterations = 15;       // sweeps without the push-out bias after integration (Box2D v3 "relax")
+  double tolerance_mps = 1e-5;     // stop when no contact velocity changed by more than this in a sweep
+  double erp = 0.2;                // error reduction: fraction of the overlap (beyond slop) closed per step
+  double slop_m = 0.005;           // overlap tolerated without push-out (prevents jitter)
+  double max_push_mps = 0.5;       // cap of the push-out velocity of rigid contacts
+  double speculative_m = 0.02;     // manifold points up to this far apart are kept (speculative contacts)
+  bool warm_start = true;          // start from the previous step's impulses (matched per contact)
+  template <class V>
+  void visit(V& v) {
+    v.field("iterations", iterations, "-", "largest number of Gauss-Seidel sweeps per step", int_in_range(1, 10000));
+    v.field("relax_iterations", relax_iterations, "-",
+            "sweeps without push-out bias after the position update, so that push-out leaves no velocity",
+            int_in_range(0, 10000));
+    v.field("tolerance_mps", tolerance_mps, "m/s", "stop when a sweep changes no contact velocity by more than this",
+            non_negative());
+    v.field("erp", erp, "-", "error reduction parameter: fraction of the overlap closed per step", in_range(0, 1));
+    v.field("slop_m", slop_m, "m", "overlap tolerated without push-out", non_negative());
+    v.field("max_push_mps", max_push_mps, "m/s", "largest push-out velocity of the ERP bias", positive());
+    v.field("speculative_m", speculative_m, "m",
+            "manifold points separated by up to this are kept as speculative contacts", non_negative());
+    v.field("warm_start", warm_start, "-", "start each step from the previous impulses");
+  }
+};
+
+struct SleepOptions {
+  bool enabled = true;
+  double linear_mps = 0.02;      // a floe slower than this ...
+  double angular_radps = 0.02;   // ... and turning slower than this ...
+  double time_s = 1.0;           // ... without contacts for this long falls asleep (not integrated)
+  template <class V>
+  void visit(V& v) {
+    v.field("enabled", enabled, "-", "let resting floes sleep (no integration until touched)");
+    v.field("linear_mps", linear_mps, "m/s", "speed below which a floe may sleep", non_negative());
+    v.field("angular_radps", angular_radps, "rad/s", "angular speed below which a floe may sleep", non_negative());
+    v.field("time_s", time_s, "s", "time below the thresholds, without contacts, before sleeping", non_negative());
+  }
+};
+
+// Numerical health: the run stops with a diagnosis instead of writing nonsense.
+struct HealthOptions {
+  double max_speed_mps = 30.0;        // any body faster than this is a blow-up
+  double max_angular_radps = 30.0;    // any body turning faster than this is a blow-up
+  template <class V>
+  void visit(V& v) {
+    v.field("max_speed_mps", max_speed_mps, "m/s", "a body faster than this stops the run (energy blow-up)",
+            positive());
+    v.field("max_angular_radps", max_angular_radps, "rad/s", "a body turning faster than this stops the run",
+            positive());
+  }
+};
+
+struct SimulateOptions {
+  double time_step_s = 0.01;
+  double duration_s = 100.0;
+  double output_interval_s = 0.2;
+  double steady_start_s = 20.0;   // statistics of the summary start here (skip the start-up transient)
+  int threads = 1;
+  IceOptions ice;
+  WaterOptions water;
+  VesselOptions vessel;
+  WindOptions wind;
+  SolverOptions solver;
+  SleepOptions sleep;
+  HealthOptions health;
+  HullLoadOptions hull;
+
+  template <class V>
+  void visit(V& v) {
+    v.field("time_step_s", time_step_s, "s", "time step", in_range(1e-5, 0.1));
+    v.field("duration_s", duration_s, "s", "simulated time (a whole number of time steps)", positive());
+    v.field("output_interval_s", output_interval_s, "s",
+            "interval of the stored body states (a whole number of time steps)", positive());
+    v.field("steady_start_s", steady_start_s, "s", "start of the steady part used for the summary statistics",
+            non_negative());
+    v.field("threads", threads, "-", "worker threads for the per-body force and narrow-phase stages",
+            int_in_range(1, 64));
+    v.section("ice", ice, "ice material");
+    v.section("water", water, "water, gravity and current");
+    v.section("vessel", vessel, "vessel start, mass, resistance, propulsion, steering");
+    v.section("wind", wind, "wind");
+    v.section("solver", solver, "contact solver");
+    v.section("sleep", sleep, "sleeping of resting floes");
+    v.section("health", health, "numerical health limits");
+    v.section("hull", hull, "how the hull file is loaded (non-convex meshes)");
+    // Cross-field checks: whole numbers of steps, statistics window inside the run.
+    if (time_step_s > 0 && duration_s > 0) {
+      const double n = duration_s / time_step_s;
+      if (std::abs(n - std::round(n)) > 1e-6 * std::max(1.0, n))
+        v.problem("duration_s", "must be a whole number of time steps (time_step_s = " + Json(time_step_s).dump() + ")");
+    }
+    if (time_step_s > 0 && output_interval_s > 0) {
+      const double n = output_interval_s / time_step_s;
+      if (output_interval_s < time_step_s * (1 - 1e-9))
+        v.problem("output_interval_s", "must be >= time_step_s");
+      else if (std::abs(n - std::round(n)) > 1e-6 * std::max(1.0, n))
+        v.problem("output_interval_s", "must be a whole number of time steps");
+    }
+    if (duration_s > 0 && output_interval_s > duration_s) v.problem("output_interval_s", "must be <= duration_s");
+    else if (duration_s > 0 && output_interval_s > 0) {
+      const double n = duration_s / output_interval_s;
+      if (std::abs(n - std::round(n)) > 1e-6 * std::max(1.0, n))
+        v.problem("output_interval_s", "must divide duration_s (frames are stored at k x output_interval_s)");
+    }
+    if (steady_start_s >= duration_s) v.problem("steady_start_s", "must be < duration_s");
+  }
+
+  long steps() const { return std::lround(duration_s / time_step_s); }
+  long output_every() const { return std::lround(output_interval_s / time_step_s); }
+};
+
+}  // namespace floesim::sim

@@ -1,0 +1,154 @@
+#include "sim/solver.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace floesim::sim {
+
+namespace {
+
+// Orthonormal tangents of a unit normal, a deterministic function of the normal alone.
+void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
+  if (std::abs(n.x()) >= 0.57735026919) t1 = Vec3(n.y(), -n.x(), 0).normalized();
+  else t1 = Vec3(0, n.z(), -n.y()).normalized();
+  t2 = n.cross(t1);
+}
+
+bool key_less(const CachedContact& c, const Contact& k) {
+  if (c.body_a != k.body_a) return c.body_a < k.body_a;
+  if (c.part_a != k.part_a) return c.part_a < k.part_a;
+  if (c.body_b != k.body_b) return c.body_b < k.body_b;
+  return c.part_b < k.part_b;
+}
+bool same_key(const CachedContact& c, const Contact& k) {
+  return c.body_a == k.body_a && c.part_a == k.part_a && c.body_b == k.body_b && c.part_b == k.part_b;
+}
+
+// Applies an impulse p along the row (d, ia, ib) to the two bodies: a gets -p, b gets +p.
+inline void apply(State& s, const SolverBodies& sb, const Contact& c, const Vec3& d, const Vec3& ia, const Vec3& ib,
+                  double p) {
+  s.velocity[c.body_a] -= (sb.inv_mass[c.body_a] * p) * d;
+  s.angular_velocity[c.body_a] -= p * ia;
+  s.velocity[c.body_b] += (sb.inv_mass[c.body_b] * p) * d;
+  s.angular_velocity[c.body_b] += p * ib;
+}
+
+// Relative velocity of b with respect to a at the contact, along d.
+inline double rel_velocity(const State& s, const Contact& c, const Vec3& d) {
+  const Vec3 va = s.velocity[c.body_a] + s.angular_velocity[c.body_a].cross(c.ra);
+  const Vec3 vb = s.velocity[c.body_b] + s.angular_velocity[c.body_b].cross(c.rb);
+  return d.dot(vb - va);
+}
+
+}  // namespace
+
+void prepare_contacts(const Model& model, const SolverBodies& sb, State& state, std::vector<Contact>& contacts,
+                      double dt) {
+  const SolverOptions& o = model.options.solver;
+  const double match_tol2 = 0.1 * 0.1;  // m^2: a cached point further than 10 cm is another point
+  for (Contact& c : contacts) {
+    // 1. Auxiliary data: lever arms, tangents, I^-1 (r x d) per row and body, effective masses 1/W.
+    c.ra = c.point - state.position[c.body_a];
+    c.rb = c.point - state.position[c.body_b];
+    tangents(c.normal, c.t1, c.t2);
+    const Mat3& Ia = sb.inv_inertia_world[c.body_a];
+    const Mat3& Ib = sb.inv_inertia_world[c.body_b];
+    const double im = sb.inv_mass[c.body_a] + sb.inv_mass[c.body_b];
+    auto row = [&](const Vec3& d, Vec3& ia, Vec3& ib) {
+      const Vec3 rad = c.ra.cross(d), rbd = c.rb.cross(d);
+      ia = Ia * rad;
+      ib = Ib * rbd;
+      const double w = im + rad.dot(ia) + rbd.dot(ib);
+      return w > 0 ? 1.0 / w : 0.0;
+    };
+    c.mass_n = row(c.normal, c.ia_n, c.ib_n);
+    c.mass_t1 = row(c.t1, c.ia_t1, c.ib_t1);
+    c.mass_t2 = row(c.t2, c.ia_t2, c.ib_t2);
+    // Bias = smallest allowed normal velocity. Rigid: push out the overlap beyond the slop at ERP per step (capped);
+    // a speculative gap allows approaching by gap/dt. Crushing rows never push out (PHYSICS.md §1.8(c)).
+    if (c.type == ContactType::crushing) c.bias = 0;
+    else if (c.gap > 0) c.bias = -c.gap / dt;
+    else c.bias = std::min(o.erp * std::max(0.0, -c.gap - o.slop_m) / dt, o.max_push_mps);
+    c.local_a = state.orientation[c.body_a].conjugate() * c.ra;
+    c.pn = c.pt1 = c.pt2 = 0;
+
+    // 2. Warm start: the nearest cached point of the same part pair, projected on the new rows.
+    if (!o.warm_start) continue;
+    auto it = std::lower_bound(state.contact_cache.begin(), state.contact_cache.end(), c, key_less);
+    const CachedContact* best = nullptr;
+    double bd = match_tol2;
+    for (; it != state.contact_cache.end() && same_key(*it, c); ++it) {
+      const double d = (it->local_a - c.local_a).squaredNorm();
+      if (d < bd) bd = d, best = &*it;
+    }
+    if (!best) continue;
+    c.pn = std::clamp(best->impulse.dot(c.normal), 0.0, c.max_normal_impulse);
+    c.pt1 = best->impulse.dot(c.t1);
+    c.pt2 = best->impulse.dot(c.t2);
+    const double lim = c.mu * c.pn, pt = std::hypot(c.pt1, c.pt2);
+    if (pt > lim) {
+      const double s = pt > 0 ? lim / pt : 0.0;
+      c.pt1 *= s;
+      c.pt2 *= s;
+    }
+    apply(state, sb, c, c.normal, c.ia_n, c.ib_n, c.pn);
+    apply(state, sb, c, c.t1, c.ia_t1, c.ib_t1, c.pt1);
+    apply(state, sb, c, c.t2, c.ia_t2, c.ib_t2, c.pt2);
+  }
+}
+
+SolverReport solve_contacts(const Model& model, const SolverBodies& sb, State& state, std::vector<Contact>& contacts,
+                            double dt, bool use_bias, int iterations, double tolerance) {
+  SolverReport rep;
+  if (contacts.empty()) return rep;
+  // 3. Sweeps. Normal row first (accumulated impulse clamped to [0, bound]), then the two friction rows projected
+  // together onto the Coulomb disk of radius mu p_n (the exact cone section, no polyhedral anisotropy).
+  for (int it = 0; it < iterations; ++it) {
+    double change = 0;
+    for (Contact& c : contacts) {
+      const double target = use_bias ? c.bias : (c.gap > 0 && c.type == ContactType::rigid ? -c.gap / dt : 0.0);
+      const double vn = rel_velocity(state, c, c.normal);
+      const double pn = std::clamp(c.pn + c.mass_n * (target - vn), 0.0, c.max_normal_impulse);
+      const double dpn = pn - c.pn;
+      if (dpn != 0) {
+        apply(state, sb, c, c.normal, c.ia_n, c.ib_n, dpn);
+        c.pn = pn;
+        change = std::max(change, std::abs(dpn) / std::max(c.mass_n, 1e-300));
+      }
+      const double lim = c.mu * c.pn;
+      const double v1 = rel_velocity(state, c, c.t1), v2 = rel_velocity(state, c, c.t2);
+      double p1 = c.pt1 - c.mass_t1 * v1, p2 = c.pt2 - c.mass_t2 * v2;
+      const double pt = std::hypot(p1, p2);
+      if (pt > lim) {
+        const double s = pt > 0 ? lim / pt : 0.0;
+        p1 *= s;
+        p2 *= s;
+      }
+      const double d1 = p1 - c.pt1, d2 = p2 - c.pt2;
+      if (d1 != 0) {
+        apply(state, sb, c, c.t1, c.ia_t1, c.ib_t1, d1);
+        change = std::max(change, std::abs(d1) / std::max(c.mass_t1, 1e-300));
+      }
+      if (d2 != 0) {
+        apply(state, sb, c, c.t2, c.ia_t2, c.ib_t2, d2);
+        change = std::max(change, std::abs(d2) / std::max(c.mass_t2, 1e-300));
+      }
+      c.pt1 = p1;
+      c.pt2 = p2;
+    }
+    // 4. Residual and iteration count.
+    rep.iterations = it + 1;
+    rep.residual = change;
+    if (!(change > tolerance)) break;  // also stops on NaN: the caller's health check reports it
+  }
+  return rep;
+}
+
+void store_impulses(const Model& model, State& state, const std::vector<Contact>& contacts) {
+  state.contact_cache.clear();
+  for (const Contact& c : contacts)
+    state.contact_cache.push_back(CachedContact{c.body_a, c.part_a, c.body_b, c.part_b, c.local_a,
+                                                c.pn * c.normal + c.pt1 * c.t1 + c.pt2 * c.t2});
+}
+
+}  // namespace floesim::sim

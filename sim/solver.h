@@ -1,0 +1,38 @@
+// Velocity-level contact solver: matrix-free projected Gauss-Seidel on the cone complementarity problem
+// (PHYSICS.md §1.4-1.6), one normal row and two friction rows per contact, with warm starting, the ERP push-out
+// bias for rigid rows and an upper bound on the normal impulse (infinite for rigid rows; the crushing cap of
+// §1.8(c) for the compliant rows of a later issue). Laid out like Chrono's ChSolverPSOR in numbered steps.
+#pragma once
+#include <vector>
+
+#include "sim/model.h"
+#include "sim/state.h"
+
+namespace floesim::sim {
+
+struct SolverReport {
+  int iterations = 0;     // sweeps of the last solve
+  double residual = 0;    // largest contact velocity change in the last sweep (m/s)
+};
+
+// Per-body data the solver needs (world frame), filled by the caller for the bodies of the step.
+struct SolverBodies {
+  std::vector<double> inv_mass;
+  std::vector<Mat3> inv_inertia_world;
+};
+
+// 1. Auxiliary data (lever arms, tangents, effective masses, bias) and 2. the warm start: impulses taken from the
+// previous step's cache (matched by body/part pair and nearest local point) and applied to the velocities.
+void prepare_contacts(const Model& model, const SolverBodies& bodies, State& state, std::vector<Contact>& contacts,
+                      double dt);
+
+// 3. Gauss-Seidel sweeps until the largest velocity change of a sweep is below `tolerance` or `iterations` sweeps.
+// use_bias = false is the relax pass: rigid rows only keep non-penetration (and speculative gaps), no push-out.
+SolverReport solve_contacts(const Model& model, const SolverBodies& bodies, State& state,
+                            std::vector<Contact>& contacts, double dt, bool use_bias, int iterations,
+                            double tolerance);
+
+// 4. Keeps the impulses for the next step's warm start (sorted, as the contacts are).
+void store_impulses(const Model& model, State& state, const std::vector<Contact>& contacts);
+
+}  // namespace floesim::sim

@@ -1,0 +1,66 @@
+// The mutable state of a simulation (MuJoCo's mjData idea), and the contact record that the collision stage fills
+// and the solver reads and updates. Comments say which stage writes each field.
+#pragma once
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "sim/mesh.h"
+
+namespace floesim::sim {
+
+using Quat = Eigen::Quaterniond;
+
+// Rigid: non-penetration with ERP push-out (this issue). Crushing: compliant ice crushing, normal impulse capped by
+// the crushing force (PHYSICS.md §1.8(c), a later issue): the row structure below already carries its bound.
+enum class ContactType : uint8_t { rigid, crushing };
+
+// One contact point between body a and body b (a < b). Written by collide, completed and solved by solve.
+struct Contact {
+  int body_a = -1, body_b = -1;
+  int part_a = -1, part_b = -1;
+  Vec3 point = Vec3::Zero();   // world, midway between the surfaces
+  Vec3 normal = Vec3::UnitZ(); // world, unit, from a to b
+  double gap = 0;              // signed distance along the normal: < 0 overlap, > 0 speculative
+  ContactType type = ContactType::rigid;
+  double mu = 0;               // friction coefficient
+  double max_normal_impulse = std::numeric_limits<double>::infinity();  // N s; finite for crushing contacts
+  // Solver data (solve): lever arms, tangents, effective masses, bias and the accumulated impulses.
+  Vec3 ra = Vec3::Zero(), rb = Vec3::Zero();
+  Vec3 t1 = Vec3::Zero(), t2 = Vec3::Zero();
+  Vec3 ia_n = Vec3::Zero(), ib_n = Vec3::Zero();    // I^-1 (r x n), world
+  Vec3 ia_t1 = Vec3::Zero(), ib_t1 = Vec3::Zero();
+  Vec3 ia_t2 = Vec3::Zero(), ib_t2 = Vec3::Zero();
+  double mass_n = 0, mass_t1 = 0, mass_t2 = 0;       // effective masses 1/W of the rows
+  double bias = 0;                                    // smallest allowed normal velocity (m/s)
+  double pn = 0, pt1 = 0, pt2 = 0;                    // accumulated impulses (N s)
+  Vec3 local_a = Vec3::Zero();                        // point in a's body frame (warm-start matching)
+};
+
+// The impulses of one contact kept for warm starting the next step, keyed by body/part pair and local point.
+struct CachedContact {
+  int body_a, part_a, body_b, part_b;
+  Vec3 local_a;
+  Vec3 impulse;  // world: pn n + pt1 t1 + pt2 t2
+};
+
+struct State {
+  double time_s = 0;
+  long step = 0;
+  // Per body (index as in Model::bodies). Positions are centres of mass; quaternions body -> world.
+  std::vector<Vec3> position;
+  std::vector<Quat> orientation;
+  std::vector<Vec3> velocity;           // world, m/s
+  std::vector<Vec3> angular_velocity;   // world, rad/s
+  std::vector<uint8_t> awake;           // 0: sleeping (not integrated, no forces)
+  std::vector<double> still_time_s;     // time spent below the sleep thresholds without contacts
+  std::vector<CachedContact> contact_cache;  // sorted by (body_a, part_a, body_b, part_b)
+  // Vessel controllers.
+  double speed_error_integral = 0;      // m, integral of the speed error (PI thrust controller)
+  double heading_ref_rad = 0;           // course held by the autopilot
+};
+
+}  // namespace floesim::sim

@@ -1,0 +1,274 @@
+#include "sim/world.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "pipeline/error.h"
+
+namespace floesim::sim {
+
+const char* stage_name(int stage) {
+  static const char* names[kStageCount] = {"collide", "forces", "solve", "integrate", "relax", "sleep"};
+  return names[stage];
+}
+
+namespace {
+
+class StageTimer {
+ public:
+  explicit StageTimer(double& acc) : acc_(acc), t0_(std::chrono::steady_clock::now()) {}
+  ~StageTimer() { acc_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count(); }
+
+ private:
+  double& acc_;
+  std::chrono::steady_clock::time_point t0_;
+};
+
+bool finite(const Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
+
+}  // namespace
+
+World::World(const Model& model) : model_(model), pool_(model.options.threads) {
+  const size_t n = model.bodies.size();
+  const SimulateOptions& o = model.options;
+  // Floes start asleep at equilibrium in still water and air; anything that drives them wakes them all.
+  const bool start_asleep = o.sleep.enabled && o.water.enabled && model.current.squaredNorm() == 0 &&
+                            model.wind.squaredNorm() == 0;
+  state_.position.resize(n);
+  state_.orientation.resize(n);
+  state_.velocity.assign(n, Vec3::Zero());
+  state_.angular_velocity.assign(n, Vec3::Zero());
+  state_.awake.assign(n, start_asleep ? 0 : 1);
+  state_.still_time_s.assign(n, 0.0);
+  for (size_t b = 0; b < n; ++b) {
+    state_.position[b] = model.bodies[b].initial_position;
+    state_.orientation[b] = model.bodies[b].initial_orientation;
+  }
+  if (model.vessel >= 0) {
+    const int v = model.vessel;
+    state_.awake[v] = 1;
+    const Mat3 R = state_.orientation[v].toRotationMatrix();
+    state_.velocity[v] = o.vessel.initial_speed_mps * R.col(0) + Vec3(model.current.x(), model.current.y(), 0);
+    state_.heading_ref_rad = heading_of(R);
+  }
+  solver_bodies_.inv_mass.resize(n);
+  solver_bodies_.inv_inertia_world.assign(n, Mat3::Zero());
+  for (size_t b = 0; b < n; ++b) solver_bodies_.inv_mass[b] = model.bodies[b].inv_mass;
+  external_.resize(n);
+  in_contact_.assign(n, 0);
+  scratch_.resize(pool_.threads());
+  collision_ = std::make_unique<CollisionWorld>(model_, state_, pool_);
+}
+
+World::~World() = default;
+
+void World::sync() {
+  std::vector<int> all(model_.bodies.size());
+  for (size_t b = 0; b < all.size(); ++b) all[b] = static_cast<int>(b);
+  collision_->update_bodies(state_, all);
+  moved_.clear();
+}
+
+void World::wake(int body) {
+  state_.awake[body] = 1;
+  state_.still_time_s[body] = 0;
+}
+
+std::string World::body_name(int body) const {
+  if (body == model_.vessel) return "the vessel";
+  return "floe id " + std::to_string(model_.bodies[body].id);
+}
+
+void World::fail(int body, const std::string& what) const {
+  std::ostringstream os;
+  os << "numerical failure at step " << state_.step + 1 << " (t = " << state_.time_s + model_.options.time_step_s
+     << " s)";
+  if (body >= 0) os << ", " << body_name(body);
+  os << ": " << what
+     << ". Nothing was written. Try a smaller time_step_s, more solver.iterations, or check the inputs.";
+  throw Error(os.str());
+}
+
+void World::step() {
+  report_ = StepReport{};
+  { StageTimer t(stage_seconds_[kCollide]); stage_collide(); }
+  { StageTimer t(stage_seconds_[kForces]); stage_forces(); }
+  { StageTimer t(stage_seconds_[kSolve]); stage_solve(); }
+  { StageTimer t(stage_seconds_[kIntegrate]); stage_integrate(); }
+  { StageTimer t(stage_seconds_[kRelax]); stage_relax(); }
+  { StageTimer t(stage_seconds_[kSleep]); stage_sleep(); }
+  state_.time_s = (state_.step + 1) * model_.options.time_step_s;  // no drift from repeated addition
+  ++state_.step;
+}
+
+void World::stage_collide() {
+  collision_->update_bodies(state_, moved_);
+  collision_->find_contacts(state_, contacts_);
+  // A contact with an awake body wakes a sleeper; its pose is current, its velocity zero.
+  for (const Contact& c : contacts_) {
+    if (!state_.awake[c.body_a]) wake(c.body_a);
+    if (!state_.awake[c.body_b]) wake(c.body_b);
+  }
+  std::fill(in_contact_.begin(), in_contact_.end(), 0);
+  for (const Contact& c : contacts_) in_contact_[c.body_a] = in_contact_[c.body_b] = 1;
+  awake_list_.clear();
+  for (size_t b = 0; b < model_.bodies.size(); ++b)
+    if (state_.awake[b]) awake_list_.push_back(static_cast<int>(b));
+}
+
+void World::stage_forces() {
+  const double dt = model_.options.time_step_s;
+  const bool water = model_.options.water.enabled;
+  auto kinematics = [&](int b) {
+    BodyKinematics k;
+    k.x = state_.position[b];
+    k.q = state_.orientation[b];
+    k.R = k.q.toRotationMatrix();
+    k.v = state_.velocity[b];
+    k.w = state_.angular_velocity[b];
+    return k;
+  };
+  // Per body: external wrench, world inverse inertia, then the predicted velocities v* = v + dt M^-1 f.
+  auto advance = [&](int b, const BodyKinematics& k, const Wrench& w) {
+    const Body& body = model_.bodies[b];
+    const Mat3 Iw = k.R * body.inertia * k.R.transpose();
+    const Mat3 Iinv = k.R * body.inv_inertia * k.R.transpose();
+    solver_bodies_.inv_inertia_world[b] = Iinv;
+    external_[b] = w;
+    // Gyroscopic term w x (I w), explicit.
+    state_.velocity[b] += dt * body.inv_mass * w.force;
+    state_.angular_velocity[b] += dt * (Iinv * (w.torque - k.w.cross(Iw * k.w)));
+  };
+  // The vessel on this thread (its controllers keep state).
+  const int vessel = model_.vessel;
+  if (vessel >= 0) {
+    const Body& body = model_.bodies[vessel];
+    const BodyKinematics k = kinematics(vessel);
+    Wrench total = gravity_force(model_, body);
+    if (water) {
+      report_.hydro_load += buoyancy_force(model_, body, k, scratch_[0]);
+      report_.hydro_load += hydrostatic_damping(model_, body, k);
+      report_.hydro_load += vessel_resistance(model_, k);
+      report_.hydro_load += vessel_cross_flow(model_, k);
+    }
+    report_.wind_load = vessel_wind(model_, k);
+    report_.propulsion_load = vessel_propulsion(model_, k, state_.time_s, dt, state_.speed_error_integral,
+                                                report_.thrust_n);
+    report_.propulsion_load += vessel_autopilot(model_, body, k, state_.heading_ref_rad);
+    total += report_.hydro_load;
+    total += report_.wind_load;
+    total += report_.propulsion_load;
+    advance(vessel, k, total);
+  }
+  // Floes in parallel: each writes only its own slots.
+  const int n = static_cast<int>(awake_list_.size());
+  pool_.parallel_for(n, [&](int begin, int end, int worker) {
+    ForceScratch& s = scratch_[worker];
+    for (int i = begin; i < end; ++i) {
+      const int b = awake_list_[i];
+      if (b == vessel) continue;
+      const Body& body = model_.bodies[b];
+      const BodyKinematics k = kinematics(b);
+      Wrench w = gravity_force(model_, body);
+      if (water) {
+        w += buoyancy_force(model_, body, k, s);
+        w += hydrostatic_damping(model_, body, k);
+        w += floe_water_drag(model_, body, k, s);
+      }
+      w += floe_wind_drag(model_, body, k, s);
+      advance(b, k, w);
+    }
+  });
+}
+
+void World::stage_solve() {
+  const SolverOptions& o = model_.options.solver;
+  prepare_contacts(model_, solver_bodies_, state_, contacts_, model_.options.time_step_s);
+  report_.solve = solve_contacts(model_, solver_bodies_, state_, contacts_, model_.options.time_step_s, true,
+                                 o.iterations, o.tolerance_mps);
+}
+
+void World::stage_integrate() {
+  const double dt = model_.options.time_step_s;
+  for (int b : awake_list_) {
+    state_.position[b] += dt * state_.velocity[b];
+    const Vec3& w = state_.angular_velocity[b];
+    Quat& q = state_.orientation[b];
+    const Quat dq(0, 0.5 * dt * w.x(), 0.5 * dt * w.y(), 0.5 * dt * w.z());
+    q.coeffs() += (dq * q).coeffs();
+    q.normalize();
+  }
+  moved_ = awake_list_;
+}
+
+void World::stage_relax() {
+  const SolverOptions& o = model_.options.solver;
+  const double dt = model_.options.time_step_s;
+  if (o.relax_iterations > 0)
+    report_.relax = solve_contacts(model_, solver_bodies_, state_, contacts_, dt, false, o.relax_iterations,
+                                   o.tolerance_mps);
+  store_impulses(model_, state_, contacts_);
+  // Contact loads on the vessel: impulse / dt, about its centre of mass (lever arms of the solve).
+  report_.contacts = static_cast<int>(contacts_.size());
+  const int vessel = model_.vessel;
+  for (const Contact& c : contacts_) {
+    if (c.body_a != vessel && c.body_b != vessel) continue;
+    ++report_.vessel_contacts;
+    const Vec3 p = (c.pn * c.normal + c.pt1 * c.t1 + c.pt2 * c.t2) / dt;  // on body b
+    Wrench w;
+    if (c.body_b == vessel) w.add_at(p, c.rb);
+    else w.add_at(-p, c.ra);
+    report_.ice_load += w;
+    (c.type == ContactType::rigid ? report_.ice_load_rigid : report_.ice_load_compliant) += w;
+  }
+}
+
+void World::stage_sleep() {
+  const SleepOptions& s = model_.options.sleep;
+  const HealthOptions& h = model_.options.health;
+  const double dt = model_.options.time_step_s;
+  if (!std::isfinite(report_.solve.residual) || !std::isfinite(report_.relax.residual))
+    fail(-1, "the contact solver diverged (residual is not finite)");
+  report_.awake_floes = static_cast<int>(awake_list_.size()) - (model_.vessel >= 0 ? 1 : 0);
+  for (int b : awake_list_) {
+    const Vec3& v = state_.velocity[b];
+    const Vec3& w = state_.angular_velocity[b];
+    if (!finite(state_.position[b]) || !finite(v) || !finite(w) || !std::isfinite(state_.orientation[b].w()))
+      fail(b, "position or velocity is not finite");
+    if (v.norm() > h.max_speed_mps)
+      fail(b, "speed " + std::to_string(v.norm()) + " m/s exceeds health.max_speed_mps (energy blow-up)");
+    if (w.norm() > h.max_angular_radps)
+      fail(b, "angular speed " + std::to_string(w.norm()) + " rad/s exceeds health.max_angular_radps (blow-up)");
+    if (b == model_.vessel) continue;
+    if (s.enabled && !in_contact_[b] && v.norm() < s.linear_mps && w.norm() < s.angular_radps) {
+      state_.still_time_s[b] += dt;
+      if (state_.still_time_s[b] >= s.time_s) {
+        state_.awake[b] = 0;
+        state_.velocity[b].setZero();
+        state_.angular_velocity[b].setZero();
+      }
+    } else {
+      state_.still_time_s[b] = 0;
+    }
+  }
+}
+
+double World::kinetic_energy() const {
+  double e = 0;
+  for (size_t b = 0; b < model_.bodies.size(); ++b) {
+    const Body& body = model_.bodies[b];
+    const Mat3 R = state_.orientation[b].toRotationMatrix();
+    const Vec3 wb = R.transpose() * state_.angular_velocity[b];
+    e += 0.5 * body.mass_kg * state_.velocity[b].squaredNorm() + 0.5 * wb.dot(body.inertia * wb);
+  }
+  return e;
+}
+
+Vec3 World::linear_momentum() const {
+  Vec3 p = Vec3::Zero();
+  for (size_t b = 0; b < model_.bodies.size(); ++b) p += model_.bodies[b].mass_kg * state_.velocity[b];
+  return p;
+}
+
+}  // namespace floesim::sim

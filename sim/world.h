@@ -1,0 +1,90 @@
+// The time step (Box2D-style list of named, timed stages) over an immutable Model and a mutable State:
+//
+//   collide    broad phase for the bodies that moved, narrow phase + manifolds; awake bodies wake sleepers they touch
+//   forces     external forces on awake bodies (gravity, buoyancy, damping, drag, resistance, propulsion, steering,
+//              wind) -> predicted velocities v* = v + dt M^-1 f
+//   solve      contact rows, warm start, PGS with the ERP bias
+//   integrate  semi-implicit Euler: x += dt v, q += dt/2 [0, w] q (normalised)
+//   relax      PGS without push-out bias, so that resolving overlap leaves no velocity; impulses stored for warm start
+//   sleep      floes at rest without contacts fall asleep; numerical health checks (NaN, blow-up)
+//
+// Loads on the vessel are recorded per step in StepReport (world frame; the recorder turns them to body axes).
+#pragma once
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sim/collision.h"
+#include "sim/forces.h"
+#include "sim/model.h"
+#include "sim/parallel.h"
+#include "sim/solver.h"
+#include "sim/state.h"
+
+namespace floesim::sim {
+
+enum Stage { kCollide, kForces, kSolve, kIntegrate, kRelax, kSleep, kStageCount };
+const char* stage_name(int stage);
+
+// What one step did and the loads on the vessel (world frame, about its centre of mass).
+struct StepReport {
+  int contacts = 0, vessel_contacts = 0;
+  int awake_floes = 0;
+  SolverReport solve, relax;
+  Wrench ice_load, ice_load_rigid, ice_load_compliant;
+  Wrench hydro_load, wind_load, propulsion_load;
+  double thrust_n = 0;
+};
+
+class World {
+ public:
+  explicit World(const Model& model);
+  ~World();
+
+  // Advances one time step. Throws floesim::Error with a diagnosis (step, time, body) on numerical failure.
+  void step();
+
+  const Model& model() const { return model_; }
+  const State& state() const { return state_; }
+  // For tests and set-up: edit the state, then call sync() so that the broad phase sees the new poses.
+  State& mutable_state() { return state_; }
+  void sync();
+  void wake(int body);
+
+  const StepReport& report() const { return report_; }
+  const std::vector<Contact>& contacts() const { return contacts_; }
+  const CollisionStats& collision_stats() const { return collision_->stats(); }
+  // Accumulated wall time per stage (s).
+  const std::array<double, kStageCount>& stage_seconds() const { return stage_seconds_; }
+
+  // Kinetic energy of all bodies (J) and their total linear momentum (N s).
+  double kinetic_energy() const;
+  Vec3 linear_momentum() const;
+
+ private:
+  void stage_collide();
+  void stage_forces();
+  void stage_solve();
+  void stage_integrate();
+  void stage_relax();
+  void stage_sleep();
+  [[noreturn]] void fail(int body, const std::string& what) const;
+  std::string body_name(int body) const;
+
+  const Model& model_;
+  State state_;
+  ThreadPool pool_;
+  std::unique_ptr<CollisionWorld> collision_;
+  std::vector<Contact> contacts_;
+  std::vector<int> awake_list_;     // bodies integrated this step (ascending)
+  std::vector<int> moved_;          // bodies integrated in the previous step (broad phase refresh)
+  std::vector<uint8_t> in_contact_;
+  std::vector<Wrench> external_;    // per body, this step
+  std::vector<ForceScratch> scratch_;
+  SolverBodies solver_bodies_;
+  StepReport report_;
+  std::array<double, kStageCount> stage_seconds_{};
+};
+
+}  // namespace floesim::sim

@@ -1,0 +1,100 @@
+// Contact mechanics as physical invariants: a floe resting on another carries its weight through the contact;
+// colliding floes in vacuum conserve linear momentum and do not gain energy.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "sim/world.h"
+#include "sim_fixtures.h"
+
+namespace floesim::sim {
+namespace {
+
+using testing::floe_options;
+using testing::rect_floe;
+
+// Net contact force on body b this step (impulse / dt), world frame.
+Vec3 contact_force_on(const World& w, int b) {
+  Vec3 f = Vec3::Zero();
+  const double dt = w.model().options.time_step_s;
+  for (const Contact& c : w.contacts()) {
+    const Vec3 p = c.pn * c.normal + c.pt1 * c.t1 + c.pt2 * c.t2;
+    if (c.body_b == b) f += p / dt;
+    if (c.body_a == b) f -= p / dt;
+  }
+  return f;
+}
+
+// A small floe put on top of a big floating one sits above the water (no buoyancy): the contact carries exactly
+// its weight m g. The pair settles to a common heave equilibrium with the big floe deeper by m_small/(rho_w A_big).
+TEST(SimContact, FloeOnFloeCarriesItsWeight) {
+  FloeField field;
+  field.floes = {rect_floe(1, 0, 0, 20, 20, 1.0), rect_floe(2, 30, 0, 4, 4, 0.5)};
+  SimulateOptions o = floe_options();
+  const Model m = build_model(field, nullptr, o);
+  World w(m);
+  State& s = w.mutable_state();
+  const double freeboard_big = s.position[0].z() + 0.5;
+  s.position[1] = Vec3(10, 10, freeboard_big + 0.25);  // small floe's bottom on the big floe's top
+  w.sync();
+  Vec3 mean = Vec3::Zero();
+  int n = 0;
+  for (int i = 0; i < 1500; ++i) {
+    w.step();
+    if (i >= 1000) {
+      mean += contact_force_on(w, 1);
+      ++n;
+    }
+  }
+  mean /= n;
+  const double weight = m.bodies[1].mass_kg * 9.81;
+  std::printf("[measured] contact force on the top floe %.2f N (weight %.2f N, %+.4f %%), horizontal %.3g N\n",
+              mean.z(), weight, 100 * (mean.z() / weight - 1), std::hypot(mean.x(), mean.y()));
+  EXPECT_NEAR(mean.z() / weight, 1.0, 1e-3);
+  EXPECT_LT(std::hypot(mean.x(), mean.y()), 1e-3 * weight);
+  // The top floe stays level on top (a single contact point would let it tip over).
+  const Vec3 up = w.state().orientation[1] * Vec3::UnitZ();
+  EXPECT_GT(up.z(), 0.9999);
+  // Heave equilibrium of the big floe carries the extra weight.
+  const double extra = m.bodies[1].mass_kg / (o.water.density_kg_m3 * 400);
+  const double sink = (m.bodies[0].initial_position.z() - w.state().position[0].z());
+  std::printf("[measured] big floe sinks %.5f m, theory %.5f m\n", sink, extra);
+  EXPECT_NEAR(sink, extra, 2e-3);
+}
+
+// No water, no gravity: two spinning floes collide obliquely. Linear momentum is conserved to round-off and the
+// kinetic energy does not grow (contacts are inelastic; the relax pass removes push-out energy).
+TEST(SimContact, CollisionConservesMomentumInVacuum) {
+  FloeField field;
+  field.floes = {rect_floe(1, 0, 0, 6, 5, 1.0), rect_floe(2, 8, 1.5, 4, 4, 0.8)};
+  SimulateOptions o = floe_options();
+  o.water.enabled = false;
+  o.water.gravity_mps2 = 0;
+  const Model m = build_model(field, nullptr, o);
+  World w(m);
+  State& s = w.mutable_state();
+  s.position[1].z() = s.position[0].z();
+  s.velocity[0] = Vec3(1.0, 0.1, 0);
+  s.velocity[1] = Vec3(-0.8, 0, 0);
+  s.angular_velocity[0] = Vec3(0, 0, 0.2);
+  s.angular_velocity[1] = Vec3(0, 0, -0.3);
+  w.sync();
+  const Vec3 p0 = w.linear_momentum();
+  const double e0 = w.kinetic_energy();
+  int contact_steps = 0;
+  for (int i = 0; i < 400; ++i) {
+    w.step();
+    contact_steps += !w.contacts().empty();
+  }
+  const Vec3 p1 = w.linear_momentum();
+  const double e1 = w.kinetic_energy();
+  std::printf("[measured] %d steps in contact; |dp|/|p| = %.3g; kinetic energy %.1f -> %.1f J\n", contact_steps,
+              (p1 - p0).norm() / p0.norm(), e0, e1);
+  EXPECT_GT(contact_steps, 0);
+  EXPECT_LT((p1 - p0).norm(), 1e-9 * p0.norm());
+  EXPECT_LE(e1, e0 * (1 + 1e-9));
+  EXPECT_GT(w.state().velocity[1].x(), -0.8 + 0.1);  // the collision did change the motion
+}
+
+}  // namespace
+}  // namespace floesim::sim

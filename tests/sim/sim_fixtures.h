@@ -1,0 +1,54 @@
+// Synthetic inputs with known answers for the simulation tests: rectangular floes, a coarse generated hull,
+// options with the pieces of physics a test needs switched on.
+#pragma once
+#include <filesystem>
+#include <string>
+
+#include "pipeline/floes_io.h"
+#include "sim/hull.h"
+#include "sim/model.h"
+#include "sim/simulate_options.h"
+
+namespace floesim::sim::testing {
+
+inline Floe rect_floe(int id, double x0, double y0, double w, double l, double h) {
+  Floe f;
+  f.id = id;
+  f.outline = {Vec2(x0, y0), Vec2(x0 + w, y0), Vec2(x0 + w, y0 + l), Vec2(x0, y0 + l)};
+  f.area_m2 = w * l;
+  f.thickness_m = h;
+  return f;
+}
+
+// Options for floe-only tests: no sleeping (we watch the motion), everything else default.
+inline SimulateOptions floe_options() {
+  SimulateOptions o;
+  o.sleep.enabled = false;
+  o.duration_s = 10;
+  o.steady_start_s = 0;
+  return o;
+}
+
+// A coarse parametric icebreaker (fast to collide), as a HullModel (parts + merged surface).
+inline HullModel coarse_hull(int sections = 8) {
+  HullGeneratorOptions g;
+  g.sections = sections;
+  HullModel h;
+  h.parts = generate_hull(g);
+  for (const TriMesh& p : h.parts) {
+    const int off = static_cast<int>(h.surface.vertices.size());
+    h.surface.vertices.insert(h.surface.vertices.end(), p.vertices.begin(), p.vertices.end());
+    for (auto t : p.triangles) h.surface.triangles.push_back({t[0] + off, t[1] + off, t[2] + off});
+  }
+  return h;
+}
+
+// A fresh temporary directory for one test.
+inline std::filesystem::path temp_dir(const std::string& name) {
+  const auto d = std::filesystem::temp_directory_path() / ("floesim_sim_test_" + name);
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+}  // namespace floesim::sim::testing
