@@ -100,6 +100,7 @@ struct CollisionWorld::Impl {
     int best = -1;
     sep = -1e300;
     for (size_t f = 0; f < ref.faces.size(); ++f) {
+      if (ref.face_internal[f]) continue;  // not a surface of the body
       double s = 1e300;
       for (const Vec3& v : other.v) s = std::min(s, rw.n[f].dot(v) - rw.d[f]);
       if (s > sep) {
@@ -137,6 +138,10 @@ struct CollisionWorld::Impl {
     const int fa = best_face(A, wa, wb, sa);
     const int fb = best_face(B, wb, wa, sb);
     const double face_overlap = -std::max(sa, sb);
+    if (fa < 0 && fb < 0) {  // cannot happen for closed parts; keep FCL's point rather than fail
+      emit(hint.pos, hint.normal, -std::max(0.0, hint.penetration_depth));
+      return true;
+    }
 
     // 2. FCL's normal, oriented from a to b by the smaller support overlap.
     Vec3 nh = hint.normal;
@@ -156,9 +161,15 @@ struct CollisionWorld::Impl {
       if (bmax - amin < amax - bmin) nh = -nh;
     }
 
-    // 3. Edge-on-edge: every face axis overlaps clearly more than FCL's penetration. Keep FCL's single point.
+    // 3. Edge-on-edge: every face axis overlaps clearly more than FCL's penetration. Keep FCL's single point,
+    // unless FCL's normal is that of a face shared with another part of the same body (not a real surface).
     const double depth = std::max(0.0, hint.penetration_depth);
-    if (depth < 0.6 * face_overlap - 1e-3) {
+    auto along_internal = [&](const ConvexPart& P, const PartWorld& w, const Vec3& n) {
+      for (size_t f = 0; f < P.faces.size(); ++f)
+        if (P.face_internal[f] && std::abs(w.n[f].dot(n)) > 0.985) return true;
+      return false;
+    };
+    if (depth < 0.6 * face_overlap - 1e-3 && !along_internal(A, wa, nh) && !along_internal(B, wb, nh)) {
       emit(hint.pos, nh, -depth);
       return true;
     }

@@ -205,9 +205,44 @@ ConvexPart make_convex_part(const TriMesh& mesh, int body) {
     for (auto& a : ang) face.push_back(a.second);
     part.faces.push_back(face);
     part.face_normal.push_back(n);
+    part.face_internal.push_back(0);
   }
   FLOESIM_REQUIRE(part.faces.size() >= 4, "internal: convex part with fewer than 4 faces");
   return part;
+}
+
+void mark_shared_faces(std::vector<ConvexPart>& parts, int first, int count) {
+  // Centroid of a face and whether a point of its plane lies inside it (convex, CCW about the normal).
+  auto centre = [](const ConvexPart& p, int f) {
+    Vec3 c = Vec3::Zero();
+    for (int i : p.faces[f]) c += p.vertices[i];
+    return Vec3(c / static_cast<double>(p.faces[f].size()));
+  };
+  auto inside = [](const ConvexPart& p, int f, const Vec3& x) {
+    const auto& face = p.faces[f];
+    const Vec3& n = p.face_normal[f];
+    for (size_t i = 0; i < face.size(); ++i) {
+      const Vec3& a = p.vertices[face[i]];
+      const Vec3& b = p.vertices[face[(i + 1) % face.size()]];
+      if ((b - a).cross(x - a).dot(n) < -1e-9) return false;
+    }
+    return true;
+  };
+  for (int i = first; i < first + count; ++i)
+    for (int j = i + 1; j < first + count; ++j) {
+      ConvexPart& P = parts[i];
+      ConvexPart& Q = parts[j];
+      const double tol = 1e-6 * std::max({1.0, P.bounding_radius, Q.bounding_radius});
+      for (size_t f = 0; f < P.faces.size(); ++f)
+        for (size_t g = 0; g < Q.faces.size(); ++g) {
+          const Vec3& nf = P.face_normal[f];
+          const Vec3& ng = Q.face_normal[g];
+          if (nf.dot(ng) > -1 + 1e-7) continue;
+          const double df = nf.dot(P.vertices[P.faces[f][0]]), dg = ng.dot(Q.vertices[Q.faces[g][0]]);
+          if (std::abs(df + dg) > tol) continue;
+          if (inside(Q, g, centre(P, f)) || inside(P, f, centre(Q, g))) P.face_internal[f] = Q.face_internal[g] = 1;
+        }
+    }
 }
 
 void read_thrust_series(const std::string& file, std::vector<double>& time_s, std::vector<double>& thrust_n) {
@@ -393,6 +428,7 @@ Model build_model(const FloeField& field, const HullModel* hull, const SimulateO
     b.part_count = static_cast<int>(hull->parts.size());
     model.vessel = 0;
     for (const TriMesh& p : hull->parts) model.parts.push_back(make_convex_part(shifted(p, -com), 0));
+    mark_shared_faces(model.parts, 0, b.part_count);
     // Metacentric heights from the clipped hull (the same buoyancy the simulation applies).
     const double rho_g = rho_w * g > 0 ? rho_w * g : rho_w * 9.81;
     const double k44 =
@@ -465,6 +501,7 @@ Model build_model(const FloeField& field, const HullModel* hull, const SimulateO
       model.parts.push_back(make_convex_part(extrude_polygon(local, -h / 2, h), body_index));
     }
     b.part_count = static_cast<int>(fg.pieces.size());
+    mark_shared_faces(model.parts, b.first_part, b.part_count);
     // Drag faces: vertices 0..n-1 the bottom ring, n..2n-1 the top ring.
     const int n = static_cast<int>(b.outline.size());
     for (int i = 0; i < n; ++i) b.drag_vertices.emplace_back(b.outline[i].x(), b.outline[i].y(), -h / 2);

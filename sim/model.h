@@ -24,6 +24,8 @@ struct ConvexPart {
   std::vector<Vec3> vertices;
   std::vector<std::vector<int>> faces;  // planar faces, counter-clockwise seen from outside (coplanar triangles merged)
   std::vector<Vec3> face_normal;        // outward unit normals
+  std::vector<uint8_t> face_internal;   // 1: the face is shared with another part of the same body (not a surface
+                                        // of the body: never a contact reference face)
   double bounding_radius = 0;           // about the body origin (for cheap rejection tests)
 };
 
@@ -98,5 +100,8 @@ double ittc57_resistance(double u_mps, const VesselParticulars& v, const Simulat
 
 // Convex part from a closed convex triangle mesh (body frame): merges coplanar triangles into faces.
 ConvexPart make_convex_part(const TriMesh& mesh, int body);
+// Marks the faces that two parts of one body share (opposite normals in the same plane, overlapping): the cut
+// planes between hull sections and the diagonals of a floe's convex decomposition.
+void mark_shared_faces(std::vector<ConvexPart>& parts, int first, int count);
 
 }  // namespace floesim::sim

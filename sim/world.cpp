@@ -32,9 +32,11 @@ bool finite(const Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y())
 World::World(const Model& model) : model_(model), pool_(model.options.threads) {
   const size_t n = model.bodies.size();
   const SimulateOptions& o = model.options;
-  // Floes start asleep at equilibrium in still water and air; anything that drives them wakes them all.
-  const bool start_asleep = o.sleep.enabled && o.water.enabled && model.current.squaredNorm() == 0 &&
-                            model.wind.squaredNorm() == 0;
+  // Floes rest only in still water and air (a current or wind drives every floe, and in vacuum nothing holds
+  // them): only then do they start asleep at their hydrostatic equilibrium, and only then may they fall asleep.
+  sleep_allowed_ = o.sleep.enabled && o.water.enabled && model.current.squaredNorm() == 0 &&
+                   model.wind.squaredNorm() == 0;
+  const bool start_asleep = sleep_allowed_;
   state_.position.resize(n);
   state_.orientation.resize(n);
   state_.velocity.assign(n, Vec3::Zero());
@@ -241,7 +243,7 @@ void World::stage_sleep() {
     if (w.norm() > h.max_angular_radps)
       fail(b, "angular speed " + std::to_string(w.norm()) + " rad/s exceeds health.max_angular_radps (blow-up)");
     if (b == model_.vessel) continue;
-    if (s.enabled && !in_contact_[b] && v.norm() < s.linear_mps && w.norm() < s.angular_radps) {
+    if (sleep_allowed_ && !in_contact_[b] && v.norm() < s.linear_mps && w.norm() < s.angular_radps) {
       state_.still_time_s[b] += dt;
       if (state_.still_time_s[b] >= s.time_s) {
         state_.awake[b] = 0;

@@ -84,6 +84,7 @@ class World {
   std::vector<ForceScratch> scratch_;
   SolverBodies solver_bodies_;
   StepReport report_;
+  bool sleep_allowed_ = false;
   std::array<double, kStageCount> stage_seconds_{};
 };
 

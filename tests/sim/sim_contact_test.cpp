@@ -98,3 +98,34 @@ TEST(SimContact, CollisionConservesMomentumInVacuum) {
 
 }  // namespace
 }  // namespace floesim::sim
+
+namespace floesim::sim {
+namespace {
+
+// Faces shared by two parts of one body are not surfaces: an L-shaped floe (two convex pieces) has exactly one
+// shared face per piece; the generated hull's sections share their cut planes with their neighbours.
+TEST(SimContact, SharedFacesAreMarked) {
+  FloeField field;
+  Floe l;
+  l.id = 1;
+  l.thickness_m = 1;
+  l.outline = {Vec2(0, 0), Vec2(10, 0), Vec2(10, 4), Vec2(4, 4), Vec2(4, 10), Vec2(0, 10)};
+  field.floes = {l};
+  SimulateOptions o;
+  const HullModel hull = testing::coarse_hull(8);
+  o.vessel.x_m = 500;  // away from the floe
+  const Model m = build_model(field, &hull, o);
+  auto shared = [&](int body) {
+    int n = 0;
+    const Body& b = m.bodies[body];
+    for (int p = b.first_part; p < b.first_part + b.part_count; ++p)
+      for (uint8_t f : m.parts[p].face_internal) n += f;
+    return n;
+  };
+  ASSERT_EQ(m.bodies[1].part_count, 2);
+  EXPECT_EQ(shared(1), 2);
+  EXPECT_EQ(shared(0), 2 * (m.bodies[0].part_count - 1));
+}
+
+}  // namespace
+}  // namespace floesim::sim
