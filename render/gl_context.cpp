@@ -37,14 +37,13 @@ const char* OffscreenContext::renderer() const {
   return s ? reinterpret_cast<const char*>(s) : "?";
 }
 
-void OffscreenContext::read_bgr(cv::Mat& out) const {
+void OffscreenContext::read_rgba_bottom_up(cv::Mat& out) const {
   gl_.Finish();
-  cv::Mat up(height_, width_, CV_8UC3);
-  gl_.PixelStorei(GL_PACK_ALIGNMENT, 1);
-  gl_.ReadPixels(0, 0, width_, height_, GL_BGR, GL_UNSIGNED_BYTE, up.data);
+  out.create(height_, width_, CV_8UC4);
+  gl_.PixelStorei(GL_PACK_ALIGNMENT, 4);
+  gl_.ReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, out.data);
   const GLenum err = gl_.GetError();
   FLOESIM_REQUIRE(err == GL_NO_ERROR, "OpenGL error 0x", std::hex, err, " while reading the frame");
-  cv::flip(up, out, 0);  // GL's first row is the bottom one
 }
 
 }  // namespace floesim::render

@@ -41,8 +41,9 @@ class OffscreenContext {
   const GlApi& gl() const { return gl_; }
   int width() const { return width_; }
   int height() const { return height_; }
-  // Finishes drawing and returns the frame as 8-bit BGR with the top row first (GL gives rows bottom-up).
-  void read_bgr(cv::Mat& out) const;
+  // Finishes drawing and reads the frame as 8-bit RGBA in GL's row order: the BOTTOM row first. (RGBA is the
+  // buffer's own layout, so this is a plain copy; asking GL for BGR costs ~10x more at 2560 x 1440.)
+  void read_rgba_bottom_up(cv::Mat& out) const;
   const char* renderer() const;
 
  private:

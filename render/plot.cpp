@@ -80,12 +80,6 @@ void write_decimated(std::ostream& os, const std::vector<double>& t, const std::
   }
 }
 
-double quantile(std::vector<double> x, double q) {
-  const size_t k = static_cast<size_t>(q * static_cast<double>(x.size() - 1));
-  std::nth_element(x.begin(), x.begin() + static_cast<long>(k), x.end());
-  return x[k];
-}
-
 // Runs a program without a shell (no quoting pitfalls), stdout and stderr into `log`; returns its exit status.
 int run_program(const std::vector<std::string>& args, const fs::path& log) {
   posix_spawn_file_actions_t fa;
@@ -196,14 +190,17 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
        << fmt("%.9g", t.back()) << ' ' << fmt("%.9g", s.mean_kN) << '\n';
     FLOESIM_REQUIRE(os.flush(), data.tmp().string(), ": write failed (disk full?)");
   }
-  // Rigid contacts give single-step spikes far above the average; "auto" keeps the average readable and says
-  // how high the clipped spikes go.
+  // Rigid contacts give single-step spikes one or two orders of magnitude above the average; "auto" keeps the
+  // average readable (top at 3 x its peak, or the raw peak if lower) and says how high the cut-off spikes go.
   const double ma_max = *std::max_element(ma.begin(), ma.end()), ma_min = *std::min_element(ma.begin(), ma.end());
+  const double raw_min = *std::min_element(res.begin(), res.end());
   double y_hi = o.y_max_kN.is_number() ? o.y_max_kN.get<double>()
-                                       : std::max({1.25 * ma_max, quantile(res, 0.995), 1.25 * s.mean_kN, 1e-3});
-  double y_lo = std::min({0.0, ma_min, quantile(res, 0.002)});
+                                       : std::max({std::min(s.raw_max_kN, 3.0 * ma_max), 1.25 * s.mean_kN, 1e-3});
+  double y_lo = std::min({0.0, ma_min, std::max(raw_min, -y_hi)});
   y_lo -= 0.03 * (y_hi - y_lo);
-  y_hi += o.y_max_kN.is_number() ? 0.0 : 0.05 * (y_hi - y_lo);
+  if (!o.y_max_kN.is_number()) y_hi += 0.05 * (y_hi - y_lo);
+  // Start the axis at 0 when the series starts within the first 5 % (it starts at the first step's end).
+  const double x_lo = t.front() > 0 && t.front() < 0.05 * t.back() ? 0.0 : t.front();
   {
     const bool clipped = s.raw_max_kN > y_hi;
     std::ostringstream gp;
@@ -215,22 +212,24 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
     gp << "set xlabel 'Time (s)'\n"
        << "set ylabel 'Ice resistance  −F_x  (kN)'\n"
        << "set border lc rgb '#404040'\n"
+       << "set bmargin 6\n"
        << "set grid xtics ytics mxtics lc rgb '#d9d9d9' lw 1 dt 1\n"
        << "set mxtics 2\n"
-       << "set key top left box lc rgb '#b0b0b0' opaque samplen 2.5 spacing 1.3 width 1\n"
-       << "set xrange [" << fmt("%.9g", t.front()) << ":" << fmt("%.9g", t.back()) << "]\n"
+       << "set key outside below center horizontal maxrows 1 samplen 2.5 width -6\n"
+       << "set style textbox opaque fillcolor rgb 'white' border lc rgb '#b0b0b0' margins 4,3\n"
+       << "set xrange [" << fmt("%.9g", x_lo) << ":" << fmt("%.9g", t.back()) << "]\n"
        << "set yrange [" << fmt("%.9g", y_lo) << ":" << fmt("%.9g", y_hi) << "]\n"
        << "set format y '%.0f'\n";
     if (y_hi - y_lo < 10) gp << "set format y '%g'\n";
     if (clipped)
       gp << "set label 1 " << quoted("raw peaks up to " + kN(s.raw_max_kN) + " kN are cut off")
-         << " at graph 0.99, graph 0.97 right noenhanced font ',9' tc rgb '#606060' front\n";
+         << " at graph 0.99, graph 0.96 right boxed noenhanced font ',9' tc rgb '#505050' front\n";
     const std::string mean_title =
         (s.steady_start_s > t.front() ? "mean for t ≥ " + fmt("%g", s.steady_start_s) + " s: "
                                       : std::string("mean: ")) +
         kN(s.mean_kN) + " kN";
     gp << "plot " << quoted(data.tmp().string())
-       << " index 0 using 1:2 with lines lc rgb '#9fb0c0' lw 0.8 title "
+       << " index 0 using 1:2 with lines lc rgb '#a9b8c6' lw 0.8 title "
        << quoted("ice resistance, every time step (Δt = " + fmt("%g", s.time_step_s) + " s)") << " noenhanced, \\\n"
        << "  '' index 1 using 1:2 with lines lc rgb '#101010' lw 2 title "
        << quoted("centred moving average, " + fmt("%g", s.window_s) + " s window") << " noenhanced, \\\n"
