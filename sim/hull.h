@@ -37,6 +37,29 @@ struct HullGeneratorOptions {
 std::vector<TriMesh> generate_hull(const HullGeneratorOptions& o);
 void write_obj(const std::filesystem::path& file, const std::vector<TriMesh>& parts, const std::string& header);
 
+// Hydrostatics of a hull made of parts (in the hull's frame) floating with the water surface at z = z0.
+// (Added by the vessel helper; additive to the interface above.)
+struct Hydrostatics {
+  double volume_m3 = 0;                    // displaced volume (below z0)
+  double displacement_t = 0;               // rho_w * volume / 1000
+  double waterplane_area_m2 = 0;           // area of the section at z0
+  Vec3 centre_of_buoyancy = Vec3::Zero();  // m, hull frame
+  double lcb_m = 0;                        // x of the centre of buoyancy (positive forward of the origin)
+  double kb_m = 0;                         // height of the centre of buoyancy above the lowest point (keel)
+  double wetted_surface_m2 = 0;            // outer surface below z0; faces shared by two parts are excluded
+  double length_wl_m = 0;                  // x extent of the waterplane
+  double beam_wl_m = 0;                    // y extent of the waterplane
+  double draught_m = 0;                    // z0 - lowest point
+  double block_coefficient = 0;            // volume / (length_wl * beam_wl * draught)
+};
+Hydrostatics hydrostatics(const std::vector<TriMesh>& parts, double rho_w_kg_m3 = 1025.0, double z0 = 0.0);
+
+// The floesim-hull stage: generates the hull, writes out_obj and its sidecar (out_obj with extension .json:
+// particulars, hydrostatics, provenance) atomically and returns the summary printed on stdout. config_file (may be
+// empty) is recorded in the provenance.
+std::string write_generated_hull(const HullGeneratorOptions& o, const std::filesystem::path& out_obj,
+                                 const std::filesystem::path& config_file);
+
 // How the loader treats a mesh that is not convex.
 struct HullLoadOptions {
   std::string non_convex = "slice";  // "slice": cut into sections along x, convex hull of each; "refuse": error

@@ -1,0 +1,742 @@
+#include "sim/hull.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <Eigen/Geometry>
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include "pipeline/atomic_file.h"
+#include "pipeline/error.h"
+#include "pipeline/provenance.h"
+
+namespace floesim::sim {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+double deg(double d) { return d * kPi / 180.0; }
+
+// 0 -> 0, 1 -> 1 with zero slope at both ends (for blending hull parameters along x without kinks).
+double smooth(double s) {
+  s = std::clamp(s, 0.0, 1.0);
+  return 0.5 - 0.5 * std::cos(kPi * s);
+}
+double lerp(double a, double b, double s) { return a + (b - a) * s; }
+
+// Coordinates of the generated hull lie on a 2^-10 m (~1 mm) grid. Such numbers are printed exactly in decimal and
+// parsed exactly even by assimp's single-precision OBJ reader (integer part + a fraction of <= 10 binary digits fit
+// a float's 24-bit mantissa for |x| < 16 km), so the hull read back is bit-identical to the one generated.
+double grid(double v) { return std::round(v * 1024.0) / 1024.0; }
+
+std::string fmt_num(double v, int prec = 6) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", prec, v);
+  return buf;
+}
+
+// ---- the parametric icebreaker ---------------------------------------------------------------------------------
+//
+// Each cross-section x = const is a convex polygon: a flat bottom at z_b(x), a bilge arc of radius r(x), a lower side
+// flared outwards at beta_lo(x) from the vertical up to the waterline knuckle at half-breadth W(x), an upper side at
+// the smaller flare beta_up(x) up to the deck. The flare decreasing upwards keeps the section convex.
+// Along x:
+// - bow: a spoon: the bottom is a plane rising at the stem angle from the forefoot to the stem head at the deck;
+//   across, it is flat with large bilges, so the bow is broad and flat (Oden's signature);
+// - reamers: the waterline widens from beam_m to reamer_beam_m at the forefoot, just behind the bow, and the bow
+//   waterline closes from there as an ellipse onto a blunt stem;
+// - parallel body with a flat bottom, a small flare and a moderate bilge;
+// - stern: a run whose bottom rises quadratically to an immersed transom, with narrowing waterline and growing bilge.
+// The shape constants below were chosen (not fitted per call) so that the default particulars displace
+// ~13,000 t at rho_w = 1025 kg/m^3 (tests/sim/hull_test.cpp checks this within 5 %).
+struct HullShape {
+  // Fractions of the length.
+  static constexpr double run_length = 0.38;      // stern run (bottom rising to the transom)
+  static constexpr double stern_narrowing = 0.38;  // waterline narrowing aft, over this part of the length
+  static constexpr double shoulder_length = 0.12;  // beam_m -> reamer_beam_m transition ahead of the reamers
+  // Fractions of the draught / half-beam.
+  static constexpr double transom_immersion = 0.15;  // transom bottom below the waterline, in draughts
+  static constexpr double transom_half_beam = 0.78;  // waterline half-breadth at the transom, of beam_m / 2
+  static constexpr double stem_half_beam = 0.30;     // half-breadth of the stem head, of reamer_beam_m / 2
+  // Flare from the vertical (deg) below / above the waterline, midbody and bow. Above the waterline the sides are
+  // nearly upright, so the extreme beam (at the reamers, on deck) stays within ~1 m of reamer_beam_m.
+  static constexpr double flare_mid_lo_deg = 12.0, flare_mid_up_deg = 6.0;
+  static constexpr double flare_bow_lo_deg = 35.0, flare_bow_up_deg = 4.0;
+  // Bilge radii (m), midbody / bow / transom.
+  static constexpr double bilge_mid_m = 4.0, bilge_bow_m = 5.0, bilge_transom_m = 5.0;
+};
+
+struct Station {
+  double z_bottom, half_wl, flare_lo, flare_up, bilge;
+};
+
+class IcebreakerGeometry {
+ public:
+  explicit IcebreakerGeometry(const HullGeneratorOptions& o) : o_(o) {
+    x_aft_ = -0.5 * o.length_m;
+    x_fwd_ = 0.5 * o.length_m;
+    z_keel_ = -o.draught_m;
+    z_deck_ = o.depth_m - o.draught_m;
+    tan_stem_ = std::tan(deg(o.stem_angle_deg));
+    // Forefoot: where the spoon meets the keel. Kept in the forward half, so a very low stem angle still leaves a
+    // parallel body (the spoon then ends below the deck in a flat, vertical stem face).
+    x_forefoot_ = std::max(x_fwd_ - o.depth_m / tan_stem_, 0.0);
+    x_reamer_ = x_forefoot_;
+    x_run_ = x_aft_ + HullShape::run_length * o.length_m;
+    x_shoulder_ = std::max(x_reamer_ - HullShape::shoulder_length * o.length_m, x_run_);
+  }
+
+  double x_aft() const { return x_aft_; }
+  double x_fwd() const { return x_fwd_; }
+  double z_deck() const { return z_deck_; }
+  double x_reamer() const { return x_reamer_; }
+
+  Station at(double x) const {
+    const HullGeneratorOptions& o = o_;
+    Station s;
+    // Bottom: keel, the bow spoon plane, the stern run.
+    const double spoon = z_keel_ + (x - x_forefoot_) * tan_stem_;
+    double run = z_keel_;
+    if (x < x_run_) {
+      const double u = (x_run_ - x) / (x_run_ - x_aft_);
+      run = z_keel_ + (1.0 - HullShape::transom_immersion) * o.draught_m * u * u;
+    }
+    s.z_bottom = std::min(std::max({z_keel_, spoon, run}), z_deck_);
+    // Waterline half-breadth.
+    const double b = 0.5 * o.beam_m, r = 0.5 * o.reamer_beam_m;
+    if (x >= x_reamer_) {
+      const double u = std::clamp((x - x_reamer_) / (x_fwd_ - x_reamer_), 0.0, 1.0);
+      const double tip = HullShape::stem_half_beam * r;
+      s.half_wl = tip + (r - tip) * std::sqrt(std::max(0.0, 1.0 - u * u));
+    } else if (x >= x_shoulder_) {
+      s.half_wl = lerp(b, r, smooth((x - x_shoulder_) / (x_reamer_ - x_shoulder_)));
+    } else {
+      const double x_narrow = x_aft_ + HullShape::stern_narrowing * o.length_m;
+      const double u = x < x_narrow ? (x_narrow - x) / (x_narrow - x_aft_) : 0.0;
+      s.half_wl = lerp(b, HullShape::transom_half_beam * b, smooth(u));
+    }
+    // Flare and bilge: midbody values, blended to the bow over the shoulder and to the stern over the run.
+    const double to_bow = smooth((x - x_shoulder_) / (x_reamer_ - x_shoulder_));
+    const double to_stern = x < x_run_ ? smooth((x_run_ - x) / (x_run_ - x_aft_)) : 0.0;
+    s.flare_lo = deg(lerp(HullShape::flare_mid_lo_deg, HullShape::flare_bow_lo_deg, to_bow));
+    s.flare_up = deg(lerp(HullShape::flare_mid_up_deg, HullShape::flare_bow_up_deg, to_bow));
+    s.bilge = lerp(lerp(HullShape::bilge_mid_m, HullShape::bilge_bow_m, to_bow), HullShape::bilge_transom_m, to_stern);
+    return s;
+  }
+
+  // Starboard half of the section at x (y >= 0), bottom to deck; the port half is its mirror.
+  std::vector<Eigen::Vector2d> half_section(double x) const {
+    Station s = at(x);
+    std::vector<Eigen::Vector2d> pts;
+    const double zb = s.z_bottom, zd = z_deck_;
+    auto side_y = [&](double z) { return s.half_wl + z * std::tan(z <= 0 ? s.flare_lo : s.flare_up); };
+    if (zd - zb < 1e-3) {  // the stem head: the section has shrunk to the deck edge
+      pts.emplace_back(side_y(zd), zd);
+      return pts;
+    }
+    if (zb < 0)  // keep at least a quarter of the waterline half-breadth at the bottom for extreme particulars
+      s.flare_lo = std::min(s.flare_lo, std::atan(0.75 * s.half_wl / -zb));
+    const double yc = side_y(zb);  // bottom corner before rounding
+    const double beta = zb < 0 ? s.flare_lo : s.flare_up;
+    const Eigen::Vector2d dir(std::sin(beta), std::cos(beta));  // up the side from the corner
+    // Length of the straight side above the corner (to the knuckle at the waterline, or to the deck).
+    const double side_len = zb < 0 ? -zb / std::cos(beta) : (zd - zb) / std::cos(beta);
+    // Fillet tangent length for the corner angle 90 deg + beta, limited by the bottom and side available.
+    const double k = std::tan(0.5 * (0.5 * kPi + beta));
+    const double t = std::min({s.bilge / k, 0.95 * yc, 0.95 * side_len});
+    const double rad = t * k;
+    const Eigen::Vector2d corner(yc, zb);
+    const Eigen::Vector2d t1 = corner - Eigen::Vector2d(t, 0);
+    const Eigen::Vector2d centre = t1 + Eigen::Vector2d(0, rad);
+    pts.push_back(t1);
+    const int arc = 4;
+    const double a0 = -0.5 * kPi, a1 = -beta;  // from straight down to the side's outward normal
+    for (int i = 1; i < arc; ++i) {
+      const double a = lerp(a0, a1, double(i) / arc);
+      pts.push_back(centre + rad * Eigen::Vector2d(std::cos(a), std::sin(a)));
+    }
+    pts.push_back(corner + t * dir);
+    if (zb < 0) pts.emplace_back(s.half_wl, 0.0);  // waterline knuckle
+    pts.emplace_back(side_y(zd), zd);               // deck edge
+    return pts;
+  }
+
+ private:
+  HullGeneratorOptions o_;
+  double x_aft_, x_fwd_, z_keel_, z_deck_, tan_stem_, x_forefoot_, x_reamer_, x_shoulder_, x_run_;
+};
+
+// ---- mesh topology -----------------------------------------------------------------------------------------------
+
+struct Topology {
+  int unbalanced_edges = 0;   // edges not used equally often in both directions: holes or flipped triangles
+  int boundary_edges = 0;     // edges used once (holes)
+  int non_manifold_edges = 0;  // edges used more than twice
+  bool even = true;           // every edge used an even number of times (closed, maybe inconsistently oriented)
+};
+
+Topology topology(const TriMesh& m) {
+  std::map<std::pair<int, int>, std::pair<int, int>> uses;  // (lo, hi) -> (uses lo->hi, uses hi->lo)
+  for (const auto& t : m.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      if (a < b) ++uses[{a, b}].first;
+      else ++uses[{b, a}].second;
+    }
+  Topology top;
+  for (const auto& [e, u] : uses) {
+    const int total = u.first + u.second;
+    top.unbalanced_edges += u.first != u.second;
+    top.boundary_edges += total == 1;
+    top.non_manifold_edges += total > 2;
+    top.even = top.even && total % 2 == 0;
+  }
+  return top;
+}
+
+// Re-orients triangles consistently by walking across manifold edges (used by exactly two triangles): a neighbour
+// must use the shared edge in the opposite direction. Returns the number of triangles flipped.
+int orient_consistently(TriMesh& m) {
+  std::map<std::pair<int, int>, std::vector<int>> tris_of_edge;
+  for (int i = 0; i < static_cast<int>(m.triangles.size()); ++i)
+    for (int k = 0; k < 3; ++k) {
+      const int a = m.triangles[i][k], b = m.triangles[i][(k + 1) % 3];
+      tris_of_edge[{std::min(a, b), std::max(a, b)}].push_back(i);
+    }
+  auto uses_forward = [&](int t, int a, int b) {
+    for (int k = 0; k < 3; ++k)
+      if (m.triangles[t][k] == a && m.triangles[t][(k + 1) % 3] == b) return true;
+    return false;
+  };
+  std::vector<char> done(m.triangles.size(), 0);
+  int flipped = 0;
+  for (size_t seed = 0; seed < m.triangles.size(); ++seed) {
+    if (done[seed]) continue;
+    done[seed] = 1;
+    std::vector<int> queue{static_cast<int>(seed)};
+    for (size_t h = 0; h < queue.size(); ++h) {
+      const int t = queue[h];
+      for (int k = 0; k < 3; ++k) {
+        const int a = m.triangles[t][k], b = m.triangles[t][(k + 1) % 3];
+        const auto& nb = tris_of_edge[{std::min(a, b), std::max(a, b)}];
+        if (nb.size() != 2) continue;
+        const int u = nb[0] == t ? nb[1] : nb[0];
+        if (done[u]) continue;
+        done[u] = 1;
+        if (uses_forward(u, a, b)) {
+          std::swap(m.triangles[u][1], m.triangles[u][2]);
+          ++flipped;
+        }
+        queue.push_back(u);
+      }
+    }
+  }
+  return flipped;
+}
+
+void flip(TriMesh& m) {
+  for (auto& t : m.triangles) std::swap(t[1], t[2]);
+}
+
+// Welds vertices at identical positions and drops triangles that collapse; formats differ in how they share
+// vertices (OBJ groups, STL not at all) and assimp only joins vertices whose every attribute matches.
+TriMesh weld(const std::vector<Vec3>& v, const std::vector<std::array<int, 3>>& tris) {
+  TriMesh m;
+  std::map<std::array<double, 3>, int> index;
+  std::vector<int> remap(v.size());
+  for (size_t i = 0; i < v.size(); ++i) {
+    const auto [it, fresh] = index.emplace(std::array<double, 3>{v[i].x(), v[i].y(), v[i].z()},
+                                           static_cast<int>(m.vertices.size()));
+    if (fresh) m.vertices.push_back(v[i]);
+    remap[i] = it->second;
+  }
+  for (const auto& t : tris) {
+    const std::array<int, 3> u{remap[t[0]], remap[t[1]], remap[t[2]]};
+    if (u[0] != u[1] && u[1] != u[2] && u[2] != u[0]) m.triangles.push_back(u);
+  }
+  return m;
+}
+
+TriMesh merge(const std::vector<TriMesh>& parts) {
+  TriMesh m;
+  for (const TriMesh& p : parts) {
+    const int off = static_cast<int>(m.vertices.size());
+    m.vertices.insert(m.vertices.end(), p.vertices.begin(), p.vertices.end());
+    for (const auto& t : p.triangles) m.triangles.push_back({t[0] + off, t[1] + off, t[2] + off});
+  }
+  return m;
+}
+
+struct Bounds {
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+  Vec3 hi = Vec3::Constant(-std::numeric_limits<double>::infinity());
+  explicit Bounds(const std::vector<Vec3>& v) {
+    for (const Vec3& p : v) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  }
+  double diagonal() const { return (hi - lo).norm(); }
+  bool contains(const Vec3& p, double pad) const {
+    return (p.array() >= lo.array() - pad).all() && (p.array() <= hi.array() + pad).all();
+  }
+};
+
+// True if p is inside the convex mesh by more than `margin` (all its triangle planes at least `margin` above p).
+bool strictly_inside_convex(const TriMesh& m, const Vec3& p, double margin) {
+  for (const auto& t : m.triangles) {
+    const Vec3& a = m.vertices[t[0]];
+    const Vec3 n = (m.vertices[t[1]] - a).cross(m.vertices[t[2]] - a);
+    const double len = n.norm();
+    if (len == 0) continue;
+    if (n.dot(p - a) / len > -margin) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+// ---- generation and OBJ ----------------------------------------------------------------------------------------
+
+std::vector<TriMesh> generate_hull(const HullGeneratorOptions& o) {
+  {  // the options' own checks, also when the struct was filled in code rather than read from JSON
+    const Json none = Json::object();  // the reader keeps a reference: must outlive it
+    OptionReader r(none, "hull generator options", "");
+    const_cast<HullGeneratorOptions&>(o).visit(r);
+    r.finish();
+  }
+  const IcebreakerGeometry g(o);
+  const int n = o.sections;
+  // Stations evenly spaced, except that the one nearest the reamers moves onto them, so the widest waterline is
+  // a station and not cut off between two.
+  std::vector<double> xs(n + 1);
+  for (int i = 0; i <= n; ++i) xs[i] = g.x_aft() + (g.x_fwd() - g.x_aft()) * i / n;
+  const int near = static_cast<int>(std::lround((g.x_reamer() - g.x_aft()) / (g.x_fwd() - g.x_aft()) * n));
+  if (near > 0 && near < n) xs[near] = g.x_reamer();
+  std::vector<std::vector<Vec3>> stations(n + 1);
+  for (int i = 0; i <= n; ++i) {
+    const double x = grid(xs[i]);
+    for (const auto& p : g.half_section(x)) {
+      const double y = grid(p.x()), z = grid(p.y());
+      stations[i].emplace_back(x, y, z);
+      stations[i].emplace_back(x, -y, z);
+    }
+  }
+  std::vector<TriMesh> parts;
+  for (int i = 0; i < n; ++i) {
+    std::vector<Vec3> pts = stations[i];
+    pts.insert(pts.end(), stations[i + 1].begin(), stations[i + 1].end());
+    parts.push_back(convex_hull(pts));
+  }
+  return parts;
+}
+
+void write_obj(const fs::path& file, const std::vector<TriMesh>& parts, const std::string& header) {
+  AtomicFile f(file);
+  {
+    std::ofstream out(f.tmp(), std::ios::binary);
+    if (!out) throw Error(file.string() + ": cannot write (is the directory writable?)");
+    std::istringstream h(header);
+    for (std::string line; std::getline(h, line);) out << "# " << line << "\n";
+    int base = 1;
+    char buf[128];
+    for (size_t k = 0; k < parts.size(); ++k) {
+      out << "o part_" << k << "\n";
+      for (const Vec3& v : parts[k].vertices) {
+        // %.17g round-trips any double; for the generator's grid coordinates it prints them short and exact.
+        std::snprintf(buf, sizeof buf, "v %.17g %.17g %.17g\n", v.x(), v.y(), v.z());
+        out << buf;
+      }
+      for (const auto& t : parts[k].triangles) out << "f " << t[0] + base << " " << t[1] + base << " " << t[2] + base << "\n";
+      base += static_cast<int>(parts[k].vertices.size());
+    }
+    out.flush();
+    if (!out) throw Error(file.string() + ": write failed (disk full?)");
+  }
+  f.commit();
+}
+
+// ---- hydrostatics ------------------------------------------------------------------------------------------------
+
+Hydrostatics hydrostatics(const std::vector<TriMesh>& parts, double rho_w, double z0) {
+  Hydrostatics h;
+  const TriMesh surface = merge(parts);
+  FLOESIM_REQUIRE(!surface.triangles.empty(), "hydrostatics: the hull has no triangles");
+  // Faces shared by two parts cancel in the signed sums (opposite orientations), so clipping the merged surface
+  // gives the union's displaced volume and waterplane as long as the parts do not overlap.
+  const Submerged s = submerged_part(surface.vertices, surface.triangles, z0);
+  const Bounds all(surface.vertices);
+  h.volume_m3 = s.volume;
+  h.displacement_t = rho_w * s.volume / 1000.0;
+  h.waterplane_area_m2 = s.waterplane_area;
+  h.centre_of_buoyancy = s.centroid;
+  h.lcb_m = s.centroid.x();
+  h.kb_m = s.centroid.z() - all.lo.z();
+  h.draught_m = z0 - all.lo.z();
+
+  // Waterplane extents from the points where edges cross z0.
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const auto& t : surface.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 &a = surface.vertices[t[k]], &b = surface.vertices[t[(k + 1) % 3]];
+      if ((a.z() - z0) * (b.z() - z0) > 0 || a.z() == b.z()) continue;
+      const Vec3 p = a + (b - a) * ((z0 - a.z()) / (b.z() - a.z()));
+      lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    }
+  if (lo.x() <= hi.x()) {
+    h.length_wl_m = hi.x() - lo.x();
+    h.beam_wl_m = hi.y() - lo.y();
+  }
+  if (h.length_wl_m > 0 && h.beam_wl_m > 0 && h.draught_m > 0)
+    h.block_coefficient = h.volume_m3 / (h.length_wl_m * h.beam_wl_m * h.draught_m);
+
+  // Wetted surface: area of each part's triangles below z0, except where material lies on both sides (a face
+  // shared with a neighbouring part): tested by nudging the clipped piece's centroid outwards and asking whether
+  // it is inside another part.
+  const double nudge = 1e-6 * all.diagonal();
+  std::vector<Bounds> boxes;
+  for (const TriMesh& p : parts) boxes.emplace_back(p.vertices);
+  for (size_t a = 0; a < parts.size(); ++a) {
+    const TriMesh& pa = parts[a];
+    for (const auto& t : pa.triangles) {
+      const Vec3* v[3] = {&pa.vertices[t[0]], &pa.vertices[t[1]], &pa.vertices[t[2]]};
+      std::vector<Vec3> poly;  // the triangle clipped to z < z0
+      for (int k = 0; k < 3; ++k) {
+        const Vec3 &p = *v[k], &q = *v[(k + 1) % 3];
+        const bool in_p = p.z() < z0, in_q = q.z() < z0;
+        if (in_p) poly.push_back(p);
+        if (in_p != in_q) poly.push_back(p + (q - p) * ((z0 - p.z()) / (q.z() - p.z())));
+      }
+      if (poly.size() < 3) continue;
+      Vec3 area_vec = Vec3::Zero(), c = Vec3::Zero();
+      double area = 0;
+      for (size_t k = 1; k + 1 < poly.size(); ++k) {
+        const Vec3 cr = (poly[k] - poly[0]).cross(poly[k + 1] - poly[0]);
+        area_vec += cr;
+        area += 0.5 * cr.norm();
+        c += 0.5 * cr.norm() * (poly[0] + poly[k] + poly[k + 1]) / 3.0;
+      }
+      if (area <= 0) continue;
+      const Vec3 probe = c / area + nudge * area_vec.normalized();
+      bool shared = false;
+      for (size_t b = 0; b < parts.size() && !shared; ++b)
+        shared = b != a && boxes[b].contains(probe, nudge) && strictly_inside_convex(parts[b], probe, 0.25 * nudge);
+      if (!shared) h.wetted_surface_m2 += area;
+    }
+  }
+  return h;
+}
+
+std::string write_generated_hull(const HullGeneratorOptions& o, const fs::path& out_obj, const fs::path& config_file) {
+  const std::vector<TriMesh> parts = generate_hull(o);
+  constexpr double rho_w = 1025.0;
+  const Hydrostatics h = hydrostatics(parts, rho_w, 0.0);
+  const Bounds b(merge(parts).vertices);
+  size_t nv = 0, nt = 0;
+  for (const TriMesh& p : parts) nv += p.vertices.size(), nt += p.triangles.size();
+
+  std::ostringstream head;
+  head << "floesim parametric icebreaker (Oden's main particulars), " << parts.size() << " convex parts\n"
+       << "written by floesim-hull " << version() << "; frame: x forward, y to port, z up, metres; calm waterline"
+       << " z = 0; origin midship on the centreline\n"
+       << "length_m " << o.length_m << ", beam_m " << o.beam_m << ", reamer_beam_m " << o.reamer_beam_m
+       << ", draught_m " << o.draught_m << ", depth_m " << o.depth_m << ", stem_angle_deg " << o.stem_angle_deg
+       << ", sections " << o.sections << "\n"
+       << "volume below z = 0: " << fmt_num(h.volume_m3) << " m^3; displacement " << fmt_num(h.displacement_t)
+       << " t at rho_w = " << rho_w << " kg/m^3\n"
+       << "waterplane area " << fmt_num(h.waterplane_area_m2) << " m^2, LCB " << fmt_num(h.lcb_m) << " m, KB "
+       << fmt_num(h.kb_m) << " m, wetted surface " << fmt_num(h.wetted_surface_m2) << " m^2\n";
+
+  nlohmann::json side;
+  side["provenance"] = make_provenance(
+      "floesim-hull",
+      config_file.empty() ? std::vector<NamedInput>{} : std::vector<NamedInput>{{"config", config_file}},
+      options_to_json(o));
+  side["hull_file"] = out_obj.filename().string();
+  side["frame"] = "x forward, y to port, z up; calm waterline z = 0; origin midship on the centreline; metres";
+  side["parts"] = parts.size();
+  side["vertices"] = nv;
+  side["triangles"] = nt;
+  side["extent_m"] = {{"x", {b.lo.x(), b.hi.x()}}, {"y", {b.lo.y(), b.hi.y()}}, {"z", {b.lo.z(), b.hi.z()}}};
+  side["hydrostatics"] = {{"rho_w_kg_m3", rho_w},
+                          {"volume_m3", h.volume_m3},
+                          {"displacement_t", h.displacement_t},
+                          {"waterplane_area_m2", h.waterplane_area_m2},
+                          {"lcb_m", h.lcb_m},
+                          {"kb_m", h.kb_m},
+                          {"wetted_surface_m2", h.wetted_surface_m2},
+                          {"length_wl_m", h.length_wl_m},
+                          {"beam_wl_m", h.beam_wl_m},
+                          {"draught_m", h.draught_m},
+                          {"block_coefficient", h.block_coefficient},
+                          {"centre_of_buoyancy_m", {h.centre_of_buoyancy.x(), h.centre_of_buoyancy.y(),
+                                                    h.centre_of_buoyancy.z()}}};
+
+  fs::path sidecar = out_obj;
+  sidecar.replace_extension(".json");
+  FLOESIM_REQUIRE(sidecar != out_obj, out_obj.string(), ": the hull file must not end in .json (the sidecar does)");
+  ensure_directory(out_obj.parent_path());
+  write_obj(out_obj, parts, head.str());
+  write_text_atomic(sidecar, side.dump(2) + "\n");
+
+  std::ostringstream sum;
+  sum << "hull: " << parts.size() << " convex parts, " << nv << " vertices, " << nt << " triangles -> "
+      << out_obj.string() << " (+ " << sidecar.filename().string() << ")\n"
+      << "  extent x " << fmt_num(b.lo.x()) << " .. " << fmt_num(b.hi.x()) << " m, y " << fmt_num(b.lo.y()) << " .. "
+      << fmt_num(b.hi.y()) << " m, z " << fmt_num(b.lo.z()) << " .. " << fmt_num(b.hi.z()) << " m\n"
+      << "  volume below z = 0   " << fmt_num(h.volume_m3) << " m^3\n"
+      << "  displacement         " << fmt_num(h.displacement_t) << " t (rho_w " << rho_w << " kg/m^3)\n"
+      << "  waterplane area      " << fmt_num(h.waterplane_area_m2) << " m^2\n"
+      << "  waterline L x B      " << fmt_num(h.length_wl_m) << " x " << fmt_num(h.beam_wl_m) << " m\n"
+      << "  block coefficient    " << fmt_num(h.block_coefficient, 3) << " (on the waterline length and beam)\n"
+      << "  LCB                  " << fmt_num(h.lcb_m) << " m (x of the centre of buoyancy; + is forward of midship)\n"
+      << "  KB                   " << fmt_num(h.kb_m) << " m\n"
+      << "  wetted surface       " << fmt_num(h.wetted_surface_m2) << " m^2\n";
+  return sum.str();
+}
+
+// ---- loading ---------------------------------------------------------------------------------------------------
+
+namespace {
+
+struct Body {
+  std::string name;
+  TriMesh mesh;
+  std::string notes;  // topology repairs, for the report
+};
+
+// Cuts a closed mesh into `n` slabs along x and returns the convex hull of each slab's piece: the mesh vertices
+// inside the slab plus the cross-section points where edges cross its two planes. Adjacent hulls share their
+// cross-section exactly (the crossing points are computed once per plane), so they meet without gap or overlap.
+std::vector<TriMesh> slice_convex(const TriMesh& m, int n) {
+  const Bounds b(m.vertices);
+  const double x0 = b.lo.x(), x1 = b.hi.x();
+  std::vector<double> plane(n + 1);
+  for (int k = 0; k <= n; ++k) plane[k] = k == n ? x1 : x0 + (x1 - x0) * k / n;
+  std::set<std::pair<int, int>> edges;
+  for (const auto& t : m.triangles)
+    for (int k = 0; k < 3; ++k) edges.insert({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])});
+  std::vector<std::vector<Vec3>> section(n + 1);
+  for (const auto& [i, j] : edges) {
+    const Vec3 &a = m.vertices[i], &c = m.vertices[j];
+    const double lo = std::min(a.x(), c.x()), hi = std::max(a.x(), c.x());
+    // Planes strictly between the ends (a vertex on a plane belongs to both slabs anyway).
+    const int k0 = static_cast<int>(std::upper_bound(plane.begin(), plane.end(), lo) - plane.begin());
+    for (int k = k0; k <= n && plane[k] < hi; ++k) {
+      Vec3 p = a + (c - a) * ((plane[k] - a.x()) / (c.x() - a.x()));
+      p.x() = plane[k];
+      section[k].push_back(p);
+    }
+  }
+  std::vector<std::vector<Vec3>> slab(n);
+  for (int k = 0; k < n; ++k) {
+    slab[k] = section[k];
+    slab[k].insert(slab[k].end(), section[k + 1].begin(), section[k + 1].end());
+  }
+  for (const Vec3& v : m.vertices) {
+    const int k = static_cast<int>(std::upper_bound(plane.begin(), plane.end(), v.x()) - plane.begin()) - 1;
+    const int kk = std::clamp(k, 0, n - 1);
+    slab[kk].push_back(v);
+    if (v.x() == plane[kk] && kk > 0) slab[kk - 1].push_back(v);  // on a plane: both neighbours
+  }
+  std::vector<TriMesh> parts;
+  for (int k = 0; k < n; ++k) {
+    if (slab[k].size() < 4) continue;
+    const Bounds sb(slab[k]);
+    // A slab holding material only in one plane (a gap in the mesh along x) has no volume.
+    if (sb.hi.x() - sb.lo.x() <= 1e-9 * b.diagonal()) continue;
+    try {
+      parts.push_back(convex_hull(slab[k]));
+    } catch (const Error& e) {
+      throw Error("slab " + std::to_string(k + 1) + " of " + std::to_string(n) + ": " + e.what());
+    }
+  }
+  return parts;
+}
+
+std::string percent(double f) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%+.2f %%", 100.0 * f);
+  return buf;
+}
+
+}  // namespace
+
+HullModel load_hull(const fs::path& file, const HullLoadOptions& o) {
+  const std::string where = file.string();
+  FLOESIM_REQUIRE(fs::exists(file), where, ": hull file not found");
+  FLOESIM_REQUIRE(fs::is_regular_file(file), where, ": not a regular file");
+  FLOESIM_REQUIRE(o.non_convex == "slice" || o.non_convex == "refuse", where,
+                  ": non_convex must be \"slice\" or \"refuse\", got \"", o.non_convex, "\"");
+  FLOESIM_REQUIRE(o.slices >= 2, where, ": slices must be >= 2, got ", o.slices);
+
+  Assimp::Importer importer;
+  // Triangulate n-gons; join identical vertices. No PreTransformVertices: node transforms are applied below, so
+  // a mesh instanced twice stays two parts.
+  const aiScene* scene = importer.ReadFile(where, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+  FLOESIM_REQUIRE(scene != nullptr, where, ": cannot read as a mesh file: ", importer.GetErrorString());
+  FLOESIM_REQUIRE(!(scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE), where, ": the file is incomplete or damaged");
+  FLOESIM_REQUIRE(scene->mRootNode != nullptr && scene->mNumMeshes > 0, where, ": the file holds no meshes");
+
+  // Every mesh instance in the node tree, in world coordinates.
+  struct Instance {
+    std::string name;
+    std::vector<Vec3> v;
+    std::vector<std::array<int, 3>> t;
+    int skipped_faces = 0;  // points and lines
+  };
+  std::vector<Instance> instances;
+  std::function<void(const aiNode*, const Eigen::Matrix4d&)> walk = [&](const aiNode* node, const Eigen::Matrix4d& up) {
+    Eigen::Matrix4d local;
+    const aiMatrix4x4& a = node->mTransformation;
+    local << a.a1, a.a2, a.a3, a.a4, a.b1, a.b2, a.b3, a.b4, a.c1, a.c2, a.c3, a.c4, a.d1, a.d2, a.d3, a.d4;
+    const Eigen::Matrix4d world = up * local;
+    const bool mirrored = world.topLeftCorner<3, 3>().determinant() < 0;
+    for (unsigned i = 0; i < node->mNumMeshes; ++i) {
+      const aiMesh* mesh = scene->mMeshes[node->mMeshes[i]];
+      Instance in;
+      in.name = mesh->mName.length > 0 ? mesh->mName.C_Str()
+                                       : (node->mName.length > 0 ? std::string(node->mName.C_Str()) : "mesh") +
+                                             "#" + std::to_string(node->mMeshes[i]);
+      for (unsigned k = 0; k < mesh->mNumVertices; ++k) {
+        const aiVector3D& p = mesh->mVertices[k];
+        const Eigen::Vector4d w = world * Eigen::Vector4d(p.x, p.y, p.z, 1.0);
+        in.v.emplace_back(w.x() / w.w(), w.y() / w.w(), w.z() / w.w());
+      }
+      for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+        const aiFace& face = mesh->mFaces[f];
+        if (face.mNumIndices != 3) {
+          ++in.skipped_faces;
+          continue;
+        }
+        std::array<int, 3> t{int(face.mIndices[0]), int(face.mIndices[1]), int(face.mIndices[2])};
+        if (mirrored) std::swap(t[1], t[2]);  // a mirroring transform turns outward normals inward
+        in.t.push_back(t);
+      }
+      instances.push_back(std::move(in));
+    }
+    for (unsigned c = 0; c < node->mNumChildren; ++c) walk(node->mChildren[c], world);
+  };
+  walk(scene->mRootNode, Eigen::Matrix4d::Identity());
+  FLOESIM_REQUIRE(!instances.empty(), where, ": the file's node tree references no meshes");
+
+  std::ostringstream report;
+  // Closed meshes are bodies of their own. Meshes that are open on their own (an OBJ whose hull, deck and transom
+  // are separate groups, as in the KCS and DTMB 5415 benchmark files) are welded together and accepted as one body
+  // if together they close; otherwise the file is refused: buoyancy needs a watertight hull.
+  std::vector<Body> bodies;
+  std::vector<const Instance*> open;
+  for (const Instance& in : instances) {
+    for (const Vec3& p : in.v)
+      FLOESIM_REQUIRE(p.allFinite(), where, ": mesh '", in.name, "' has a non-finite vertex coordinate");
+    Body body{in.name, weld(in.v, in.t), ""};
+    if (in.skipped_faces > 0) body.notes += std::to_string(in.skipped_faces) + " point/line faces ignored; ";
+    FLOESIM_REQUIRE(!body.mesh.triangles.empty(), where, ": mesh '", in.name, "' has no triangles (degenerate mesh)");
+    Topology top = topology(body.mesh);
+    if (top.unbalanced_edges > 0 && top.even) {
+      const int f = orient_consistently(body.mesh);
+      top = topology(body.mesh);
+      if (top.unbalanced_edges == 0) body.notes += std::to_string(f) + " triangles re-oriented consistently; ";
+    }
+    if (top.unbalanced_edges == 0) {
+      if (top.non_manifold_edges > 0)
+        body.notes += std::to_string(top.non_manifold_edges) + " non-manifold edges; ";
+      bodies.push_back(std::move(body));
+    } else {
+      open.push_back(&in);
+    }
+  }
+  if (!open.empty()) {
+    Instance all;
+    std::string names;
+    for (const Instance* in : open) {
+      const int off = static_cast<int>(all.v.size());
+      all.v.insert(all.v.end(), in->v.begin(), in->v.end());
+      for (const auto& t : in->t) all.t.push_back({t[0] + off, t[1] + off, t[2] + off});
+      names += (names.empty() ? "'" : ", '") + in->name + "'";
+    }
+    Body body{open.size() == 1 ? open[0]->name : "", weld(all.v, all.t), ""};
+    if (open.size() > 1)
+      for (const Instance* in : open) body.name += (body.name.empty() ? "" : "+") + in->name;
+    Topology top = topology(body.mesh);
+    int flipped = 0;
+    if (top.unbalanced_edges > 0 && top.even) {
+      flipped = orient_consistently(body.mesh);
+      top = topology(body.mesh);
+    }
+    FLOESIM_REQUIRE(top.unbalanced_edges == 0, where, ": mesh", open.size() > 1 ? "es " : " ", names,
+                    open.size() > 1 ? " are" : " is", " not closed (", top.boundary_edges,
+                    " boundary edges, i.e. holes", open.size() > 1 ? ", also when welded together" : "",
+                    "); a hull must be watertight for buoyancy. Close the holes (e.g. Blender: Select > All by Trait >"
+                    " Non Manifold, then F to fill) and export again.");
+    if (open.size() > 1) body.notes += "open on their own, closed when welded together: one body; ";
+    if (flipped > 0) body.notes += std::to_string(flipped) + " triangles re-oriented consistently; ";
+    if (top.non_manifold_edges > 0) body.notes += std::to_string(top.non_manifold_edges) + " non-manifold edges; ";
+    bodies.push_back(std::move(body));
+  }
+
+  HullModel model;
+  for (Body& body : bodies) {
+    const Bounds bb(body.mesh.vertices);
+    const double size = bb.diagonal();
+    MassProperties mp = mass_properties(body.mesh);
+    FLOESIM_REQUIRE(body.mesh.vertices.size() >= 4 && size > 0 && std::abs(mp.volume) > 1e-9 * size * size * size,
+                    where, ": mesh '", body.name, "' is degenerate (it encloses no volume)");
+    if (mp.volume < 0) {
+      flip(body.mesh);
+      mp.volume = -mp.volume;
+      body.notes += "triangles faced inwards: flipped; ";
+    }
+    model.mesh_volume_m3 += mp.volume;
+    std::ostringstream line;
+    line << "mesh '" << body.name << "': closed, " << body.mesh.triangles.size() << " triangles, volume "
+         << fmt_num(mp.volume) << " m^3; " << body.notes;
+    // Tolerance relative to the mesh: assimp stores single-precision coordinates (relative error ~6e-8).
+    const double max_abs = std::max(bb.lo.cwiseAbs().maxCoeff(), bb.hi.cwiseAbs().maxCoeff());
+    const double tol = 1e-6 * std::max(size, max_abs);
+    if (is_convex(body.mesh, tol)) {
+      line << "convex: kept as 1 part";
+      model.parts.push_back(std::move(body.mesh));
+      model.parts_volume_m3 += mp.volume;
+    } else {
+      FLOESIM_REQUIRE(o.non_convex == "slice", where, ": mesh '", body.name,
+                      "' is not convex (a vertex lies more than ", fmt_num(tol),
+                      " m outside the plane of a face); set \"non_convex\": \"slice\" to cut it into convex sections"
+                      " along x, or split it into convex meshes (one per object) yourself");
+      std::vector<TriMesh> pieces;
+      try {
+        pieces = slice_convex(body.mesh, o.slices);
+      } catch (const Error& e) {
+        throw Error(where + ": mesh '" + body.name + "': slicing into convex parts failed: " + e.what());
+      }
+      double v = 0;
+      for (const TriMesh& p : pieces) v += mass_properties(p).volume;
+      const double err = (v - mp.volume) / mp.volume;
+      FLOESIM_REQUIRE(std::abs(err) <= o.max_volume_error, where, ": mesh '", body.name, "' is not convex and its ",
+                      pieces.size(), " convex slices change its volume by ", percent(err), " (", fmt_num(mp.volume),
+                      " -> ", fmt_num(v), " m^3), more than max_volume_error = ", o.max_volume_error,
+                      "; raise \"slices\" or split the mesh into convex meshes (one per object) yourself");
+      line << "not convex: sliced along x into " << pieces.size() << " convex parts, volume " << fmt_num(v)
+           << " m^3 (" << percent(err) << ")";
+      model.parts_volume_m3 += v;
+      for (TriMesh& p : pieces) model.parts.push_back(std::move(p));
+    }
+    report << line.str() << "\n";
+  }
+  model.surface = merge(model.parts);
+  report << "total: " << model.parts.size() << " convex parts, mesh volume " << fmt_num(model.mesh_volume_m3)
+         << " m^3, parts volume " << fmt_num(model.parts_volume_m3) << " m^3 ("
+         << percent((model.parts_volume_m3 - model.mesh_volume_m3) / model.mesh_volume_m3) << ")\n";
+  model.report = report.str();
+  return model;
+}
+
+}  // namespace floesim::sim

@@ -1,0 +1,248 @@
+// The parametric icebreaker (main particulars, convex parts, displacement) and the hull loader on the generated OBJ
+// and on two real benchmark hulls.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "pipeline/error.h"
+#include "sim/hull.h"
+
+#ifndef FLOESIM_SHARED_DATA_DIR
+#error "FLOESIM_SHARED_DATA_DIR must be defined by the build"
+#endif
+
+namespace floesim::sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("floesim_hull_test_" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+fs::path hull_file(const std::string& name) {
+  const fs::path f = fs::path(FLOESIM_SHARED_DATA_DIR) / "hulls" / name;
+  if (!fs::exists(f))
+    ADD_FAILURE() << "test data missing: " << f << " (FLOESIM_SHARED_DATA_DIR must hold ../shared/data)";
+  return f;
+}
+
+// Half-breadths of the waterline: points where edges of the parts cross z = 0.
+struct Waterline {
+  double max_half_beam = 0;       // anywhere
+  double midship_half_beam = 0;   // |x| < 5 m
+  double x_of_max = 0;
+};
+Waterline waterline(const std::vector<TriMesh>& parts) {
+  Waterline w;
+  for (const TriMesh& p : parts)
+    for (const auto& t : p.triangles)
+      for (int k = 0; k < 3; ++k) {
+        const Vec3 &a = p.vertices[t[k]], &b = p.vertices[t[(k + 1) % 3]];
+        if (a.z() * b.z() > 0 || a.z() == b.z()) continue;
+        const Vec3 q = a + (b - a) * (-a.z() / (b.z() - a.z()));
+        if (std::abs(q.y()) > w.max_half_beam) w.max_half_beam = std::abs(q.y()), w.x_of_max = q.x();
+        if (std::abs(q.x()) < 5) w.midship_half_beam = std::max(w.midship_half_beam, std::abs(q.y()));
+      }
+  return w;
+}
+
+TEST(GeneratedHull, MainParticularsAndDisplacement) {
+  const HullGeneratorOptions o;
+  const std::vector<TriMesh> parts = generate_hull(o);
+  ASSERT_EQ(parts.size(), static_cast<size_t>(o.sections));
+  EXPECT_GE(parts.size(), 20u);
+  EXPECT_LE(parts.size(), 40u);
+  Vec3 lo = Vec3::Constant(1e300), hi = -lo;
+  for (const TriMesh& p : parts) {
+    EXPECT_TRUE(is_convex(p, 1e-6)) << "a part is not convex";
+    EXPECT_GT(mass_properties(p).volume, 0);
+    for (const Vec3& v : p.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  }
+  EXPECT_NEAR(hi.x() - lo.x(), o.length_m, 0.01);
+  EXPECT_NEAR(-lo.z(), o.draught_m, 0.01);
+  EXPECT_NEAR(hi.z() - lo.z(), o.depth_m, 0.01);
+
+  const Waterline w = waterline(parts);
+  EXPECT_NEAR(2 * w.midship_half_beam, o.beam_m, 0.05);
+  EXPECT_NEAR(2 * w.max_half_beam, o.reamer_beam_m, 0.05);
+  EXPECT_GT(w.x_of_max, 0.1 * o.length_m) << "the reamers (widest waterline) must be in the forward part";
+
+  const Hydrostatics h = hydrostatics(parts, 1025.0, 0.0);
+  EXPECT_NEAR(h.displacement_t, 13000.0, 0.05 * 13000.0);
+  EXPECT_NEAR(h.draught_m, o.draught_m, 0.01);
+  EXPECT_NEAR(h.beam_wl_m, o.reamer_beam_m, 0.05);
+  EXPECT_GT(h.block_coefficient, 0.5);
+  EXPECT_LT(h.block_coefficient, 0.75);
+  // The centre of buoyancy is below the waterline, above half the draught for a full, flat-bottomed hull.
+  EXPECT_GT(h.kb_m, 0.5 * o.draught_m);
+  EXPECT_LT(h.kb_m, o.draught_m);
+  // Wetted surface: between the waterplane + the projected side area and a box's wetted surface.
+  EXPECT_GT(h.wetted_surface_m2, h.waterplane_area_m2);
+  EXPECT_LT(h.wetted_surface_m2, h.length_wl_m * (h.beam_wl_m + 2 * h.draught_m) + 2 * h.beam_wl_m * h.draught_m);
+}
+
+TEST(GeneratedHull, SubmergedVolumeOfPartsEqualsSurfaceClipping) {
+  // Faces shared by neighbouring parts cancel: clipping the merged surface equals summing the parts' clips.
+  const std::vector<TriMesh> parts = generate_hull(HullGeneratorOptions{});
+  double sum = 0;
+  TriMesh all;
+  for (const TriMesh& p : parts) {
+    sum += submerged_part(p.vertices, p.triangles, 0.0).volume;
+    const int off = static_cast<int>(all.vertices.size());
+    all.vertices.insert(all.vertices.end(), p.vertices.begin(), p.vertices.end());
+    for (const auto& t : p.triangles) all.triangles.push_back({t[0] + off, t[1] + off, t[2] + off});
+  }
+  EXPECT_NEAR(submerged_part(all.vertices, all.triangles, 0.0).volume, sum, 1e-9 * sum);
+}
+
+TEST(GeneratedHull, ObjRoundTripThroughLoader) {
+  const fs::path dir = temp_dir("roundtrip");
+  const fs::path obj = dir / "hull.obj";
+  HullGeneratorOptions o;
+  const std::string summary = write_generated_hull(o, obj, "");
+  EXPECT_NE(summary.find("displacement"), std::string::npos);
+  ASSERT_TRUE(fs::exists(obj));
+  ASSERT_TRUE(fs::exists(dir / "hull.json"));
+  const nlohmann::json side = nlohmann::json::parse(std::ifstream(dir / "hull.json"));
+  EXPECT_EQ(side["parts"].get<int>(), o.sections);
+  EXPECT_EQ(side["provenance"]["program"], "floesim-hull");
+  EXPECT_NEAR(side["hydrostatics"]["displacement_t"].get<double>(), 13000.0, 650.0);
+  {  // the header records the particulars and the displacement
+    std::ifstream in(obj);
+    std::string first, all;
+    for (std::string line; std::getline(in, line) && line.rfind("#", 0) == 0;) all += line + "\n";
+    EXPECT_NE(all.find("displacement"), std::string::npos);
+    EXPECT_NE(all.find("length_m 107.75"), std::string::npos);
+  }
+
+  const std::vector<TriMesh> parts = generate_hull(o);
+  const HullModel m = load_hull(obj, HullLoadOptions{"refuse", 24, 0.05});  // all parts convex: nothing refused
+  ASSERT_EQ(m.parts.size(), parts.size());
+  for (size_t k = 0; k < parts.size(); ++k) {
+    const double v0 = mass_properties(parts[k]).volume, v1 = mass_properties(m.parts[k]).volume;
+    EXPECT_NEAR(v1, v0, 1e-9 * v0) << "part " << k;
+  }
+  EXPECT_NEAR(m.parts_volume_m3, m.mesh_volume_m3, 1e-12 * m.mesh_volume_m3);
+  std::istringstream rep(m.report);
+  int convex_lines = 0;
+  for (std::string line; std::getline(rep, line);) convex_lines += line.find("convex: kept") != std::string::npos;
+  EXPECT_EQ(convex_lines, o.sections) << m.report;
+  EXPECT_EQ(m.surface.triangles.size(), [&] {
+    size_t n = 0;
+    for (const TriMesh& p : parts) n += p.triangles.size();
+    return n;
+  }());
+  fs::remove_all(dir);
+}
+
+TEST(GeneratedHull, BadOptionsAreErrors) {
+  HullGeneratorOptions o;
+  o.reamer_beam_m = 20;  // < beam
+  EXPECT_THROW(generate_hull(o), Error);
+  o = HullGeneratorOptions{};
+  o.sections = 2;
+  EXPECT_THROW(generate_hull(o), Error);
+}
+
+TEST(LoadHull, MissingAndUnreadableFilesNameTheFile) {
+  const fs::path dir = temp_dir("errors");
+  try {
+    load_hull(dir / "nope.obj");
+    FAIL() << "no error for a missing file";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("nope.obj"), std::string::npos) << e.what();
+  }
+  const fs::path junk = dir / "junk.obj";
+  std::ofstream(junk) << "this is not a mesh\n";
+  try {
+    load_hull(junk);
+    FAIL() << "no error for a file without meshes";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("junk.obj"), std::string::npos) << e.what();
+  }
+  // An open mesh (a single triangle... a tetrahedron missing a face) is refused with the reason.
+  const fs::path open = dir / "open.obj";
+  std::ofstream(open) << "o tet\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\n";
+  try {
+    load_hull(open);
+    FAIL() << "no error for an open mesh";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("open.obj"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("not closed"), std::string::npos) << e.what();
+  }
+  // A flat (zero-volume) closed mesh: degenerate.
+  const fs::path flat = dir / "flat.obj";
+  std::ofstream(flat) << "o flat\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 3 2\n";
+  EXPECT_THROW(load_hull(flat), Error);
+  fs::remove_all(dir);
+}
+
+TEST(LoadHull, InwardFacingConvexMeshIsFlipped) {
+  const fs::path dir = temp_dir("flip");
+  // A unit cube written with every triangle facing inwards: loaded with positive volume, and the report says so.
+  const fs::path cube = dir / "cube.obj";
+  std::ofstream(cube) << "o cube\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n"
+                         "f 1 4 3\nf 1 2 4\nf 5 8 6\nf 5 7 8\nf 1 6 2\nf 1 5 6\nf 3 8 7\nf 3 4 8\n"
+                         "f 1 7 5\nf 1 3 7\nf 2 8 4\nf 2 6 8\n";
+  const HullModel m = load_hull(cube);
+  ASSERT_EQ(m.parts.size(), 1u);
+  EXPECT_NEAR(mass_properties(m.parts[0]).volume, 1.0, 1e-12);
+  EXPECT_NE(m.report.find("flipped"), std::string::npos) << m.report;
+  fs::remove_all(dir);
+}
+
+// ---- the real benchmark hulls (model scale, waterline at z = 0, not convex) ----
+
+struct RealHull {
+  const char* file;
+  double published_volume_m3;  // displacement volume at the design draught, model scale
+};
+
+void check_real_hull(const RealHull& r, double max_volume_error, double max_displacement_error) {
+  const fs::path f = hull_file(r.file);
+  // Reference: displaced volume of the raw mesh (all of the file's faces, welded) below z = 0.
+  const HullModel m = load_hull(f, HullLoadOptions{"slice", 24, 0.05});
+  std::cout << r.file << ":\n" << m.report;
+  ASSERT_GT(m.parts.size(), 10u);
+  for (const TriMesh& p : m.parts) ASSERT_TRUE(is_convex(p, 1e-6));
+  const double verr = (m.parts_volume_m3 - m.mesh_volume_m3) / m.mesh_volume_m3;
+  EXPECT_GE(verr, 0) << "convex hulls of slices can only add volume";
+  EXPECT_LT(verr, max_volume_error);
+
+  // The raw mesh's displacement, independently of the loader: clip the file's own triangles.
+  // (load_hull with every mesh kept would be circular; the slices are what the simulator sees.)
+  const Hydrostatics parts = hydrostatics(m.parts, 1000.0, 0.0);
+  std::cout << "  displaced volume of the convex parts: " << parts.volume_m3 << " m^3 (published "
+            << r.published_volume_m3 << " m^3)\n";
+  EXPECT_NEAR(parts.volume_m3, r.published_volume_m3, max_displacement_error * r.published_volume_m3);
+}
+
+TEST(LoadHull, KcsSlicedIntoConvexParts) { check_real_hull({"KCS_model_scale_L7.2786m.obj", 1.6490}, 0.03, 0.03); }
+
+TEST(LoadHull, Dtmb5415SlicedIntoConvexParts) {
+  check_real_hull({"DTMB5415_model_scale_L5.72m.obj", 0.549}, 0.03, 0.03);
+}
+
+TEST(LoadHull, RefuseNamesTheFile) {
+  const fs::path f = hull_file("KCS_model_scale_L7.2786m.obj");
+  try {
+    load_hull(f, HullLoadOptions{"refuse", 24, 0.05});
+    FAIL() << "a non-convex hull was accepted with non_convex = refuse";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("KCS_model_scale_L7.2786m.obj"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("not convex"), std::string::npos) << msg;
+  }
+}
+
+}  // namespace
+}  // namespace floesim::sim
