@@ -82,8 +82,8 @@ struct PropulsionOptions {
   double thrust_n = 0.0;             // constant_thrust: thrust along the body x axis
   std::string thrust_file;           // thrust_series: CSV "time_s,thrust_N" (relative to the config file)
   double speed_mps = 2.0;            // speed: prescribed forward speed through the water
-  double kp_n_per_mps = 2e6;         // speed: proportional gain
-  double ki_n_per_m = 2e5;           // speed: integral gain
+  double kp_n_per_mps = 4e6;         // speed: proportional gain (m / kp ~ 3 s for Oden)
+  double ki_n_per_m = 2e5;           // speed: integral gain (closed loop overdamped, zeta ~ 1.2 for Oden)
   double min_thrust_n = 0.0;         // speed: thrust limits (anti-windup clamps the integral)
   double max_thrust_n = 4e6;
   template <class V>

@@ -1,0 +1,123 @@
+// The vessel in open water against closed forms: hydrostatic equilibrium and heave period from the clipped hull,
+// terminal speed under constant thrust = ITTC-57 resistance, the speed controller, numerical-health stop.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "pipeline/error.h"
+#include "sim/forces.h"
+#include "sim/simulate.h"
+#include "sim/world.h"
+#include "sim_fixtures.h"
+
+namespace floesim::sim {
+namespace {
+
+using testing::coarse_hull;
+constexpr double kPi = 3.14159265358979323846;
+
+double surge_speed(const World& w) {
+  const int v = w.model().vessel;
+  return (w.state().orientation[v].toRotationMatrix().transpose() * w.state().velocity[v]).x();
+}
+
+// Released 10 cm low, undamped, the vessel heaves with T = 2 pi sqrt(m / (rho_w g A_wp)) (no added mass) about its
+// initial (hydrostatic) position; heave-pitch coupling of the asymmetric waterplane shifts it a little.
+TEST(SimVessel, HeavePeriodFromWaterplane) {
+  const HullModel hull = coarse_hull(10);
+  SimulateOptions o;
+  o.water.vessel_heave_damping_ratio = 0;
+  o.water.vessel_pitch_damping_ratio = 0;
+  o.vessel.initial_speed_mps = 0;
+  o.vessel.propulsion.mode = "constant_thrust";
+  o.vessel.propulsion.thrust_n = 0;
+  const Model m = build_model(FloeField{}, &hull, o);
+  World w(m);
+  const double z0 = w.state().position[0].z();
+  w.mutable_state().position[0].z() -= 0.1;
+  w.sync();
+  std::vector<double> up;
+  double prev = -0.1, tprev = 0, zsum = 0;
+  int n = 0;
+  for (int i = 0; i < 3000; ++i) {
+    w.step();
+    const double cur = w.state().position[0].z() - z0, t = w.state().time_s;
+    if (prev < 0 && cur >= 0) up.push_back(tprev + (t - tprev) * (-prev) / (cur - prev));
+    prev = cur;
+    tprev = t;
+    zsum += cur;
+    ++n;
+  }
+  ASSERT_GE(up.size(), 3u);
+  const double period = (up.back() - up.front()) / (up.size() - 1);
+  const double theory = 2 * kPi * std::sqrt(m.vessel_info.mass_kg /
+                                            (o.water.density_kg_m3 * 9.81 * m.vessel_info.waterplane_area_m2));
+  std::printf("[measured] vessel heave period %.3f s, theory %.3f s (%+.2f %%); mean heave offset %.4f m\n", period,
+              theory, 100 * (period / theory - 1), zsum / n);
+  EXPECT_NEAR(period / theory, 1.0, 0.05);
+  EXPECT_NEAR(zsum / n, 0.0, 0.01);  // oscillates about the hydrostatic equilibrium it was built at
+}
+
+// Constant thrust equal to the ITTC-57 resistance at 3 m/s holds 3 m/s; level and on course.
+TEST(SimVessel, TerminalSpeedUnderConstantThrust) {
+  const HullModel hull = coarse_hull(10);
+  SimulateOptions o;
+  o.vessel.initial_speed_mps = 3.0;
+  o.vessel.heading_deg = 30;
+  o.vessel.propulsion.mode = "constant_thrust";
+  Model m = build_model(FloeField{}, &hull, o);
+  const double r3 = ittc57_resistance(3.0, m.vessel_info, o);
+  m.options.vessel.propulsion.thrust_n = r3;
+  World w(m);
+  for (int i = 0; i < 3000; ++i) w.step();
+  const double u = surge_speed(w);
+  const Mat3 R = w.state().orientation[0].toRotationMatrix();
+  std::printf("[measured] R_ow(3 m/s) = %.1f kN; speed after 30 s %.5f m/s; heading %.4f deg\n", r3 / 1e3, u,
+              heading_of(R) * 180 / kPi);
+  EXPECT_NEAR(u, 3.0, 0.003);
+  EXPECT_NEAR(heading_of(R) * 180 / kPi, 30.0, 0.01);
+  EXPECT_GT(R(2, 2), std::cos(0.2 * kPi / 180));  // no heel or trim beyond 0.2 deg
+}
+
+// Speed mode: the PI controller brings the vessel from 1 to 2 m/s and settles at the open-water thrust (the
+// closed loop is overdamped with a slow pole of ~16 s for Oden's mass).
+TEST(SimVessel, SpeedControllerHoldsTarget) {
+  const HullModel hull = coarse_hull(10);
+  SimulateOptions o;
+  o.vessel.initial_speed_mps = 1.0;
+  o.vessel.propulsion.speed_mps = 2.0;
+  const Model m = build_model(FloeField{}, &hull, o);
+  World w(m);
+  for (int i = 0; i < 15000; ++i) w.step();
+  const double r2 = ittc57_resistance(2.0, m.vessel_info, o);
+  std::printf("[measured] speed after 150 s %.5f m/s, thrust %.1f kN (R_ow(2) %.1f kN)\n", surge_speed(w),
+              w.report().thrust_n / 1e3, r2 / 1e3);
+  EXPECT_NEAR(surge_speed(w), 2.0, 0.002);
+  EXPECT_NEAR(w.report().thrust_n / r2, 1.0, 0.05);
+}
+
+// A health limit crossed stops the stage with a diagnosis naming the body, and nothing is written.
+TEST(SimVessel, HealthStopWritesNothing) {
+  const auto dir = testing::temp_dir("health");
+  FloeField field;
+  field.floes = {testing::rect_floe(1, 300, 0, 5, 5, 1)};
+  write_floes(dir / "floes.geojson", field);
+  HullGeneratorOptions g;
+  g.sections = 6;
+  write_obj(dir / "hull.obj", generate_hull(g), "test hull");
+  std::ofstream(dir / "sim.json") << R"({"duration_s": 1.0, "steady_start_s": 0.5, "health": {"max_speed_mps": 1.5}})";
+  try {
+    run_simulate(dir / "floes.geojson", dir / "hull.obj", dir / "sim.json", dir / "out");
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    std::printf("[message] %s\n", msg.c_str());
+    EXPECT_NE(msg.find("the vessel"), std::string::npos);
+    EXPECT_NE(msg.find("step 1 "), std::string::npos);
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "results.h5"));
+}
+
+}  // namespace
+}  // namespace floesim::sim
