@@ -43,7 +43,7 @@ struct RenderOptions {
     v.field("fps", fps, "1/s", "video playback rate; one video frame per results frame", in_range(0.1, 240));
     v.field("max_frames", max_frames, "-", "render only the first N results frames (0 = all)",
             int_in_range(0, 1 << 30));
-    v.field("view", view, "-", "camera: chase (behind and above the vessel) | top (orthographic, north up)",
+    v.field("view", view, "-", "camera: chase (behind and above the vessel) or top (orthographic, north up)",
             one_of({"chase", "top"}));
     v.field("chase_distance_m", chase_distance_m, "m", "chase camera: horizontal distance behind the vessel",
             non_negative());

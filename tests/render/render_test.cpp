@@ -8,6 +8,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "pipeline/error.h"
+#include "pipeline/provenance.h"
 #include "pipeline/results_io.h"
 #include "render/scene.h"
 #include "render/video.h"
@@ -158,6 +159,17 @@ TEST(Render, MaxFramesLimitsTheVideoAndStillFrameWritesAnImage) {
   EXPECT_EQ(still.size(), cv::Size(160, 90));
   EXPECT_THROW(render_still(dir / "results.h5", cfg, 12, dir / "bad.png"), Error);
   EXPECT_FALSE(fs::exists(dir / "bad.png"));
+  fs::remove_all(dir);
+}
+
+TEST(Render, SameInputsGiveByteIdenticalVideos) {
+  const fs::path dir = fresh_dir("determinism");
+  write_results(dir / "results.h5", make_results(default_synthetic()));
+  const auto cfg = write_json(dir / "render.json", {{"width_px", 320}, {"height_px", 180}});
+  render_video(dir / "results.h5", cfg, dir / "a" / "v.mp4");
+  render_video(dir / "results.h5", cfg, dir / "b" / "v.mp4");
+  EXPECT_EQ(sha256_file(dir / "a" / "v.mp4"), sha256_file(dir / "b" / "v.mp4"));
+  EXPECT_EQ(sha256_file(dir / "a" / "v.json"), sha256_file(dir / "b" / "v.json"));
   fs::remove_all(dir);
 }
 
