@@ -1,0 +1,585 @@
+#include "imaging/segment.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <map>
+#include <numeric>
+
+#include <opencv2/imgproc.hpp>
+
+#include "pipeline/error.h"
+
+namespace floesim::imaging {
+
+namespace {
+
+constexpr int kDr[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
+constexpr int kDc[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
+
+// Otsu's threshold of a 256-bin histogram: the grey level t maximising the between-class variance of
+// {<= t} and {> t}.
+int otsu(const std::array<double, 256>& hist) {
+  double total = 0, sum = 0;
+  for (int i = 0; i < 256; ++i) {
+    total += hist[i];
+    sum += i * hist[i];
+  }
+  double w0 = 0, s0 = 0, best = -1;
+  int t_best = 0;
+  for (int t = 0; t < 255; ++t) {
+    w0 += hist[t];
+    s0 += t * hist[t];
+    const double w1 = total - w0;
+    if (w0 <= 0 || w1 <= 0) continue;
+    const double m0 = s0 / w0, m1 = (sum - s0) / w1;
+    const double between = w0 * w1 * (m0 - m1) * (m0 - m1);
+    if (between > best) {
+      best = between;
+      t_best = t;
+    }
+  }
+  return t_best;
+}
+
+// Smooth average of `gray` over the pixels of `mask` (Gaussian of sigma_px), computed on a coarse grid (the
+// result is smooth by construction) and interpolated back. Where the mask has no support, `fallback`.
+cv::Mat masked_smooth(const cv::Mat& gray, const cv::Mat& mask, double sigma_px, double fallback) {
+  const int f = std::max(1, static_cast<int>(sigma_px / 4));
+  const cv::Size small((gray.cols + f - 1) / f, (gray.rows + f - 1) / f);
+  cv::Mat m, v;
+  mask.convertTo(m, CV_32F, 1.0 / 255);
+  gray.convertTo(v, CV_32F);
+  v = v.mul(m);
+  cv::Mat ms, vs;
+  cv::resize(m, ms, small, 0, 0, cv::INTER_AREA);
+  cv::resize(v, vs, small, 0, 0, cv::INTER_AREA);
+  const double sigma_small = std::max(0.5, sigma_px / f);
+  cv::GaussianBlur(ms, ms, cv::Size(0, 0), sigma_small, sigma_small, cv::BORDER_REFLECT);
+  cv::GaussianBlur(vs, vs, cv::Size(0, 0), sigma_small, sigma_small, cv::BORDER_REFLECT);
+  // Normalised convolution; the small constant lets regions without support fall back to the global level.
+  const float eps = 1e-3f;
+  cv::Mat est = (vs + eps * static_cast<float>(fallback)) / (ms + eps);
+  cv::Mat out;
+  cv::resize(est, out, gray.size(), 0, 0, cv::INTER_LINEAR);
+  return out;
+}
+
+// Fills the 8-connected non-ice components that touch neither the image border nor a no-data pixel and have
+// at most max_px pixels (melt ponds and other water enclosed by ice).
+void fill_small_holes(cv::Mat& ice, const cv::Mat& valid, double max_px) {
+  const int R = ice.rows, C = ice.cols;
+  cv::Mat comp, stats, cents;
+  const int n = cv::connectedComponentsWithStats(~ice, comp, stats, cents, 8, CV_32S);
+  std::vector<char> fill(n, 0);
+  for (int k = 1; k < n; ++k) {
+    const int x = stats.at<int>(k, cv::CC_STAT_LEFT), y = stats.at<int>(k, cv::CC_STAT_TOP);
+    const int w = stats.at<int>(k, cv::CC_STAT_WIDTH), h = stats.at<int>(k, cv::CC_STAT_HEIGHT);
+    fill[k] = x > 0 && y > 0 && x + w < C && y + h < R && stats.at<int>(k, cv::CC_STAT_AREA) <= max_px;
+  }
+  for (int r = 0; r < R; ++r)
+    for (int c = 0; c < C; ++c)
+      if (!valid.at<uint8_t>(r, c)) fill[comp.at<int>(r, c)] = 0;
+  for (int r = 0; r < R; ++r)
+    for (int c = 0; c < C; ++c)
+      if (fill[comp.at<int>(r, c)]) ice.at<uint8_t>(r, c) = 255;
+}
+
+// Per-label bounding boxes (index = label) over labels 1..max_label.
+std::vector<cv::Rect> label_boxes(const cv::Mat& lab, int max_label) {
+  std::vector<int> r0(max_label + 1, INT32_MAX), r1(max_label + 1, -1), c0(max_label + 1, INT32_MAX),
+      c1(max_label + 1, -1);
+  for (int r = 0; r < lab.rows; ++r) {
+    const int* p = lab.ptr<int>(r);
+    for (int c = 0; c < lab.cols; ++c) {
+      const int l = p[c];
+      if (l <= 0) continue;
+      r0[l] = std::min(r0[l], r);
+      r1[l] = std::max(r1[l], r);
+      c0[l] = std::min(c0[l], c);
+      c1[l] = std::max(c1[l], c);
+    }
+  }
+  std::vector<cv::Rect> boxes(max_label + 1);
+  for (int l = 1; l <= max_label; ++l)
+    if (r1[l] >= 0) boxes[l] = cv::Rect(c0[l], r0[l], c1[l] - c0[l] + 1, r1[l] - r0[l] + 1);
+  return boxes;
+}
+
+// Mask of label l inside box, padded by one pixel of zeros all round.
+cv::Mat padded_mask(const cv::Mat& lab, const cv::Rect& box, int l) {
+  cv::Mat m(box.height + 2, box.width + 2, CV_8U, cv::Scalar(0));
+  for (int r = 0; r < box.height; ++r) {
+    const int* p = lab.ptr<int>(box.y + r) + box.x;
+    uint8_t* q = m.ptr<uint8_t>(r + 1) + 1;
+    for (int c = 0; c < box.width; ++c) q[c] = p[c] == l ? 255 : 0;
+  }
+  return m;
+}
+
+// Fills the holes of every region: the pixels of 8-connected non-region components enclosed by the region
+// (not reaching the padding) join it, whatever they were (water, or another region it encloses). Holes that
+// contain no-data pixels are left alone: no data is never ice.
+void fill_region_holes(cv::Mat& lab, int max_label, const cv::Mat& valid) {
+  const std::vector<cv::Rect> boxes = label_boxes(lab, max_label);
+  for (int l = 1; l <= max_label; ++l) {
+    const cv::Rect& box = boxes[l];
+    if (box.width < 3 || box.height < 3) continue;  // too thin to enclose anything
+    cv::Mat m = padded_mask(lab, box, l);
+    cv::Mat comp;
+    const int n = cv::connectedComponents(m == 0, comp, 8, CV_32S);
+    if (n <= 2) continue;  // background is one component: no holes
+    const int outside = comp.at<int>(0, 0);
+    std::vector<char> hole(n, 1);
+    hole[0] = 0;
+    hole[outside] = 0;
+    for (int r = 0; r < box.height; ++r)
+      for (int c = 0; c < box.width; ++c)
+        if (!valid.at<uint8_t>(box.y + r, box.x + c)) hole[comp.at<int>(r + 1, c + 1)] = 0;
+    for (int r = 0; r < box.height; ++r)
+      for (int c = 0; c < box.width; ++c)
+        if (hole[comp.at<int>(r + 1, c + 1)]) lab.at<int>(box.y + r, box.x + c) = l;
+  }
+}
+
+// Keeps the largest 4-connected part of every region; the rest becomes 0.
+void keep_largest_part(cv::Mat& lab, int max_label) {
+  const std::vector<cv::Rect> boxes = label_boxes(lab, max_label);
+  for (int l = 1; l <= max_label; ++l) {
+    const cv::Rect& box = boxes[l];
+    if (box.width == 0) continue;
+    cv::Mat m = padded_mask(lab, box, l);
+    cv::Mat comp, stats, cents;
+    const int n = cv::connectedComponentsWithStats(m, comp, stats, cents, 4, CV_32S);
+    if (n <= 2) continue;
+    int best = 1;
+    for (int k = 2; k < n; ++k)
+      if (stats.at<int>(k, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA)) best = k;
+    for (int r = 0; r < box.height; ++r)
+      for (int c = 0; c < box.width; ++c) {
+        const int k = comp.at<int>(r + 1, c + 1);
+        if (k > 0 && k != best) lab.at<int>(box.y + r, box.x + c) = 0;
+      }
+  }
+}
+
+// Removes every pixel of a region that is 8-adjacent to a region with a smaller label, so no two regions touch
+// even diagonally (their outlines then stay at least a pixel apart and cannot overlap after simplification).
+void separate_regions(cv::Mat& lab) {
+  std::vector<cv::Point> drop;
+  for (int r = 0; r < lab.rows; ++r)
+    for (int c = 0; c < lab.cols; ++c) {
+      const int l = lab.at<int>(r, c);
+      if (l <= 0) continue;
+      for (int k = 0; k < 8; ++k) {
+        const int rr = r + kDr[k], cc = c + kDc[k];
+        if (rr < 0 || cc < 0 || rr >= lab.rows || cc >= lab.cols) continue;
+        const int m = lab.at<int>(rr, cc);
+        if (m > 0 && m < l) {
+          drop.emplace_back(c, r);
+          break;
+        }
+      }
+    }
+  for (const cv::Point& p : drop) lab.at<int>(p) = 0;
+}
+
+// Union-find over seed labels (deterministic: the smaller label is the root).
+struct UnionFind {
+  std::vector<int> parent;
+  explicit UnionFind(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int find(int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  bool unite(int a, int b) {
+    a = find(a);
+    b = find(b);
+    if (a == b) return false;
+    if (b < a) std::swap(a, b);
+    parent[b] = a;
+    return true;
+  }
+};
+
+}  // namespace
+
+void reconstruct_by_dilation(cv::Mat& marker, const cv::Mat& mask, const cv::Mat& domain) {
+  const int R = marker.rows, C = marker.cols;
+  auto in = [&](int r, int c) { return r >= 0 && c >= 0 && r < R && c < C && domain.at<uint8_t>(r, c); };
+  // Forward raster scan with the causal half of the 8-neighbourhood, then the backward scan.
+  for (int r = 0; r < R; ++r)
+    for (int c = 0; c < C; ++c) {
+      if (!domain.at<uint8_t>(r, c)) continue;
+      float v = marker.at<float>(r, c);
+      for (int k = 0; k < 4; ++k)
+        if (in(r + kDr[k], c + kDc[k])) v = std::max(v, marker.at<float>(r + kDr[k], c + kDc[k]));
+      marker.at<float>(r, c) = std::min(v, mask.at<float>(r, c));
+    }
+  std::deque<int> fifo;
+  for (int r = R - 1; r >= 0; --r)
+    for (int c = C - 1; c >= 0; --c) {
+      if (!domain.at<uint8_t>(r, c)) continue;
+      float v = marker.at<float>(r, c);
+      for (int k = 4; k < 8; ++k)
+        if (in(r + kDr[k], c + kDc[k])) v = std::max(v, marker.at<float>(r + kDr[k], c + kDc[k]));
+      v = std::min(v, mask.at<float>(r, c));
+      marker.at<float>(r, c) = v;
+      for (int k = 4; k < 8; ++k) {
+        const int rr = r + kDr[k], cc = c + kDc[k];
+        if (in(rr, cc) && marker.at<float>(rr, cc) < v && marker.at<float>(rr, cc) < mask.at<float>(rr, cc)) {
+          fifo.push_back(r * C + c);
+          break;
+        }
+      }
+    }
+  // Propagate what the two scans could not reach.
+  while (!fifo.empty()) {
+    const int p = fifo.front();
+    fifo.pop_front();
+    const int r = p / C, c = p % C;
+    const float v = marker.at<float>(r, c);
+    for (int k = 0; k < 8; ++k) {
+      const int rr = r + kDr[k], cc = c + kDc[k];
+      if (!in(rr, cc)) continue;
+      float& q = marker.at<float>(rr, cc);
+      const float g = mask.at<float>(rr, cc);
+      if (q < v && q != g) {
+        q = std::min(v, g);
+        fifo.push_back(rr * C + cc);
+      }
+    }
+  }
+}
+
+cv::Mat watershed_distance(const cv::Mat& markers, const cv::Mat& relief, const cv::Mat& domain) {
+  const int R = markers.rows, C = markers.cols, W = C + 2;
+  // Flat arrays with a one-pixel frame outside the domain, so the 8 neighbours need no bounds checks.
+  std::vector<int> lab(static_cast<size_t>(R + 2) * W, 0), level(lab.size(), 0);
+  std::vector<uint8_t> open(lab.size(), 0);  // in the domain and not yet queued
+  // Hierarchical queue: the relief quantised to 1/16 (of a pixel of distance), one FIFO per level, highest level
+  // first; FIFO order makes plateaus flood evenly and the result deterministic.
+  constexpr double kLevelsPerUnit = 16;
+  double lo = 0, hi = 0;
+  cv::minMaxLoc(relief, &lo, &hi, nullptr, nullptr, domain);
+  for (int r = 0; r < R; ++r) {
+    const int* m = markers.ptr<int>(r);
+    const float* f = relief.ptr<float>(r);
+    const uint8_t* d = domain.ptr<uint8_t>(r);
+    for (int c = 0; c < C; ++c) {
+      const size_t p = static_cast<size_t>(r + 1) * W + c + 1;
+      lab[p] = m[c];
+      open[p] = d[c] && m[c] == 0;
+      if (d[c]) level[p] = static_cast<int>((f[c] - lo) * kLevelsPerUnit);
+    }
+  }
+  const int off[8] = {-W - 1, -W, -W + 1, -1, 1, W - 1, W, W + 1};
+  const int n_levels = static_cast<int>((hi - lo) * kLevelsPerUnit) + 2;
+  std::vector<std::vector<int>> fifo(n_levels);
+  int current = n_levels - 1;
+  auto push_neighbours = [&](int p) {
+    for (int k = 0; k < 8; ++k) {
+      const int q = p + off[k];
+      if (!open[q]) continue;
+      open[q] = 0;
+      // A neighbour above the flood level is reached over the current level (it has no seed of its own).
+      fifo[std::min(level[q], current)].push_back(q);
+    }
+  };
+  for (int p = 0; p < static_cast<int>(lab.size()); ++p)
+    if (lab[p] > 0) push_neighbours(p);
+  for (; current >= 0; --current) {
+    std::vector<int>& q = fifo[current];
+    for (size_t i = 0; i < q.size(); ++i) {
+      const int p = q[i];
+      int label = 0;
+      bool conflict = false;
+      for (int k = 0; k < 8; ++k) {
+        const int l = lab[p + off[k]];
+        if (l <= 0) continue;
+        if (label == 0)
+          label = l;
+        else if (l != label)
+          conflict = true;
+      }
+      if (conflict || label == 0) {
+        lab[p] = -1;  // on the line between two floods
+        continue;
+      }
+      lab[p] = label;
+      push_neighbours(p);
+    }
+    std::vector<int>().swap(q);
+  }
+  cv::Mat out(R, C, CV_32S);
+  for (int r = 0; r < R; ++r) std::copy_n(&lab[static_cast<size_t>(r + 1) * W + 1], C, out.ptr<int>(r));
+  return out;
+}
+
+Segmentation segment_floes(const cv::Mat& gray, double s, const DigitiseOptions& o, const std::string& name) {
+  CV_Assert(gray.type() == CV_8UC1);
+  Segmentation seg;
+  const int R = gray.rows, C = gray.cols;
+  const double px_area = s * s;
+
+  // 1. No data.
+  seg.valid = gray > 0;
+  seg.valid_pixels = cv::countNonZero(seg.valid);
+  FLOESIM_REQUIRE(seg.valid_pixels > 0, name,
+                  ": every pixel is 0, which digitise reads as \"no data\" (outside the camera footprint); "
+                  "is this the right image?");
+
+  // 2. Ice / water.
+  std::array<double, 256> hist{};
+  for (int r = 0; r < R; ++r) {
+    const uint8_t* p = gray.ptr<uint8_t>(r);
+    for (int c = 0; c < C; ++c) hist[p[c]] += 1;
+  }
+  hist[0] = 0;
+  const int t = otsu(hist);
+  double n0 = 0, s0 = 0, n1 = 0, s1 = 0;
+  for (int i = 1; i < 256; ++i) (i <= t ? n0 : n1) += hist[i], (i <= t ? s0 : s1) += i * hist[i];
+  seg.otsu_threshold = t;
+  seg.water_grey = n0 > 0 ? s0 / n0 : 0;
+  seg.ice_grey = n1 > 0 ? s1 / n1 : 0;
+  const double contrast = (n0 > 0 && n1 > 0) ? seg.ice_grey - seg.water_grey : 0.0;
+
+  cv::Mat ice, norm;
+  if (contrast < o.min_contrast) {
+    // One class. Its brightness decides which (the middle of the 8-bit range: water photographs dark, ice bright).
+    double sum = 0;
+    for (int i = 1; i < 256; ++i) sum += i * hist[i];
+    const double mean = sum / static_cast<double>(seg.valid_pixels);
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "ice-water contrast %.1f grey levels < min_contrast %.1f, mean grey %.1f: ",
+                  contrast, o.min_contrast, mean);
+    if (mean < 128) {
+      seg.classes = "no_ice";
+      seg.warnings.push_back(name + ": " + buf + "no ice found; the result has no floes");
+      seg.labels = cv::Mat(R, C, CV_32S, cv::Scalar(0));
+      return seg;
+    }
+    seg.classes = "all_ice";
+    seg.warnings.push_back(name + ": " + buf +
+                           "no water found; floes cannot be separated without water between them, so each "
+                           "connected valid area is one floe (concentration 1)");
+    ice = seg.valid.clone();
+  } else {
+    seg.classes = "mixed";
+    ice = seg.valid & (gray > t);
+    const double sigma_px = o.illumination_scale_m / s;
+    cv::Mat g32;
+    gray.convertTo(g32, CV_32F);
+    for (int pass = 0; pass < 2; ++pass) {
+      const cv::Mat water = seg.valid & ~ice;
+      const cv::Mat wl = masked_smooth(gray, water, sigma_px, seg.water_grey);
+      const cv::Mat il = masked_smooth(gray, ice, sigma_px, seg.ice_grey);
+      // Local contrast floored at half the least contrast, so a patch with one class does not blow up.
+      cv::Mat den = cv::max(il - wl, 0.5 * o.min_contrast);
+      norm = (g32 - wl) / den;
+      ice = seg.valid & (norm > o.threshold_fraction);
+    }
+
+    // 3. Cleanup: melt ponds, opening, brash.
+    fill_small_holes(ice, seg.valid, o.max_hole_area_m2 / px_area);
+    const int rad = static_cast<int>(std::lround(o.opening_radius_m / s));
+    if (rad >= 1) {
+      const cv::Mat k = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * rad + 1, 2 * rad + 1));
+      cv::morphologyEx(ice, ice, cv::MORPH_OPEN, k);
+    }
+  }
+  {
+    cv::Mat comp, stats, cents;
+    const int n = cv::connectedComponentsWithStats(ice, comp, stats, cents, 4, CV_32S);
+    std::vector<char> keep(n, 0);
+    for (int k = 1; k < n; ++k) keep[k] = stats.at<int>(k, cv::CC_STAT_AREA) * px_area >= o.brash_cutoff_m2;
+    for (int r = 0; r < R; ++r)
+      for (int c = 0; c < C; ++c) ice.at<uint8_t>(r, c) = keep[comp.at<int>(r, c)] ? 255 : 0;
+  }
+
+  cv::Mat lab;
+  int max_label = 0;
+  if (seg.classes == "all_ice") {
+    max_label = cv::connectedComponents(ice, lab, 4, CV_32S) - 1;
+  } else {
+    // 4. Splitting touching floes. Two cues: the dark line between floes (the core mask, brighter than
+    //    core_fraction, loses it even where blur bridged the gap) and the neck of the outline (h-maxima of the
+    //    core's distance map). The flooding relief is the core distance inside the core and the normalised
+    //    brightness below it, so boundaries run along the darkest pixels between cores.
+    // The core is taken on a lightly smoothed brightness so sensor noise does not fragment it, and relative to
+    // the bright level of its own ice piece (95th percentile), so a darker floe has a core too.
+    cv::Mat norm_s;
+    cv::GaussianBlur(norm, norm_s, cv::Size(0, 0), 1.0);
+    cv::Mat piece;
+    const int n_pieces = cv::connectedComponents(ice, piece, 4, CV_32S);
+    std::vector<float> bright(n_pieces, 1.0f);
+    {
+      std::vector<std::vector<float>> values(n_pieces);
+      for (int r = 0; r < R; ++r)
+        for (int c = 0; c < C; ++c)
+          if (const int k = piece.at<int>(r, c)) values[k].push_back(norm_s.at<float>(r, c));
+      for (int k = 1; k < n_pieces; ++k) {
+        auto& v = values[k];
+        auto q = v.begin() + static_cast<long>(0.95 * (v.size() - 1));
+        std::nth_element(v.begin(), q, v.end());
+        bright[k] = std::min(1.0f, *q);  // never above the local ice level: a bright piece keeps the plain rule
+      }
+    }
+    cv::Mat core(R, C, CV_8U, cv::Scalar(0));
+    for (int r = 0; r < R; ++r)
+      for (int c = 0; c < C; ++c)
+        if (const int k = piece.at<int>(r, c))
+          core.at<uint8_t>(r, c) = norm_s.at<float>(r, c) > o.core_fraction * bright[k] ? 255 : 0;
+    fill_small_holes(core, seg.valid, o.max_hole_area_m2 / px_area);
+    cv::Mat dist;
+    cv::distanceTransform(core, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+    const float h = static_cast<float>(o.marker_dynamic_m / s);
+    cv::Mat rec = dist - h;
+    reconstruct_by_dilation(rec, dist, core);
+    // Regional maxima of the h-maxima transform (its plateaus with no higher neighbour): reconstruct it lowered
+    // by a small epsilon; the regional maxima are where it stays lowered.
+    const float eps = 1e-3f;
+    cv::Mat rec2 = rec - eps;
+    reconstruct_by_dilation(rec2, rec, core);
+    cv::Mat seeds = core & ((rec - rec2) > 0.5f * eps);
+    // An ice piece without core (a small floe) is seeded at its deepest pixel.
+    {
+      cv::Mat ice_dist;
+      cv::distanceTransform(ice, ice_dist, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+      std::vector<char> has_seed(n_pieces, 0);
+      std::vector<float> best(n_pieces, -1);
+      std::vector<cv::Point> where(n_pieces);
+      for (int r = 0; r < R; ++r)
+        for (int c = 0; c < C; ++c) {
+          const int k = piece.at<int>(r, c);
+          if (k == 0) continue;
+          if (seeds.at<uint8_t>(r, c)) has_seed[k] = 1;
+          if (ice_dist.at<float>(r, c) > best[k]) best[k] = ice_dist.at<float>(r, c), where[k] = cv::Point(c, r);
+        }
+      for (int k = 1; k < n_pieces; ++k)
+        if (!has_seed[k]) seeds.at<uint8_t>(where[k]) = 255;
+    }
+    cv::Mat relief = dist.clone();
+    for (int r = 0; r < R; ++r)
+      for (int c = 0; c < C; ++c)
+        if (ice.at<uint8_t>(r, c) && !core.at<uint8_t>(r, c))
+          relief.at<float>(r, c) = norm_s.at<float>(r, c) - 2.0f;  // below every core pixel (>= 1)
+    cv::Mat seed_lab;
+    const int n_seeds = cv::connectedComponents(seeds, seed_lab, 8, CV_32S) - 1;
+
+    // Seeds closer than the separation within one ice piece are one floe.
+    std::vector<cv::Point> top(n_seeds + 1, cv::Point(-1, -1));
+    std::vector<float> top_d(n_seeds + 1, -1);
+    for (int r = 0; r < R; ++r)
+      for (int c = 0; c < C; ++c) {
+        const int l = seed_lab.at<int>(r, c);
+        if (l > 0 && dist.at<float>(r, c) > top_d[l]) top_d[l] = dist.at<float>(r, c), top[l] = cv::Point(c, r);
+      }
+    UnionFind uf(n_seeds + 1);
+    const double sep_px = o.min_marker_separation_m / s;
+    if (sep_px > 0) {
+      std::vector<int> order(n_seeds);
+      std::iota(order.begin(), order.end(), 1);
+      std::sort(order.begin(), order.end(), [&](int a, int b) { return top[a].x < top[b].x || (top[a].x == top[b].x && a < b); });
+      for (size_t i = 0; i < order.size(); ++i)
+        for (size_t j = i + 1; j < order.size() && top[order[j]].x - top[order[i]].x < sep_px; ++j) {
+          const cv::Point d = top[order[j]] - top[order[i]];
+          if (std::hypot(d.x, d.y) < sep_px && piece.at<int>(top[order[i]]) == piece.at<int>(top[order[j]]))
+            uf.unite(order[i], order[j]);
+        }
+    }
+
+    // Watershed, then pieces rejoin a neighbour and the flooding is repeated: a piece below min_floe_area_m2
+    // joins the neighbour it shares the longest boundary with; two pieces whose shared boundary is not a neck
+    // (its highest core distance, the saddle, reaches neck_ratio of the smaller piece's deepest point) are one
+    // floe with a dent, not two floes. A boundary through the dark band between cores has saddle 0 and stays.
+    const double min_px = o.min_floe_area_m2 / px_area;
+    for (int iter = 0; iter < 8; ++iter) {
+      cv::Mat markers(R, C, CV_32S, cv::Scalar(0));
+      for (int r = 0; r < R; ++r)
+        for (int c = 0; c < C; ++c) {
+          const int l = seed_lab.at<int>(r, c);
+          if (l > 0) markers.at<int>(r, c) = uf.find(l);
+        }
+      lab = watershed_distance(markers, relief, ice);
+      std::vector<long long> area(n_seeds + 1, 0);
+      std::vector<float> depth(n_seeds + 1, 0.0f);
+      struct Shared {
+        int pixels = 0;
+        float saddle = 0;
+      };
+      std::map<std::pair<int, int>, Shared> shared;  // boundary pixels between two floods
+      for (int r = 0; r < R; ++r)
+        for (int c = 0; c < C; ++c) {
+          const int l = lab.at<int>(r, c);
+          if (l > 0) {
+            ++area[l];
+            depth[l] = std::max(depth[l], dist.at<float>(r, c));
+          }
+          if (l != -1) continue;
+          int found[8], nf = 0;
+          for (int k = 0; k < 8; ++k) {
+            const int rr = r + kDr[k], cc = c + kDc[k];
+            if (rr < 0 || cc < 0 || rr >= R || cc >= C) continue;
+            const int m = lab.at<int>(rr, cc);
+            if (m > 0 && std::find(found, found + nf, m) == found + nf) found[nf++] = m;
+          }
+          for (int a = 0; a < nf; ++a)
+            for (int b = a + 1; b < nf; ++b) {
+              Shared& sh = shared[{std::min(found[a], found[b]), std::max(found[a], found[b])}];
+              ++sh.pixels;
+              sh.saddle = std::max(sh.saddle, dist.at<float>(r, c));
+            }
+        }
+      std::vector<std::pair<int, int>> best(n_seeds + 1, {0, 0});  // (shared pixels, neighbour)
+      int merged = 0;
+      for (const auto& [pair, sh] : shared) {
+        const auto [a, b] = pair;
+        if (sh.pixels > best[a].first || (sh.pixels == best[a].first && b < best[a].second)) best[a] = {sh.pixels, b};
+        if (sh.pixels > best[b].first || (sh.pixels == best[b].first && a < best[b].second)) best[b] = {sh.pixels, a};
+        if (sh.saddle > 0 && sh.saddle >= o.neck_ratio * std::min(depth[a], depth[b])) merged += uf.unite(a, b);
+      }
+      for (int l = 1; l <= n_seeds; ++l)
+        if (area[l] > 0 && area[l] < min_px && best[l].second > 0) merged += uf.unite(l, best[l].second);
+      seg.merged_pieces += merged;
+      if (merged == 0) break;
+    }
+    lab.setTo(0, lab < 0);
+    max_label = n_seeds;
+    for (int l = 1; l <= n_seeds; ++l) seg.seeds += uf.find(l) == l;
+  }
+
+  // 5. Regions.
+  fill_region_holes(lab, max_label, seg.valid);
+  separate_regions(lab);
+  keep_largest_part(lab, max_label);
+  fill_region_holes(lab, max_label, seg.valid);
+  std::vector<long long> area(max_label + 1, 0);
+  for (int r = 0; r < R; ++r)
+    for (int c = 0; c < C; ++c)
+      if (lab.at<int>(r, c) > 0) ++area[lab.at<int>(r, c)];
+  const double min_px = o.min_floe_area_m2 / px_area;
+  std::vector<int> renum(max_label + 1, 0);
+  int next = 0;
+  for (int r = 0; r < R; ++r) {
+    int* p = lab.ptr<int>(r);
+    for (int c = 0; c < C; ++c) {
+      const int l = p[c];
+      if (l <= 0) continue;
+      if (area[l] < min_px) {
+        p[c] = 0;
+        continue;
+      }
+      if (renum[l] == 0) renum[l] = ++next;
+      p[c] = renum[l];
+    }
+  }
+  seg.labels = lab;
+  seg.floes = next;
+  if (seg.classes == "mixed" && next == 0)
+    seg.warnings.push_back(name + ": no floe larger than min_floe_area_m2 = " + std::to_string(o.min_floe_area_m2) +
+                           " m^2 was found; the result has no floes");
+  return seg;
+}
+
+}  // namespace floesim::imaging

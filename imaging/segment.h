@@ -1,0 +1,55 @@
+// Digitise's image processing: from an 8-bit grayscale photograph to a label image of floes.
+//
+//   1. no data: pure black (0) pixels are outside the camera footprint - never ice, not part of the valid area.
+//   2. ice/water: Otsu on the valid pixels gives a first split; the smooth local water and ice brightness
+//      (masked Gaussian averages at illumination_scale_m) then normalise the image, which removes illumination
+//      gradients, and ice is where the normalised brightness exceeds threshold_fraction (twice, refining the
+//      split). An image whose classes differ by less than min_contrast is one class: all ice or no ice.
+//   3. cleanup: enclosed water up to max_hole_area_m2 is filled (melt ponds), a morphological opening of
+//      opening_radius_m removes thin bridges and specks, connected pieces below brash_cutoff_m2 are dropped.
+//   4. splitting of touching floes: Euclidean distance transform; seeds are its h-maxima with
+//      h = marker_dynamic_m (a bump must rise that much to be a floe of its own), seeds closer than
+//      min_marker_separation_m within one piece merged; marker-based watershed flooding from the seeds
+//      (highest distance first) with one-pixel boundaries; pieces below min_floe_area_m2 rejoin the neighbour
+//      they share the longest boundary with and the flooding is repeated.
+//   5. regions: holes of each region filled (a region enclosed by another joins it), each region reduced to its
+//      largest 4-connected part, regions never 8-adjacent, lone regions below min_floe_area_m2 dropped,
+//      numbered 1..N in raster order of their first pixel.
+#pragma once
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "imaging/digitise_options.h"
+
+namespace floesim::imaging {
+
+struct Segmentation {
+  cv::Mat labels;            // CV_32S: 0 = no floe, k = floe k (see step 5 for the guarantees)
+  int floes = 0;
+  cv::Mat valid;             // CV_8U, 255 where the pixel is data (non-zero)
+  long long valid_pixels = 0;
+  std::string classes;       // "mixed", "no_ice" or "all_ice"
+  double otsu_threshold = 0; // first global split (grey level)
+  double water_grey = 0, ice_grey = 0;  // mean grey levels of the two classes (first split)
+  int seeds = 0;             // watershed seeds after merging close ones
+  int merged_pieces = 0;     // split pieces below min_floe_area_m2 merged into a neighbour
+  std::vector<std::string> warnings;
+};
+
+// `name` is used in messages (the image file). Throws floesim::Error if the image holds no valid pixel.
+Segmentation segment_floes(const cv::Mat& gray, double metres_per_pixel, const DigitiseOptions& o,
+                           const std::string& name);
+
+// Morphological reconstruction by dilation of `marker` under `mask` (both CV_32F, marker <= mask), restricted to
+// the non-zero pixels of `domain` (8-connectivity; Vincent's hybrid raster/queue algorithm). In place.
+void reconstruct_by_dilation(cv::Mat& marker, const cv::Mat& mask, const cv::Mat& domain);
+
+// Marker-controlled watershed of `relief` (CV_32F, e.g. a distance map) inside `domain`: floods from the
+// markers (CV_32S, > 0) in order of decreasing relief (quantised to 1/16 unit; FIFO within a level); returns
+// CV_32S labels with -1 on the one-pixel boundaries, 0 outside the domain. Two different labels are never
+// 8-adjacent.
+cv::Mat watershed_distance(const cv::Mat& markers, const cv::Mat& relief, const cv::Mat& domain);
+
+}  // namespace floesim::imaging
