@@ -12,6 +12,7 @@
 
 #include <Eigen/Geometry>
 #include <assimp/Importer.hpp>
+#include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
@@ -513,53 +514,162 @@ struct Body {
   std::string notes;  // topology repairs, for the report
 };
 
-// Cuts a closed mesh into `n` slabs along x and returns the convex hull of each slab's piece: the mesh vertices
-// inside the slab plus the cross-section points where edges cross its two planes. Adjacent hulls share their
-// cross-section exactly (the crossing points are computed once per plane), so they meet without gap or overlap.
-std::vector<TriMesh> slice_convex(const TriMesh& m, int n) {
-  const Bounds b(m.vertices);
-  const double x0 = b.lo.x(), x1 = b.hi.x();
-  std::vector<double> plane(n + 1);
-  for (int k = 0; k <= n; ++k) plane[k] = k == n ? x1 : x0 + (x1 - x0) * k / n;
-  std::set<std::pair<int, int>> edges;
-  for (const auto& t : m.triangles)
-    for (int k = 0; k < 3; ++k) edges.insert({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])});
-  std::vector<std::vector<Vec3>> section(n + 1);
-  for (const auto& [i, j] : edges) {
-    const Vec3 &a = m.vertices[i], &c = m.vertices[j];
-    const double lo = std::min(a.x(), c.x()), hi = std::max(a.x(), c.x());
-    // Planes strictly between the ends (a vertex on a plane belongs to both slabs anyway).
-    const int k0 = static_cast<int>(std::upper_bound(plane.begin(), plane.end(), lo) - plane.begin());
-    for (int k = k0; k <= n && plane[k] < hi; ++k) {
-      Vec3 p = a + (c - a) * ((plane[k] - a.x()) / (c.x() - a.x()));
-      p.x() = plane[k];
-      section[k].push_back(p);
+// Sutherland-Hodgman step: keeps the part of `poly` with sign * (p[axis] - value) >= 0. A crossing point is
+// interpolated from the lexicographically smaller end of its edge, so neighbouring cells cut the same edge into the
+// same point.
+void clip_polygon(std::vector<Vec3>& poly, int axis, double value, double sign) {
+  if (poly.empty()) return;
+  std::vector<Vec3> out;
+  const size_t n = poly.size();
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3& p = poly[i];
+    const Vec3& q = poly[(i + 1) % n];
+    const double dp = sign * (p[axis] - value), dq = sign * (q[axis] - value);
+    if (dp >= 0) out.push_back(p);
+    if ((dp > 0 && dq < 0) || (dp < 0 && dq > 0)) {
+      const bool p_first = std::lexicographical_compare(p.data(), p.data() + 3, q.data(), q.data() + 3);
+      const Vec3& a = p_first ? p : q;
+      const Vec3& c = p_first ? q : p;
+      Vec3 x = a + (c - a) * ((value - a[axis]) / (c[axis] - a[axis]));
+      x[axis] = value;
+      out.push_back(x);
     }
   }
-  std::vector<std::vector<Vec3>> slab(n);
-  for (int k = 0; k < n; ++k) {
-    slab[k] = section[k];
-    slab[k].insert(slab[k].end(), section[k + 1].begin(), section[k + 1].end());
+  poly.swap(out);
+}
+
+// Volume of the closed mesh where x < x0: the triangles clipped to that half-space, summed as signed tetrahedra
+// with their apex on the plane x = x0, where the cap lies (so the cap adds nothing).
+double volume_behind(const TriMesh& m, double x0, const Vec3& centre) {
+  const Vec3 ref(x0, centre.y(), centre.z());
+  double v6 = 0;
+  std::vector<Vec3> poly;
+  for (const auto& t : m.triangles) {
+    poly = {m.vertices[t[0]], m.vertices[t[1]], m.vertices[t[2]]};
+    clip_polygon(poly, 0, x0, -1.0);
+    for (size_t k = 1; k + 1 < poly.size(); ++k)
+      v6 += (poly[0] - ref).dot((poly[k] - ref).cross(poly[k + 1] - ref));
   }
-  for (const Vec3& v : m.vertices) {
-    const int k = static_cast<int>(std::upper_bound(plane.begin(), plane.end(), v.x()) - plane.begin()) - 1;
-    const int kk = std::clamp(k, 0, n - 1);
-    slab[kk].push_back(v);
-    if (v.x() == plane[kk] && kk > 0) slab[kk - 1].push_back(v);  // on a plane: both neighbours
+  return v6 / 6.0;
+}
+
+// The points whose convex hull is the hull of (solid inside the cell x in [a, b], z in [c, d]): every vertex of
+// the mesh's triangles clipped to the cell (mesh vertices inside it, edges crossing its planes, triangles crossing
+// its edge lines). Sorted and unique.
+std::vector<Vec3> cell_points(const TriMesh& m, const std::vector<int>& tris, double a, double b, double c, double d) {
+  std::vector<Vec3> pts, poly;
+  for (int i : tris) {
+    const auto& t = m.triangles[i];
+    poly = {m.vertices[t[0]], m.vertices[t[1]], m.vertices[t[2]]};
+    clip_polygon(poly, 0, a, 1.0);
+    clip_polygon(poly, 0, b, -1.0);
+    clip_polygon(poly, 2, c, 1.0);
+    clip_polygon(poly, 2, d, -1.0);
+    pts.insert(pts.end(), poly.begin(), poly.end());
   }
+  auto less = [](const Vec3& p, const Vec3& q) {
+    return std::lexicographical_compare(p.data(), p.data() + 3, q.data(), q.data() + 3);
+  };
+  std::sort(pts.begin(), pts.end(), less);
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  return pts;
+}
+
+// Convex hull of a cell's points, or nothing if the cell holds no volume (a gap in the mesh along x or z).
+bool cell_hull(const std::vector<Vec3>& pts, double size, TriMesh& out) {
+  if (pts.size() < 4) return false;
+  const Bounds cb(pts);
+  if ((cb.hi - cb.lo).minCoeff() <= 1e-9 * size) return false;
+  out = convex_hull(pts);
+  return true;
+}
+
+struct Sliced {
   std::vector<TriMesh> parts;
-  for (int k = 0; k < n; ++k) {
-    if (slab[k].size() < 4) continue;
-    const Bounds sb(slab[k]);
-    // A slab holding material only in one plane (a gap in the mesh along x) has no volume.
-    if (sb.hi.x() - sb.lo.x() <= 1e-9 * b.diagonal()) continue;
-    try {
-      parts.push_back(convex_hull(slab[k]));
-    } catch (const Error& e) {
-      throw Error("slab " + std::to_string(k + 1) + " of " + std::to_string(n) + ": " + e.what());
-    }
+  int layered_sections = 0;  // sections also cut horizontally
+  int max_layers = 1;
+  int merges = 0;            // neighbouring sections merged into one part
+};
+
+// Cuts a closed mesh into `n` sections along x and takes the convex hull of each. A section whose hull adds more
+// than `target` of its own volume (a bulbous bow, a skeg, flare over a narrow waterline: a concave cross-section)
+// is also cut by horizontal planes into 2, 4 or 8 layers, whichever first meets the target (else the best), with
+// one hull per cell. Cells share their cutting planes, so their hulls meet without overlapping. Then neighbouring
+// uncut sections are merged while the hull of both adds less than `merge` of their volume (a parallel middle body
+// needs no cuts), which keeps the part count, and so the contact work, down.
+Sliced slice_convex(const TriMesh& m, int n, double target, double merge) {
+  const Bounds b(m.vertices);
+  const double size = b.diagonal();
+  const Vec3 centre = 0.5 * (b.lo + b.hi);
+  std::vector<double> plane(n + 1);
+  for (int k = 0; k <= n; ++k) plane[k] = k == n ? b.hi.x() : b.lo.x() + (b.hi.x() - b.lo.x()) * k / n;
+  std::vector<double> behind(n + 1);
+  behind[0] = 0;
+  behind[n] = mass_properties(m).volume;
+  for (int k = 1; k < n; ++k) behind[k] = volume_behind(m, plane[k], centre);
+  // Triangles by section (those whose x range meets the section's).
+  std::vector<std::vector<int>> tris(n);
+  for (int i = 0; i < static_cast<int>(m.triangles.size()); ++i) {
+    const auto& t = m.triangles[i];
+    const double lo = std::min({m.vertices[t[0]].x(), m.vertices[t[1]].x(), m.vertices[t[2]].x()});
+    const double hi = std::max({m.vertices[t[0]].x(), m.vertices[t[1]].x(), m.vertices[t[2]].x()});
+    for (int k = 0; k < n; ++k)
+      if (hi >= plane[k] && lo <= plane[k + 1]) tris[k].push_back(i);
   }
-  return parts;
+  const double inf = std::numeric_limits<double>::infinity();
+  Sliced out;
+  bool open_run = false;  // the last part is an uncut section that the next may merge into
+  for (int k = 0; k < n; ++k) {
+    const double truth = behind[k + 1] - behind[k];
+    const std::vector<Vec3> pts = cell_points(m, tris[k], plane[k], plane[k + 1], -inf, inf);
+    TriMesh whole;
+    if (!cell_hull(pts, size, whole)) {
+      open_run = false;
+      continue;
+    }
+    std::vector<TriMesh> best{whole};
+    double best_excess = mass_properties(whole).volume - truth;
+    int best_layers = 1;
+    if (best_excess > target * truth) {
+      const Bounds sb(pts);
+      for (int layers : {2, 4, 8}) {
+        std::vector<TriMesh> cells;
+        double v = 0;
+        for (int j = 0; j < layers; ++j) {
+          const double c = j == 0 ? -inf : sb.lo.z() + (sb.hi.z() - sb.lo.z()) * j / layers;
+          const double d = j == layers - 1 ? inf : sb.lo.z() + (sb.hi.z() - sb.lo.z()) * (j + 1) / layers;
+          TriMesh cell;
+          if (!cell_hull(cell_points(m, tris[k], plane[k], plane[k + 1], c, d), size, cell)) continue;
+          v += mass_properties(cell).volume;
+          cells.push_back(std::move(cell));
+        }
+        if (v - truth < best_excess) best = std::move(cells), best_excess = v - truth, best_layers = layers;
+        if (best_excess <= target * truth) break;
+      }
+    }
+    if (best_layers > 1) {
+      ++out.layered_sections, out.max_layers = std::max(out.max_layers, best_layers);
+      for (TriMesh& p : best) out.parts.push_back(std::move(p));
+      open_run = false;
+      continue;
+    }
+    // Uncut section: merge into the previous part if that is an uncut section too and the union stays convex.
+    if (open_run) {
+      TriMesh& last = out.parts.back();
+      std::vector<Vec3> both = last.vertices;
+      both.insert(both.end(), whole.vertices.begin(), whole.vertices.end());
+      TriMesh merged = convex_hull(both);
+      const double v_sep = mass_properties(last).volume + mass_properties(whole).volume;
+      if (mass_properties(merged).volume - v_sep <= merge * v_sep) {
+        last = std::move(merged);
+        ++out.merges;
+        continue;
+      }
+    }
+    out.parts.push_back(std::move(whole));
+    open_run = true;
+  }
+  return out;
 }
 
 std::string percent(double f) {
@@ -570,6 +680,11 @@ std::string percent(double f) {
 
 }  // namespace
 
+// A section whose convex hull adds more than this fraction of its volume is also cut horizontally.
+constexpr double kSectionExcessTarget = 0.02;
+// Neighbouring sections are merged into one part while the hull of both adds less than this fraction.
+constexpr double kMergeExcess = 0.001;
+
 HullModel load_hull(const fs::path& file, const HullLoadOptions& o) {
   const std::string where = file.string();
   FLOESIM_REQUIRE(fs::exists(file), where, ": hull file not found");
@@ -579,6 +694,10 @@ HullModel load_hull(const fs::path& file, const HullLoadOptions& o) {
   FLOESIM_REQUIRE(o.slices >= 2, where, ": slices must be >= 2, got ", o.slices);
 
   Assimp::Importer importer;
+  // Our world is z-up like most CAD exports. assimp would turn a Collada file declaring Z_UP into its own y-up
+  // convention with a root rotation; keep the file's axes instead. (glTF is y-up by definition: such a hull must
+  // be exported z-up.)
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
   // Triangulate n-gons; join identical vertices. No PreTransformVertices: node transforms are applied below, so
   // a mesh instanced twice stays two parts.
   const aiScene* scene = importer.ReadFile(where, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
@@ -683,6 +802,21 @@ HullModel load_hull(const fs::path& file, const HullLoadOptions& o) {
     bodies.push_back(std::move(body));
   }
 
+  {  // where meshes meet (the KCS rudder on its hull): edges shared by more than two triangles of the whole file
+    Instance all;
+    for (const Instance& in : instances) {
+      const int off = static_cast<int>(all.v.size());
+      all.v.insert(all.v.end(), in.v.begin(), in.v.end());
+      for (const auto& t : in.t) all.t.push_back({t[0] + off, t[1] + off, t[2] + off});
+    }
+    int within = 0;
+    for (const Body& body : bodies) within += topology(body.mesh).non_manifold_edges;
+    const int total = topology(weld(all.v, all.t)).non_manifold_edges;
+    if (instances.size() > 1 && total > within)
+      report << "meshes touch each other along " << total - within
+             << " non-manifold edges (accepted: each body above is closed on its own)\n";
+  }
+
   HullModel model;
   for (Body& body : bodies) {
     const Bounds bb(body.mesh.vertices);
@@ -711,28 +845,34 @@ HullModel load_hull(const fs::path& file, const HullLoadOptions& o) {
                       "' is not convex (a vertex lies more than ", fmt_num(tol),
                       " m outside the plane of a face); set \"non_convex\": \"slice\" to cut it into convex sections"
                       " along x, or split it into convex meshes (one per object) yourself");
-      std::vector<TriMesh> pieces;
+      Sliced sliced;
       try {
-        pieces = slice_convex(body.mesh, o.slices);
+        sliced = slice_convex(body.mesh, o.slices, kSectionExcessTarget, kMergeExcess);
       } catch (const Error& e) {
         throw Error(where + ": mesh '" + body.name + "': slicing into convex parts failed: " + e.what());
       }
+      std::vector<TriMesh>& pieces = sliced.parts;
       double v = 0;
       for (const TriMesh& p : pieces) v += mass_properties(p).volume;
       const double err = (v - mp.volume) / mp.volume;
       FLOESIM_REQUIRE(std::abs(err) <= o.max_volume_error, where, ": mesh '", body.name, "' is not convex and its ",
-                      pieces.size(), " convex slices change its volume by ", percent(err), " (", fmt_num(mp.volume),
+                      pieces.size(), " convex parts change its volume by ", percent(err), " (", fmt_num(mp.volume),
                       " -> ", fmt_num(v), " m^3), more than max_volume_error = ", o.max_volume_error,
                       "; raise \"slices\" or split the mesh into convex meshes (one per object) yourself");
-      line << "not convex: sliced along x into " << pieces.size() << " convex parts, volume " << fmt_num(v)
-           << " m^3 (" << percent(err) << ")";
+      line << "not convex: cut into " << o.slices << " sections along x";
+      if (sliced.layered_sections > 0)
+        line << " (" << sliced.layered_sections << " of them also into up to " << sliced.max_layers
+             << " horizontal layers)";
+      if (sliced.merges > 0) line << ", " << sliced.merges << " neighbouring sections merged";
+      line << ", " << pieces.size() << " convex part" << (pieces.size() == 1 ? "" : "s") << ", volume " << fmt_num(v) << " m^3 (" << percent(err) << ")";
       model.parts_volume_m3 += v;
       for (TriMesh& p : pieces) model.parts.push_back(std::move(p));
     }
     report << line.str() << "\n";
   }
   model.surface = merge(model.parts);
-  report << "total: " << model.parts.size() << " convex parts, mesh volume " << fmt_num(model.mesh_volume_m3)
+  report << "total: " << model.parts.size() << " convex part" << (model.parts.size() == 1 ? "" : "s")
+         << ", mesh volume " << fmt_num(model.mesh_volume_m3)
          << " m^3, parts volume " << fmt_num(model.parts_volume_m3) << " m^3 ("
          << percent((model.parts_volume_m3 - model.mesh_volume_m3) / model.mesh_volume_m3) << ")\n";
   model.report = report.str();

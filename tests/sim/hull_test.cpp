@@ -200,37 +200,104 @@ TEST(LoadHull, InwardFacingConvexMeshIsFlipped) {
   fs::remove_all(dir);
 }
 
+TEST(LoadHull, NodeTransformsPlaceTheMeshes) {
+  // Collada with two instances of a unit cube: one translated, one mirrored and stretched (determinant < 0, which
+  // would turn the triangles inside out unless the loader reverses them). Z_UP is kept as the file says.
+  const fs::path dir = temp_dir("dae");
+  const fs::path dae = dir / "cubes.dae";
+  std::ofstream(dae) << R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="meter" meter="1"/><up_axis>Z_UP</up_axis></asset>
+  <library_geometries><geometry id="cube" name="cube"><mesh>
+    <source id="pos"><float_array id="pos-array" count="24">0 0 0 1 0 0 0 1 0 1 1 0 0 0 1 1 0 1 0 1 1 1 1 1</float_array>
+      <technique_common><accessor source="#pos-array" count="8" stride="3">
+        <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/></accessor>
+      </technique_common></source>
+    <vertices id="vtx"><input semantic="POSITION" source="#pos"/></vertices>
+    <triangles count="12"><input semantic="VERTEX" source="#vtx" offset="0"/>
+      <p>0 2 3 0 3 1 4 5 7 4 7 6 0 1 5 0 5 4 2 6 7 2 7 3 0 4 6 0 6 2 1 3 7 1 7 5</p></triangles>
+  </mesh></geometry></library_geometries>
+  <library_visual_scenes><visual_scene id="scene">
+    <node id="moved" name="moved"><matrix>1 0 0 10 0 1 0 20 0 0 1 -3 0 0 0 1</matrix>
+      <instance_geometry url="#cube"/></node>
+    <node id="mirrored" name="mirrored"><matrix>-2 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1</matrix>
+      <instance_geometry url="#cube"/></node>
+  </visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#scene"/></scene>
+</COLLADA>
+)";
+  const HullModel m = load_hull(dae);
+  ASSERT_EQ(m.parts.size(), 2u) << m.report;
+  const MassProperties a = mass_properties(m.parts[0]), b = mass_properties(m.parts[1]);
+  EXPECT_NEAR(a.volume, 1.0, 1e-9);
+  EXPECT_NEAR((a.centroid - Vec3(10.5, 20.5, -2.5)).norm(), 0, 1e-9);
+  EXPECT_NEAR(b.volume, 2.0, 1e-9);
+  EXPECT_NEAR((b.centroid - Vec3(-1.0, 0.5, 0.5)).norm(), 0, 1e-9);
+  EXPECT_EQ(m.report.find("flipped"), std::string::npos) << m.report;
+  fs::remove_all(dir);
+}
+
 // ---- the real benchmark hulls (model scale, waterline at z = 0, not convex) ----
+
+// The file's own faces (fan-triangulated), for a reference independent of assimp and of the loader.
+TriMesh read_obj_faces(const fs::path& f) {
+  TriMesh m;
+  std::ifstream in(f);
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream s(line);
+    std::string tag;
+    s >> tag;
+    if (tag == "v") {
+      double x, y, z;
+      s >> x >> y >> z;
+      m.vertices.emplace_back(x, y, z);
+    } else if (tag == "f") {
+      std::vector<int> f;
+      for (std::string w; s >> w;) f.push_back(std::stoi(w) - 1);  // "i", "i/t" or "i/t/n": stoi stops at '/'
+      for (size_t k = 1; k + 1 < f.size(); ++k) m.triangles.push_back({f[0], f[k], f[k + 1]});
+    }
+  }
+  return m;
+}
 
 struct RealHull {
   const char* file;
-  double published_volume_m3;  // displacement volume at the design draught, model scale
+  double published_volume_m3;  // displacement volume at the design draught (model scale, published)
 };
 
-void check_real_hull(const RealHull& r, double max_volume_error, double max_displacement_error) {
+void check_real_hull(const RealHull& r) {
   const fs::path f = hull_file(r.file);
-  // Reference: displaced volume of the raw mesh (all of the file's faces, welded) below z = 0.
+  const TriMesh raw = read_obj_faces(f);
+  const double raw_volume = mass_properties(raw).volume;
+  const double raw_displaced = submerged_part(raw.vertices, raw.triangles, 0.0).volume;
+  // The benchmark geometry itself matches the published displacement (checks the reading and the clipping).
+  EXPECT_NEAR(raw_displaced, r.published_volume_m3, 0.01 * r.published_volume_m3);
+
   const HullModel m = load_hull(f, HullLoadOptions{"slice", 24, 0.05});
   std::cout << r.file << ":\n" << m.report;
   ASSERT_GT(m.parts.size(), 10u);
   for (const TriMesh& p : m.parts) ASSERT_TRUE(is_convex(p, 1e-6));
+  EXPECT_NEAR(m.mesh_volume_m3, raw_volume, 1e-6 * raw_volume);
+  // Hulls of slices can only add volume; horizontal cuts of the concave sections keep it small.
   const double verr = (m.parts_volume_m3 - m.mesh_volume_m3) / m.mesh_volume_m3;
-  EXPECT_GE(verr, 0) << "convex hulls of slices can only add volume";
-  EXPECT_LT(verr, max_volume_error);
-
-  // The raw mesh's displacement, independently of the loader: clip the file's own triangles.
-  // (load_hull with every mesh kept would be circular; the slices are what the simulator sees.)
-  const Hydrostatics parts = hydrostatics(m.parts, 1000.0, 0.0);
-  std::cout << "  displaced volume of the convex parts: " << parts.volume_m3 << " m^3 (published "
-            << r.published_volume_m3 << " m^3)\n";
-  EXPECT_NEAR(parts.volume_m3, r.published_volume_m3, max_displacement_error * r.published_volume_m3);
+  EXPECT_GE(verr, 0);
+  EXPECT_LT(verr, 0.02);
+  // What the simulator floats: the parts clipped at the waterline.
+  const Hydrostatics h = hydrostatics(m.parts, 1000.0, 0.0);
+  std::cout << "  displaced volume: raw mesh " << raw_displaced << " m^3, convex parts " << h.volume_m3
+            << " m^3, published " << r.published_volume_m3 << " m^3\n";
+  EXPECT_GE(h.volume_m3, raw_displaced * (1 - 1e-9));
+  EXPECT_LT(h.volume_m3, raw_displaced * 1.02);
+  // The surface (all parts merged) floats the same volume.
+  EXPECT_NEAR(submerged_part(m.surface.vertices, m.surface.triangles, 0.0).volume, h.volume_m3,
+              1e-9 * h.volume_m3);
 }
 
-TEST(LoadHull, KcsSlicedIntoConvexParts) { check_real_hull({"KCS_model_scale_L7.2786m.obj", 1.6490}, 0.03, 0.03); }
+// KCS model (scale 1:31.6): Lpp 7.2786 m, T 0.3418 m, displacement volume 1.6490 m^3 (SIMMAN / Tokyo 2015).
+TEST(LoadHull, KcsSlicedIntoConvexParts) { check_real_hull({"KCS_model_scale_L7.2786m.obj", 1.6490}); }
 
-TEST(LoadHull, Dtmb5415SlicedIntoConvexParts) {
-  check_real_hull({"DTMB5415_model_scale_L5.72m.obj", 0.549}, 0.03, 0.03);
-}
+// DTMB 5415 model (INSEAN 2340, scale 1:24.83): Lpp 5.72 m, T 0.248 m, displacement volume 0.549 m^3 (SIMMAN 2008).
+TEST(LoadHull, Dtmb5415SlicedIntoConvexParts) { check_real_hull({"DTMB5415_model_scale_L5.72m.obj", 0.549}); }
 
 TEST(LoadHull, RefuseNamesTheFile) {
   const fs::path f = hull_file("KCS_model_scale_L7.2786m.obj");
