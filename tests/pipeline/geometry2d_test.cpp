@@ -90,6 +90,7 @@ TEST(ConvexDecompose, RandomStarShapedPolygons) {
   // like digitised outlines.
   std::mt19937_64 rng(20240611);
   std::uniform_real_distribution<double> U(0, 1);
+  int tested[3] = {0, 0, 0};  // plain, collinear midpoints, staircase
   for (int k = 0; k < 1000; ++k) {
     const int n = 10 + static_cast<int>(U(rng) * 190);
     Polygon p;
@@ -104,20 +105,28 @@ TEST(ConvexDecompose, RandomStarShapedPolygons) {
         if (i % 2 == 0) q.push_back(0.5 * (p[i] + p[(i + 1) % n]));
       }
       p = q;
-    } else if (k % 3 == 2) {  // staircase on a 0.5 m grid (pixel contour)
-      Polygon q;
-      for (int i = 0; i < n; ++i) {
-        const Vec2 a = (p[i] * 2).array().round() / 2, b = (p[(i + 1) % n] * 2).array().round() / 2;
-        q.push_back(a);
-        q.emplace_back(b.x(), a.y());
-      }
-      p = clean_polygon(q, 0);  // drop repeats only
-      if (p.size() < 3 || find_self_intersection(p).first != -1 || signed_area(p) <= 0) continue;
+    } else if (k % 3 == 2) {
+      // Pixel-contour-like: an x-monotone orthogonal polygon (column skylines above and below a baseline) on a
+      // 1.1794 m grid; equal neighbouring columns leave collinear vertices.
+      const int cols = 5 + n / 4;
+      std::uniform_int_distribution<int> H(1, 12);
+      std::vector<int> top(cols), bot(cols);
+      for (int i = 0; i < cols; ++i) top[i] = H(rng), bot[i] = -H(rng);
+      const double g = 1.1794;
+      p.clear();
+      for (int i = 0; i < cols; ++i) p.emplace_back(100 + g * i, -50 + g * bot[i]), p.emplace_back(100 + g * (i + 1), -50 + g * bot[i]);
+      for (int i = cols - 1; i >= 0; --i) p.emplace_back(100 + g * (i + 1), -50 + g * top[i]), p.emplace_back(100 + g * i, -50 + g * top[i]);
+      Polygon q;  // drop the repeated corner where neighbouring columns are equal; keep the collinear vertices
+      for (const Vec2& v : p)
+        if (q.empty() || v != q.back()) q.push_back(v);
+      p = q;
     }
     ASSERT_EQ(find_self_intersection(p).first, -1);
     check_decomposition(p, "random polygon " + std::to_string(k));
+    ++tested[k % 3];
     if (HasFailure()) return;
   }
+  for (int kind = 0; kind < 3; ++kind) EXPECT_GT(tested[kind], 250) << "kind " << kind;
 }
 
 TEST(ConvexDecompose, RealDigitisedFloes) {

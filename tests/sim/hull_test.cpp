@@ -55,6 +55,36 @@ Waterline waterline(const std::vector<TriMesh>& parts) {
   return w;
 }
 
+// Box [x0, x1] x [-b/2, b/2] x [-T, D - T] as a closed mesh (outward triangles).
+TriMesh box(double x0, double x1, double b, double T, double D) {
+  TriMesh m;
+  for (int i = 0; i < 8; ++i)
+    m.vertices.emplace_back(i & 1 ? x1 : x0, i & 2 ? b / 2 : -b / 2, i & 4 ? D - T : -T);
+  const int q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : q) {
+    m.triangles.push_back({f[0], f[1], f[2]});
+    m.triangles.push_back({f[0], f[2], f[3]});
+  }
+  return m;
+}
+
+TEST(Hydrostatics, BargeOfTwoBoxesClosedForm) {
+  // A 10 x 4 barge floating 1.5 m deep in 2 m depth, as two 5 m boxes sharing a face: the shared face is not
+  // wetted. V = 60, WP = 40, S = bottom 40 + sides 2 * (10 + 4) * 1.5 = 82, KB = 0.75, LCB at the middle.
+  const std::vector<TriMesh> parts{box(-5, 0, 4, 1.5, 2), box(0, 5, 4, 1.5, 2)};
+  const Hydrostatics h = hydrostatics(parts, 1025.0, 0.0);
+  EXPECT_NEAR(h.volume_m3, 60.0, 1e-9);
+  EXPECT_NEAR(h.displacement_t, 61.5, 1e-9);
+  EXPECT_NEAR(h.waterplane_area_m2, 40.0, 1e-9);
+  EXPECT_NEAR(h.wetted_surface_m2, 82.0, 1e-9);
+  EXPECT_NEAR(h.kb_m, 0.75, 1e-9);
+  EXPECT_NEAR(h.lcb_m, 0.0, 1e-9);
+  EXPECT_NEAR(h.length_wl_m, 10.0, 1e-9);
+  EXPECT_NEAR(h.beam_wl_m, 4.0, 1e-9);
+  EXPECT_NEAR(h.draught_m, 1.5, 1e-9);
+  EXPECT_NEAR(h.block_coefficient, 1.0, 1e-9);
+}
+
 TEST(GeneratedHull, MainParticularsAndDisplacement) {
   const HullGeneratorOptions o;
   const std::vector<TriMesh> parts = generate_hull(o);
