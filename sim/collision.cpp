@@ -57,12 +57,15 @@ struct CollisionWorld::Impl {
   std::vector<std::shared_ptr<fcl::Convexd>> shapes;
   std::vector<std::unique_ptr<PartObject>> objects;
   std::vector<PartWorld> world;
-  fcl::DynamicAABBTreeCollisionManagerd manager;
+  // Two trees (Box2D's static/dynamic split): parts of sleeping bodies do not move and are never paired with each
+  // other, so the per-step cost scales with the awake bodies: awake x awake and awake x sleeping.
+  fcl::DynamicAABBTreeCollisionManagerd awake_tree, sleeping_tree;
+  std::vector<uint8_t> in_awake_tree;  // per body
+  std::vector<fcl::CollisionObjectd*> moved_awake, moved_sleeping;
   std::vector<PairCandidate> pairs;
   const State* state = nullptr;  // during find_contacts (the broad-phase callback reads the awake flags)
   ThreadPool& pool;
   std::vector<Scratch> scratch;
-  std::vector<fcl::CollisionObjectd*> moved_objects;
 
   Impl(const Model& m, ThreadPool& p) : model(m), pool(p), scratch(p.threads()) {}
 
@@ -90,6 +93,9 @@ struct CollisionWorld::Impl {
     int b1 = self->model.parts[p1].body, b2 = self->model.parts[p2].body;
     if (b1 == b2) return false;
     if (!self->state->awake[b1] && !self->state->awake[b2]) return false;
+    // The tree keeps a leaf's old box while the new one fits inside it (FCL's HierarchyTree::update), so its pairs
+    // depend on the history; the exact boxes make the candidate set a function of the current poses only.
+    if (!o1->getAABB().overlap(o2->getAABB())) return false;
     PairCandidate c = b1 < b2 ? PairCandidate{b1, p1, b2, p2} : PairCandidate{b2, p2, b1, p1};
     self->pairs.push_back(c);
     return false;  // keep going
@@ -266,7 +272,6 @@ CollisionWorld::CollisionWorld(const Model& model, const State& state, ThreadPoo
   m.shapes.resize(np);
   m.objects.resize(np);
   m.world.resize(np);
-  std::vector<fcl::CollisionObjectd*> all;
   for (size_t p = 0; p < np; ++p) {
     const ConvexPart& cp = model.parts[p];
     auto verts = std::make_shared<std::vector<Vec3>>(cp.vertices);
@@ -282,25 +287,48 @@ CollisionWorld::CollisionWorld(const Model& model, const State& state, ThreadPoo
     m.world[p].n.resize(cp.faces.size());
     m.world[p].d.resize(cp.faces.size());
     m.place_part(static_cast<int>(p), state.position[cp.body], state.orientation[cp.body]);
-    all.push_back(m.objects[p].get());
   }
-  m.manager.registerObjects(all);
-  m.manager.setup();
+  m.in_awake_tree.assign(model.bodies.size(), 0);
+  std::vector<fcl::CollisionObjectd*> awake, sleeping;
+  for (size_t b = 0; b < model.bodies.size(); ++b) {
+    const Body& body = model.bodies[b];
+    m.in_awake_tree[b] = state.awake[b];
+    for (int p = body.first_part; p < body.first_part + body.part_count; ++p)
+      (state.awake[b] ? awake : sleeping).push_back(m.objects[p].get());
+  }
+  m.awake_tree.registerObjects(awake);
+  m.awake_tree.setup();
+  m.sleeping_tree.registerObjects(sleeping);
+  m.sleeping_tree.setup();
 }
 
 CollisionWorld::~CollisionWorld() = default;
 
 void CollisionWorld::update_bodies(const State& state, const std::vector<int>& moved) {
   Impl& m = *impl_;
-  m.moved_objects.clear();
+  m.moved_awake.clear();
+  m.moved_sleeping.clear();
   for (int b : moved) {
     const Body& body = m.model.bodies[b];
     for (int p = body.first_part; p < body.first_part + body.part_count; ++p) {
       m.place_part(p, state.position[b], state.orientation[b]);
-      m.moved_objects.push_back(m.objects[p].get());
+      (m.in_awake_tree[b] ? m.moved_awake : m.moved_sleeping).push_back(m.objects[p].get());
     }
   }
-  if (!m.moved_objects.empty()) m.manager.update(m.moved_objects);
+  if (!m.moved_awake.empty()) m.awake_tree.update(m.moved_awake);
+  if (!m.moved_sleeping.empty()) m.sleeping_tree.update(m.moved_sleeping);
+  // Bodies that fell asleep or woke up since the last call change trees (their boxes are current).
+  for (size_t b = 0; b < m.model.bodies.size(); ++b) {
+    if (m.in_awake_tree[b] == state.awake[b]) continue;
+    const Body& body = m.model.bodies[b];
+    auto& from = m.in_awake_tree[b] ? m.awake_tree : m.sleeping_tree;
+    auto& to = m.in_awake_tree[b] ? m.sleeping_tree : m.awake_tree;
+    for (int p = body.first_part; p < body.first_part + body.part_count; ++p) {
+      from.unregisterObject(m.objects[p].get());
+      to.registerObject(m.objects[p].get());
+    }
+    m.in_awake_tree[b] = state.awake[b];
+  }
 }
 
 void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out) {
@@ -309,7 +337,8 @@ void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out
   // Broad phase: candidate part pairs, then a fixed order so that runs are deterministic.
   m.pairs.clear();
   m.state = &state;
-  m.manager.collide(&m, &Impl::broadphase_callback);
+  m.awake_tree.collide(&m, &Impl::broadphase_callback);
+  m.awake_tree.collide(&m.sleeping_tree, &m, &Impl::broadphase_callback);
   std::sort(m.pairs.begin(), m.pairs.end());
   stats_ = CollisionStats{};
   stats_.broadphase_pairs = static_cast<long>(m.pairs.size());
