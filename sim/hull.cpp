@@ -7,7 +7,6 @@
 #include <functional>
 #include <limits>
 #include <map>
-#include <set>
 #include <sstream>
 
 #include <Eigen/Geometry>
@@ -792,8 +791,9 @@ HullModel load_hull(const fs::path& file, const HullLoadOptions& o) {
       top = topology(body.mesh);
     }
     FLOESIM_REQUIRE(top.unbalanced_edges == 0, where, ": mesh", open.size() > 1 ? "es " : " ", names,
-                    open.size() > 1 ? " are" : " is", " not closed (", top.boundary_edges,
-                    " boundary edges, i.e. holes", open.size() > 1 ? ", also when welded together" : "",
+                    open.size() > 1 ? " are" : " is", " not closed (", top.unbalanced_edges,
+                    " edges without a matching opposite edge, ", top.boundary_edges, " of them boundary edges, i.e. holes",
+                    open.size() > 1 ? ", also when welded together" : "",
                     "); a hull must be watertight for buoyancy. Close the holes (e.g. Blender: Select > All by Trait >"
                     " Non Manifold, then F to fill) and export again.");
     if (open.size() > 1) body.notes += "open on their own, closed when welded together: one body; ";

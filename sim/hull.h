@@ -84,6 +84,12 @@ struct HullModel {
 
 // Loads any mesh file assimp reads (OBJ first of all); each mesh is one part. Convex meshes are kept as they are;
 // non-convex ones are sliced or refused per the options, never silently replaced by their convex hull.
+// Details (vessel helper): node transforms are applied (mirroring ones too); vertices at equal positions are
+// welded; inconsistently oriented triangles are re-oriented and an inside-out mesh is flipped; meshes that are open
+// on their own but close when welded together (OBJ groups hull / deck / transom, as in the KCS and DTMB 5415 files)
+// become one body; anything still open is an Error. Slicing cuts along x; a section whose hull would add more than
+// 2 % of its volume (bulb, skeg, flare) is also cut horizontally into up to 8 layers, and neighbouring uncut
+// sections are merged while that adds < 0.1 %. Convexity is judged to 1e-6 of the mesh size.
 HullModel load_hull(const std::filesystem::path& file, const HullLoadOptions& o = {});
 
 }  // namespace floesim::sim
