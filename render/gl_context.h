@@ -21,7 +21,7 @@ namespace floesim::render {
   X(ColorPointer) X(DrawArrays) X(Color4f) X(Color4ub) X(Normal3f) X(Lightfv) X(LightModelfv) X(LightModeli)  \
   X(ColorMaterial) X(Materialfv) X(Materialf) X(ShadeModel) X(Fogi) X(Fogf) X(Fogfv) X(PolygonOffset)        \
   X(LineWidth) X(ReadPixels) X(PixelStorei) X(Finish) X(GetError) X(GetString) X(DepthFunc) X(DepthMask)      \
-  X(Hint) X(BlendFunc) X(CullFace) X(FrontFace)
+  X(Hint) X(BlendFunc) X(CullFace) X(FrontFace) X(ClipPlane)
 
 struct GlApi {
 #define FLOESIM_GL_DECLARE(name) decltype(&::gl##name) name = nullptr;

@@ -52,6 +52,9 @@ std::string fmt(const char* f, double a) {
 // Loads are read by people in kN: whole kN from 100 kN up, three significant digits below.
 std::string kN(double x) { return std::abs(x) >= 100 ? fmt("%.0f", x) : fmt("%.3g", x); }
 
+// NaN has no JSON spelling: null.
+nlohmann::json json_number(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+
 // gnuplot single-quoted string: only the quote itself needs escaping (doubled).
 std::string quoted(const std::string& s) {
   std::string out = "'";
@@ -136,6 +139,12 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
                                                      : o.moving_average_window_s.get<double>();
   s.window_samples = window_samples(s.window_s, s.time_step_s);
   const std::vector<double> ma = moving_average_centred(res, s.window_samples);
+  // Only samples whose whole window lies in the run are reported: near the ends a cut window averages what is
+  // left (e.g. 10 s of open water and one spike) and looks like data it is not. If the run is shorter than the
+  // window, the cut averages are all there is; they are shown and flagged.
+  auto [f0, f1] = full_window_range(res.size(), s.window_samples);
+  s.moving_average_complete = f0 < f1;
+  if (!s.moving_average_complete) f0 = 0, f1 = res.size();
 
   // 3. The steady part and its mean (of the unfiltered signal: the primary validation metric).
   s.steady_start_s = 0;
@@ -151,13 +160,13 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
   {
     double sum2 = 0, mx = -1e300;
     size_t c = 0;
-    for (size_t i = 0; i < t.size(); ++i)
+    for (size_t i = f0; i < f1; ++i)
       if (t[i] >= s.steady_start_s) {
         const double d = ma[i] - m.mean;
         sum2 += d * d, mx = std::max(mx, ma[i]), ++c;
       }
-    s.moving_average_std_kN = std::sqrt(sum2 / static_cast<double>(c));
-    s.moving_average_max_kN = mx;
+    s.moving_average_std_kN = c > 0 ? std::sqrt(sum2 / static_cast<double>(c)) : std::nan("");
+    s.moving_average_max_kN = c > 0 ? mx : std::nan("");
   }
   s.raw_max_kN = *std::max_element(res.begin(), res.end());
 
@@ -171,9 +180,10 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
   // 4. CSV with every sample.
   {
     std::ofstream os(csv.tmp());
-    os << "time_s,ice_resistance_kN,moving_average_kN\n";
+    os << "time_s,ice_resistance_kN,moving_average_kN\n";  // average empty where its window is cut
     for (size_t i = 0; i < t.size(); ++i)
-      os << fmt("%.10g", t[i]) << ',' << fmt("%.10g", res[i]) << ',' << fmt("%.10g", ma[i]) << '\n';
+      os << fmt("%.10g", t[i]) << ',' << fmt("%.10g", res[i]) << ','
+         << (i >= f0 && i < f1 ? fmt("%.10g", ma[i]) : std::string()) << '\n';
     FLOESIM_REQUIRE(os.flush(), csv.path().string(), ": write failed (disk full?)");
   }
 
@@ -183,7 +193,9 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
     std::ofstream os(data.tmp());
     write_decimated(os, t, res, bins);
     os << "\n\n";
-    write_decimated(os, t, ma, bins);
+    const std::vector<double> tm(t.begin() + static_cast<long>(f0), t.begin() + static_cast<long>(f1)),
+        mm(ma.begin() + static_cast<long>(f0), ma.begin() + static_cast<long>(f1));
+    write_decimated(os, tm, mm, bins);
     os << "\n\n";
     const double t_mean0 = std::max(s.steady_start_s, t.front());
     os << fmt("%.9g", t_mean0) << ' ' << fmt("%.9g", s.mean_kN) << '\n'
@@ -192,17 +204,19 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
   }
   // Rigid contacts give single-step spikes one or two orders of magnitude above the average; "auto" keeps the
   // average readable (top at 3 x its peak, or the raw peak if lower) and says how high the cut-off spikes go.
-  const double ma_max = *std::max_element(ma.begin(), ma.end()), ma_min = *std::min_element(ma.begin(), ma.end());
+  const double ma_max = *std::max_element(ma.begin() + static_cast<long>(f0), ma.begin() + static_cast<long>(f1)),
+               ma_min = *std::min_element(ma.begin() + static_cast<long>(f0), ma.begin() + static_cast<long>(f1));
   const double raw_min = *std::min_element(res.begin(), res.end());
   double y_hi = o.y_max_kN.is_number() ? o.y_max_kN.get<double>()
                                        : std::max({std::min(s.raw_max_kN, 3.0 * ma_max), 1.25 * s.mean_kN, 1e-3});
-  double y_lo = std::min({0.0, ma_min, std::max(raw_min, -y_hi)});
+  // Negative surge loads (ice pushing the hull ahead) are brief: show them down to a fifth of the top.
+  double y_lo = std::min({0.0, ma_min, std::max(raw_min, -0.2 * y_hi)});
   y_lo -= 0.03 * (y_hi - y_lo);
   if (!o.y_max_kN.is_number()) y_hi += 0.05 * (y_hi - y_lo);
   // Start the axis at 0 when the series starts within the first 5 % (it starts at the first step's end).
   const double x_lo = t.front() > 0 && t.front() < 0.05 * t.back() ? 0.0 : t.front();
   {
-    const bool clipped = s.raw_max_kN > y_hi;
+    const bool clipped = s.raw_max_kN > y_hi || raw_min < y_lo;
     std::ostringstream gp;
     gp << "set encoding utf8\n"
        << "set terminal pngcairo size " << o.width_px << "," << o.height_px
@@ -222,7 +236,7 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
        << "set format y '%.0f'\n";
     if (y_hi - y_lo < 10) gp << "set format y '%g'\n";
     if (clipped)
-      gp << "set label 1 " << quoted("raw peaks up to " + kN(s.raw_max_kN) + " kN are cut off")
+      gp << "set label 1 " << quoted("raw signal spans " + kN(raw_min) + " to " + kN(s.raw_max_kN) + " kN (cut off here)")
          << " at graph 0.99, graph 0.96 right boxed noenhanced font ',9' tc rgb '#505050' front\n";
     const std::string mean_title =
         (s.steady_start_s > t.front() ? "mean for t ≥ " + fmt("%g", s.steady_start_s) + " s: "
@@ -232,7 +246,8 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
        << " index 0 using 1:2 with lines lc rgb '#a9b8c6' lw 0.8 title "
        << quoted("ice resistance, every time step (Δt = " + fmt("%g", s.time_step_s) + " s)") << " noenhanced, \\\n"
        << "  '' index 1 using 1:2 with lines lc rgb '#101010' lw 2 title "
-       << quoted("centred moving average, " + fmt("%g", s.window_s) + " s window") << " noenhanced, \\\n"
+       << quoted("centred moving average, " + fmt("%g", s.window_s) + " s window" +
+                  (s.moving_average_complete ? "" : " (longer than the run: cut windows)")) << " noenhanced, \\\n"
        << "  '' index 2 using 1:2 with lines lc rgb '#d1232a' lw 2.5 dt (8,4) title " << quoted(mean_title)
        << " noenhanced\n"
        << "set terminal svg size " << o.width_px << "," << o.height_px
@@ -260,12 +275,16 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
       {"unit", "kN"},
       {"contact_model", s.contact_model},
       {"time_step_s", s.time_step_s},
-      {"moving_average", {{"kind", "centred"}, {"window_s", s.window_s}, {"window_samples", s.window_samples}}},
+      {"moving_average",
+       {{"kind", "centred"},
+        {"window_s", s.window_s},
+        {"window_samples", s.window_samples},
+        {"complete_windows", s.moving_average_complete}}},
       {"steady_start_s", s.steady_start_s},
       {"steady_samples", s.steady_samples},
       {"mean_kN", s.mean_kN},
-      {"moving_average_std_kN", s.moving_average_std_kN},
-      {"moving_average_max_kN", s.moving_average_max_kN},
+      {"moving_average_std_kN", json_number(s.moving_average_std_kN)},
+      {"moving_average_max_kN", json_number(s.moving_average_max_kN)},
       {"raw_max_kN", s.raw_max_kN},
       {"files", {"surge_ice_load.png", "surge_ice_load.svg", "surge_ice_load.csv"}},
       {"provenance", provenance},

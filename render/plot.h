@@ -49,7 +49,8 @@ struct SurgeLoadSummary {
   double steady_start_s = 0;
   size_t steady_samples = 0;
   double mean_kN = 0;              // mean ice resistance (-Fx) over t >= steady_start_s, unfiltered
-  double moving_average_std_kN = 0;  // of the moving average over the steady part
+  bool moving_average_complete = true;  // false: the run is shorter than the window (all windows cut)
+  double moving_average_std_kN = 0;  // of the moving average over the steady part, full windows only (NaN if none)
   double moving_average_max_kN = 0;
   double raw_max_kN = 0;           // over the whole run
 };

@@ -126,6 +126,54 @@ std::vector<std::array<int, 3>> triangulate(const std::vector<Vec2>& p) {
   return tris;
 }
 
+// A hull made of convex parts (floesim-hull, the simulator's collision model) has the faces between neighbouring
+// parts twice, once per part and triangulated differently. Inside the solid they are hidden, but they peek through
+// the hairline cracks of the deck as coloured dots. A face is internal if its centroid lies inside another
+// coplanar triangle (either orientation): an outer surface never overlaps itself.
+std::vector<bool> internal_faces(const std::vector<double>& v, const std::vector<int32_t>& t) {
+  const size_t nt = t.size() / 3;
+  auto corner = [&](size_t k, int j) { return Vec3(&v[3 * static_cast<size_t>(t[3 * k + j])]); };
+  // Planes keyed by a sign-canonical unit normal (to 1e-3) and offset (to 1 mm).
+  std::vector<std::pair<std::array<int64_t, 4>, size_t>> plane(nt);
+  std::vector<Vec3> normal(nt);
+  for (size_t k = 0; k < nt; ++k) {
+    Vec3 n = (corner(k, 1) - corner(k, 0)).cross(corner(k, 2) - corner(k, 0));
+    n = n.norm() > 0 ? Vec3(n.normalized()) : Vec3::Zero();
+    const int lead = std::abs(n.x()) > 0.5 ? 0 : (std::abs(n.y()) > 0.5 ? 1 : 2);
+    if (n[lead] < 0) n = -n;
+    normal[k] = n;
+    plane[k] = {{std::llround(1000 * n.x()), std::llround(1000 * n.y()), std::llround(1000 * n.z()),
+                 std::llround(1000 * n.dot(corner(k, 0)))},
+                k};
+  }
+  std::sort(plane.begin(), plane.end());
+  std::vector<bool> internal(nt, false);
+  for (size_t a = 0; a < nt;) {
+    size_t b = a;
+    while (b < nt && plane[b].first == plane[a].first) ++b;
+    for (size_t i = a; i < b; ++i) {
+      const size_t f = plane[i].second;
+      if (normal[f].isZero()) continue;
+      const Vec3 c = (corner(f, 0) + corner(f, 1) + corner(f, 2)) / 3;
+      for (size_t j = a; j < b && !internal[f]; ++j) {
+        const size_t g = plane[j].second;
+        if (g == f) continue;
+        // Strictly inside g: same side of all three edges, with a margin of 1 mm.
+        const Vec3 p0 = corner(g, 0), p1 = corner(g, 1), p2 = corner(g, 2);
+        const Vec3 ng = (p1 - p0).cross(p2 - p0);
+        if (ng.norm() <= 0) continue;
+        const Vec3 u = ng.normalized();
+        const double e0 = (p1 - p0).cross(c - p0).dot(u) / (p1 - p0).norm();
+        const double e1 = (p2 - p1).cross(c - p1).dot(u) / (p2 - p1).norm();
+        const double e2 = (p0 - p2).cross(c - p2).dot(u) / (p0 - p2).norm();
+        internal[f] = e0 > 1e-3 && e1 > 1e-3 && e2 > 1e-3;
+      }
+    }
+    a = b;
+  }
+  return internal;
+}
+
 struct FloeDraw {
   GLint first = 0, count = 0;            // triangles in the vertex arrays: the top face, then 6 per side quad
   GLint top_count = 0;                   // vertices of the top face
@@ -276,7 +324,9 @@ struct SceneRenderer::Impl {
       }
       f.count = vertex_count() - f.first;
       f.ring_first = vertex_count();
-      for (const Vec2& p : ring) vertex(Vec3(p.x(), p.y(), zt), up, t);
+      // Lifted a little above the top face, so that the outline wins the depth test without a polygon offset
+      // (an offset, large at grazing angles, would push distant floes behind one another).
+      for (const Vec2& p : ring) vertex(Vec3(p.x(), p.y(), zt + 0.03), up, t);
       f.ring_count = vertex_count() - f.ring_first;
     }
   }
@@ -297,13 +347,18 @@ struct SceneRenderer::Impl {
       zmax = std::max(zmax, v[3 * i + 2]);
       hull_radius = std::max(hull_radius, Vec3(v[3 * i], v[3 * i + 1], v[3 * i + 2]).norm());
     }
+    const size_t nt = t.size() / 3;
+    for (size_t k = 0; k < nt; ++k)
+      for (int j = 0; j < 3; ++j)
+        FLOESIM_REQUIRE(t[3 * k + j] >= 0 && static_cast<size_t>(t[3 * k + j]) < nv, source, ": hull triangle ", k,
+                        " uses vertex ", t[3 * k + j], " of ", nv);
+    const std::vector<bool> internal = internal_faces(v, t);
     hull_first = vertex_count();
-    for (size_t k = 0; k < t.size() / 3; ++k) {
+    for (size_t k = 0; k < nt; ++k) {
+      if (internal[k]) continue;
       Vec3 p[3];
       for (int j = 0; j < 3; ++j) {
         const int32_t i = t[3 * k + j];
-        FLOESIM_REQUIRE(i >= 0 && static_cast<size_t>(i) < nv, source, ": hull triangle ", k, " uses vertex ", i,
-                        " of ", nv);
         p[j] = Vec3(v[3 * i], v[3 * i + 1], v[3 * i + 2]);
       }
       Vec3 n = (p[1] - p[0]).cross(p[2] - p[0]);
@@ -347,7 +402,6 @@ struct SceneRenderer::Impl {
     gl.Fogf(GL_FOG_START, static_cast<float>(0.3 * o.view_distance_m));
     gl.Fogf(GL_FOG_END, static_cast<float>(o.view_distance_m));
     gl.Hint(GL_FOG_HINT, GL_NICEST);
-    gl.PolygonOffset(1.0f, 1.0f);  // faces slightly back so that outlines drawn at the same depth show
     gl.LineWidth(static_cast<float>(std::max(1.0, 0.75 * o.supersample)));
     gl.Viewport(0, 0, ctx.width(), ctx.height());
   }
@@ -398,10 +452,17 @@ struct SceneRenderer::Impl {
     if (chase && o.fog) gl.Enable(GL_FOG);
     else gl.Disable(GL_FOG);
 
+    // The water surface hides everything below z = 0. Floes float only centimetres above it, closer than the
+    // depth buffer resolves at a few hundred metres, so the water is not depth-tested against them: it is painted
+    // first without writing depth, and every body is clipped at z = 0 by a user clip plane instead (exact).
+    const GLdouble water_plane[4] = {0, 0, 1, 0};  // keeps z >= 0 (given while the modelview is the view matrix)
+    gl.ClipPlane(GL_CLIP_PLANE0, water_plane);
+
     // Water: an unlit grid under the camera. A grid, not one big quad: fixed-function fog is computed per vertex,
     // and a quad whose corners all lie beyond the fog end would be fogged away entirely.
     gl.Disable(GL_LIGHTING);
     gl.EnableClientState(GL_VERTEX_ARRAY);
+    gl.DepthMask(GL_FALSE);
     {
       const double s = chase ? 1.5 * o.view_distance_m : o.top_width_m;
       Mat4 t = Mat4::Identity();
@@ -414,6 +475,8 @@ struct SceneRenderer::Impl {
       gl.Color4f(water[0], water[1], water[2], 1);
       gl.DrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(water_grid.size() / 3));
     }
+    gl.DepthMask(GL_TRUE);
+    gl.Enable(GL_CLIP_PLANE0);
 
     // Floes: the visible ones are posed on the CPU into one batch and drawn with a single call. llvmpipe costs
     // ~20-40 us per draw call, so one call per floe (glMultMatrix of its pose) spent most of a 1000-floe frame in
@@ -481,9 +544,7 @@ struct SceneRenderer::Impl {
       gl.EnableClientState(GL_COLOR_ARRAY);
       gl.VertexPointer(3, GL_FLOAT, 0, batch_pos.data());
       gl.ColorPointer(4, GL_UNSIGNED_BYTE, 0, batch_col.data());
-      gl.Enable(GL_POLYGON_OFFSET_FILL);
       gl.DrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(batch_pos.size() / 3));
-      gl.Disable(GL_POLYGON_OFFSET_FILL);
       gl.DisableClientState(GL_COLOR_ARRAY);
     }
 
@@ -509,6 +570,7 @@ struct SceneRenderer::Impl {
     gl.DisableClientState(GL_COLOR_ARRAY);
     gl.DisableClientState(GL_NORMAL_ARRAY);
     gl.DisableClientState(GL_VERTEX_ARRAY);
+    gl.Disable(GL_CLIP_PLANE0);
     const GLenum err = gl.GetError();
     FLOESIM_REQUIRE(err == GL_NO_ERROR, "OpenGL error 0x", std::hex, err, " while drawing frame ", std::dec, k);
   }

@@ -48,6 +48,11 @@ std::vector<double> moving_average_centred(const std::vector<double>& x, size_t 
   return y;
 }
 
+std::pair<size_t, size_t> full_window_range(size_t n, size_t n_win) {
+  const size_t h = n_win / 2;  // odd N: (N-1)/2 each side; even N: N/2 each side (half-weighted ends)
+  return n > 2 * h ? std::make_pair(h, n - h) : std::make_pair(size_t(0), size_t(0));
+}
+
 std::vector<double> moving_average_causal(const std::vector<double>& x, size_t n_win) {
   FLOESIM_REQUIRE(n_win >= 1, "moving-average window must be at least 1 sample");
   if (n_win == 1 || x.empty()) return x;

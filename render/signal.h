@@ -2,6 +2,7 @@
 // uniformly sampled series, so that tests can check them against closed-form answers.
 #pragma once
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 namespace floesim::render {
@@ -15,6 +16,10 @@ size_t window_samples(double window_s, double dt_s);
 // Near the ends the window is cut to the samples that exist and renormalised (like pandas' min_periods=1), so the
 // output has the input's length; only the interior (>= N/2 samples from either end) is a full-window average.
 std::vector<double> moving_average_centred(const std::vector<double>& x, size_t window_samples);
+
+// Samples [first, last) of a series of n whose centred window of N samples lies wholly inside the series (the
+// interior above); empty (first >= last) when the series is shorter than the window.
+std::pair<size_t, size_t> full_window_range(size_t n, size_t window_samples);
 
 // Causal moving average: y_n = mean of x_{n-N+1} .. x_n (fewer samples at the start).
 std::vector<double> moving_average_causal(const std::vector<double>& x, size_t window_samples);

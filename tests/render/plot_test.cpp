@@ -48,9 +48,10 @@ TEST(Plot, WritesPngSvgCsvAndTheSteadyMean) {
   EXPECT_DOUBLE_EQ(s.window_s, 0.5);  // "auto" for compliant contacts
   EXPECT_EQ(s.window_samples, 10u);
   EXPECT_NEAR(s.time_step_s, 0.05, 1e-12);
-  // The even window cancels the +-300 kN alternation: the steady moving average is flat at 1000 kN, except within
-  // half a window of the end (cut window) -- so its maximum is close to 1000 and its spread small.
-  EXPECT_NEAR(s.moving_average_max_kN, 1000.0, 60.0);
+  // The even window cancels the +-300 kN alternation: over full windows the steady moving average is flat at
+  // 1000 kN once the 200 -> 1000 kN step has passed through the window.
+  EXPECT_TRUE(s.moving_average_complete);
+  EXPECT_NEAR(s.moving_average_max_kN, 1000.0, 1e-6);
   EXPECT_LT(s.moving_average_std_kN, 60.0);  // the 200 -> 1000 kN step smears into the first samples
   EXPECT_NEAR(s.raw_max_kN, 1300.0, 1e-9);
 
@@ -69,6 +70,14 @@ TEST(Plot, WritesPngSvgCsvAndTheSteadyMean) {
   const std::string csv = slurp(dir / "plots" / "surge_ice_load.csv");
   EXPECT_EQ(csv.rfind("time_s,ice_resistance_kN,moving_average_kN\n", 0), 0u);
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 401);
+  // The average is left empty where its window is cut (5 samples at each end for N = 10).
+  std::istringstream rows(csv);
+  std::string row;
+  std::getline(rows, row);
+  size_t empty = 0, filled = 0;
+  while (std::getline(rows, row)) (row.back() == ',' ? empty : filled)++;
+  EXPECT_EQ(empty, 10u);
+  EXPECT_EQ(filled, 390u);
 
   const auto j = nlohmann::json::parse(slurp(dir / "plots" / "plot.json"));
   EXPECT_NEAR(j["mean_kN"].get<double>(), 1000.0, 1e-9);
@@ -86,6 +95,7 @@ TEST(Plot, AutoWindowIsTwentySecondsForRigidOrUnknownContactsAndOptionsOverride)
   const SurgeLoadSummary s = plot_surge_load(dir / "results.h5", write_config(dir, "{}"), dir / "a");
   EXPECT_DOUBLE_EQ(s.window_s, 20.0);
   EXPECT_EQ(s.window_samples, 400u);
+  EXPECT_FALSE(s.moving_average_complete) << "a 20 s window does not fit in a 20 s run";
   EXPECT_DOUBLE_EQ(s.steady_start_s, 0.0);
   EXPECT_EQ(s.steady_samples, 400u);
   EXPECT_NEAR(s.mean_kN, (100 * 200.0 + 300 * 1000.0) / 400.0, 1e-9);

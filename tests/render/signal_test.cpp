@@ -43,11 +43,23 @@ TEST(Signal, CentredAverageOfARampIsTheRampInTheInterior) {
   const auto x = ramp(200, -3.0, 0.25);
   for (size_t n : {3u, 4u, 9u, 10u, 51u}) {  // odd and even windows: both centred, no lag
     const auto y = moving_average_centred(x, n);
-    for (size_t i = n / 2; i + n / 2 < x.size(); ++i) EXPECT_NEAR(y[i], x[i], 1e-9) << "window " << n << " i " << i;
+    const auto [first, last] = full_window_range(x.size(), n);
+    EXPECT_EQ(first, n / 2);
+    EXPECT_EQ(last, x.size() - n / 2);
+    for (size_t i = first; i < last; ++i) EXPECT_NEAR(y[i], x[i], 1e-9) << "window " << n << " i " << i;
     // At the ends the window is cut short on one side, so the average is pulled inwards.
     EXPECT_GT(y.front(), x.front());
     EXPECT_LT(y.back(), x.back());
   }
+}
+
+TEST(Signal, FullWindowRange) {
+  EXPECT_EQ(full_window_range(10, 1), std::make_pair(size_t(0), size_t(10)));
+  EXPECT_EQ(full_window_range(10, 3), std::make_pair(size_t(1), size_t(9)));
+  EXPECT_EQ(full_window_range(10, 4), std::make_pair(size_t(2), size_t(8)));  // 5 taps: 2 each side
+  EXPECT_EQ(full_window_range(11, 10), std::make_pair(size_t(5), size_t(6)));
+  const auto none = full_window_range(10, 10);  // 11 taps do not fit in 10 samples
+  EXPECT_GE(none.first, none.second);
 }
 
 TEST(Signal, CausalAverageOfARampLagsByHalfTheWindow) {
