@@ -151,10 +151,15 @@ SynthResult synthesize(const SynthOptions& o) {
   const double margin = 0.75 * o.max_diameter_m;
   const BBox domain{-margin, -margin, W + margin, H + margin};
   const double domain_area = (W + 2 * margin) * (H + 2 * margin);
+  // A floe centred near the domain's edge spills over it; each floe counts with its expected area inside the
+  // domain, that of a disc of radius r centred uniformly in a Wd x Hd rectangle:
+  // pi r^2 - 4/3 r^3 (Wd + Hd) / (Wd Hd) + r^4 / (2 Wd Hd).
+  const double wd = W + 2 * margin, hd = H + 2 * margin;
   std::vector<double> diameters;
   for (double area = 0; area < o.concentration * domain_area;) {
     diameters.push_back(sample_diameter(rng, o.alpha, o.min_diameter_m, o.max_diameter_m));
-    area += kPi / 4 * diameters.back() * diameters.back();
+    const double r = diameters.back() / 2;
+    area += kPi * r * r - 4.0 / 3.0 * r * r * r * (wd + hd) / (wd * hd) + r * r * r * r / (2 * wd * hd);
   }
   std::sort(diameters.begin(), diameters.end(), std::greater<double>());
 
@@ -170,17 +175,25 @@ SynthResult synthesize(const SynthOptions& o) {
     const double aspect = 1.0 + (o.max_aspect_ratio - 1.0) * U(rng);
     const bool convex = U(rng) < o.convex_fraction;
     const Polygon shape = random_outline(rng, n, aspect, o.irregularity, convex, kPi / 4 * d * d);
-    const double radius = max_radius(shape);
+    // A non-convex floe cut by the border with its star centre outside the image could leave several pieces in
+    // the image; there it takes its convex hull, scaled to the same area (rejecting the position instead would
+    // leave the border band short of ice).
+    Polygon hull = convex_hull(shape);
+    for (Vec2& v : hull) v *= std::sqrt(std::abs(signed_area(shape)) / signed_area(hull));
     bool ok = false;
     for (int attempt = 0; attempt < o.placement_attempts && !ok; ++attempt) {
       const Vec2 c(domain.x0 + U(rng) * (domain.x1 - domain.x0), domain.y0 + U(rng) * (domain.y1 - domain.y0));
       Polygon poly = translated(shape, c);
-      const BBox box = bounding_box(poly);
-      // A non-convex floe cut by the border must have its star centre inside the image, so its clipped truth is
-      // one polygon (see clip_to_rect).
-      const bool cut = box.overlaps({0, 0, W, H}) && (box.x0 < 0 || box.y0 < 0 || box.x1 > W || box.y1 > H);
+      BBox box = bounding_box(poly);
       const bool centre_inside = c.x() > 0 && c.x() < W && c.y() > 0 && c.y() < H;
-      if (!convex && cut && !centre_inside) continue;
+      auto cut = [&](const BBox& b) {
+        return b.overlaps({0, 0, W, H}) && (b.x0 < 0 || b.y0 < 0 || b.x1 > W || b.y1 > H);
+      };
+      if (!convex && !centre_inside && cut(box)) {
+        poly = translated(hull, c);
+        box = bounding_box(poly);
+      }
+      const double radius = max_radius(translated(poly, -c));
       if (!occ.fits(poly, box, c, radius, o.min_gap_m)) continue;
       occ.insert(poly, box, c, radius);
       placed.push_back({std::move(poly), d});

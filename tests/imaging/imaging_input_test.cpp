@@ -1,0 +1,155 @@
+// Bad input to digitise and synth: each case is a floesim::Error whose message names the file, key or value and
+// the fix, and nothing is written to the output directory.
+#include <cmath>
+#include <fstream>
+#include <limits>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "imaging/digitise.h"
+#include "imaging/image_io.h"
+#include "imaging/synth.h"
+#include "test_util.h"
+
+namespace floesim::imaging {
+namespace {
+
+class DigitiseBadInput : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    cv::Mat img(120, 160, CV_8U);
+    cv::randu(img, 30, 60);
+    cv::rectangle(img, cv::Rect(20, 20, 50, 40), cv::Scalar(220), cv::FILLED);
+    cv::rectangle(img, cv::Rect(90, 60, 40, 40), cv::Scalar(210), cv::FILLED);
+    good_ = dir_.path / "good.png";
+    ASSERT_TRUE(cv::imwrite(good_.string(), img));
+    out_ = dir_.path / "out";
+  }
+  DigitiseRequest request(const std::filesystem::path& image) const {
+    DigitiseRequest r;
+    r.image = image;
+    r.metres_per_pixel = 1.0;
+    r.out_dir = out_;
+    return r;
+  }
+  // Runs digitise, expects an Error whose message contains every `needle`, and checks that nothing was written.
+  void expect_refused(const DigitiseRequest& req, std::vector<std::string> needles) {
+    try {
+      run_digitise(req);
+      ADD_FAILURE() << "expected an error";
+    } catch (const Error& e) {
+      const std::string msg = e.what();
+      for (const auto& n : needles) EXPECT_NE(msg.find(n), std::string::npos) << "message lacks \"" << n << "\": " << msg;
+    }
+    EXPECT_TRUE(test::list_dir(out_).empty()) << "files were left in the output directory";
+  }
+  test::ScratchDir dir_;
+  std::filesystem::path good_, out_;
+};
+
+TEST_F(DigitiseBadInput, TheGoodImageWorks) {
+  // The reference for the cases below: the same request on a good image succeeds.
+  const DigitiseResult res = run_digitise(request(good_));
+  EXPECT_EQ(res.floes.floes.size(), 2u);
+  EXPECT_EQ(test::list_dir(out_).size(), 4u);
+}
+
+TEST_F(DigitiseBadInput, MissingFile) { expect_refused(request(dir_.path / "nope.png"), {"nope.png", "does not exist"}); }
+
+TEST_F(DigitiseBadInput, NotAnImage) {
+  const auto f = dir_.path / "text.png";
+  std::ofstream(f) << "this is not a PNG\n";
+  expect_refused(request(f), {"text.png", "cannot decode"});
+}
+
+TEST_F(DigitiseBadInput, TruncatedPng) {
+  std::ifstream in(good_, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto f = dir_.path / "truncated.png";
+  std::ofstream(f, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size() / 2));
+  expect_refused(request(f), {"truncated.png", "cannot decode"});
+}
+
+TEST_F(DigitiseBadInput, SixteenBitImage) {
+  cv::Mat img16(50, 60, CV_16U, cv::Scalar(40000));
+  const auto f = dir_.path / "deep.png";
+  ASSERT_TRUE(cv::imwrite(f.string(), img16));
+  expect_refused(request(f), {"deep.png", "16-bit", "8 bits"});
+}
+
+TEST_F(DigitiseBadInput, ColourImage) {
+  cv::Mat bgr(50, 60, CV_8UC3, cv::Scalar(200, 150, 100));
+  const auto f = dir_.path / "colour.png";
+  ASSERT_TRUE(cv::imwrite(f.string(), bgr));
+  expect_refused(request(f), {"colour.png", "colour", "grayscale"});
+}
+
+TEST_F(DigitiseBadInput, GreyStoredAsRgbIsAcceptedWithANote) {
+  cv::Mat g = cv::imread(good_.string(), cv::IMREAD_GRAYSCALE), bgr;
+  cv::Mat planes[] = {g, g, g};
+  cv::merge(planes, 3, bgr);
+  const auto f = dir_.path / "grey_rgb.png";
+  ASSERT_TRUE(cv::imwrite(f.string(), bgr));
+  const DigitiseResult res = run_digitise(request(f));
+  EXPECT_EQ(res.floes.floes.size(), 2u);
+  ASSERT_FALSE(res.warnings.empty());
+  EXPECT_NE(res.warnings[0].find("read as grayscale"), std::string::npos);
+}
+
+TEST_F(DigitiseBadInput, AllNoData) {
+  const auto f = dir_.path / "black.png";
+  ASSERT_TRUE(cv::imwrite(f.string(), cv::Mat(40, 40, CV_8U, cv::Scalar(0))));
+  expect_refused(request(f), {"black.png", "no data"});
+}
+
+TEST_F(DigitiseBadInput, MetresPerPixel) {
+  for (double s : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    DigitiseRequest r = request(good_);
+    r.metres_per_pixel = s;
+    expect_refused(r, {"--metres-per-pixel", "> 0"});
+  }
+}
+
+TEST_F(DigitiseBadInput, LargerThanMaxPixels) {
+  // Refused from the PNG header, before the pixels are decoded.
+  DigitiseRequest r = request(good_);
+  r.config = {{"max_pixels", 10000}};
+  expect_refused(r, {"good.png", "160 x 120", "max_pixels"});
+  int w = 0, h = 0;
+  ASSERT_TRUE(read_image_size(good_, w, h));
+  EXPECT_EQ(w, 160);
+  EXPECT_EQ(h, 120);
+}
+
+TEST_F(DigitiseBadInput, UnknownAndInvalidConfigKeys) {
+  DigitiseRequest r = request(good_);
+  r.config_file = dir_.path / "digitise.json";
+  r.config = {{"brash_cutof_m2", 3.0}, {"min_floe_area_m2", -1.0}};
+  expect_refused(r, {"digitise.json", "brash_cutof_m2", "not a known key", "brash_cutoff_m2", "min_floe_area_m2",
+                     "must be >= 0"});
+  r.config = {{"simplify_tolerance_m", "half a metre"}};
+  expect_refused(r, {"simplify_tolerance_m", "wrong type"});
+}
+
+TEST_F(DigitiseBadInput, WrongTruthFile) {
+  DigitiseRequest r = request(good_);
+  r.truth = dir_.path / "missing.geojson";
+  expect_refused(r, {"missing.geojson"});
+}
+
+TEST(SynthBadInput, CrossFieldChecks) {
+  try {
+    read_options<SynthOptions>(Json{{"min_diameter_m", 50.0}, {"max_diameter_m", 20.0}, {"colour", 1}}, "synth.json");
+    ADD_FAILURE() << "expected an error";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("synth.json"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("max_diameter_m must be >= min_diameter_m"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("colour is not a known key"), std::string::npos) << msg;
+  }
+}
+
+}  // namespace
+}  // namespace floesim::imaging
