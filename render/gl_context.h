@@ -16,12 +16,11 @@ namespace floesim::render {
 // names, the pointer declarations and the loader in one place; the types come from the prototypes in GL/gl.h
 // (decltype only: nothing is linked by name).
 #define FLOESIM_GL_FUNCTIONS(X)                                                                              \
-  X(Clear) X(ClearColor) X(Enable) X(Disable) X(Viewport) X(MatrixMode) X(LoadMatrixd) X(PushMatrix)         \
-  X(PopMatrix) X(MultMatrixd) X(EnableClientState) X(DisableClientState) X(VertexPointer) X(NormalPointer)   \
-  X(ColorPointer) X(DrawArrays) X(Color4f) X(Color4ub) X(Normal3f) X(Lightfv) X(LightModelfv) X(LightModeli)  \
-  X(ColorMaterial) X(Materialfv) X(Materialf) X(ShadeModel) X(Fogi) X(Fogf) X(Fogfv) X(PolygonOffset)        \
-  X(LineWidth) X(ReadPixels) X(PixelStorei) X(Finish) X(GetError) X(GetString) X(DepthFunc) X(DepthMask)      \
-  X(Hint) X(BlendFunc) X(CullFace) X(FrontFace) X(ClipPlane)
+  X(Clear) X(ClearColor) X(Enable) X(Disable) X(Viewport) X(MatrixMode) X(LoadMatrixd) X(EnableClientState)  \
+  X(DisableClientState) X(VertexPointer) X(NormalPointer) X(ColorPointer) X(DrawArrays) X(Color4f)           \
+  X(Lightfv) X(LightModelfv) X(LightModeli) X(ColorMaterial) X(ShadeModel) X(Fogi) X(Fogf) X(Fogfv)          \
+  X(LineWidth) X(ReadPixels) X(PixelStorei) X(Finish) X(GetError) X(GetString) X(DepthFunc) X(DepthMask)     \
+  X(Hint) X(ClipPlane)
 
 struct GlApi {
 #define FLOESIM_GL_DECLARE(name) decltype(&::gl##name) name = nullptr;

@@ -126,54 +126,6 @@ std::vector<std::array<int, 3>> triangulate(const std::vector<Vec2>& p) {
   return tris;
 }
 
-// A hull made of convex parts (floesim-hull, the simulator's collision model) has the faces between neighbouring
-// parts twice, once per part and triangulated differently. Inside the solid they are hidden, but they peek through
-// the hairline cracks of the deck as coloured dots. A face is internal if its centroid lies inside another
-// coplanar triangle (either orientation): an outer surface never overlaps itself.
-std::vector<bool> internal_faces(const std::vector<double>& v, const std::vector<int32_t>& t) {
-  const size_t nt = t.size() / 3;
-  auto corner = [&](size_t k, int j) { return Vec3(&v[3 * static_cast<size_t>(t[3 * k + j])]); };
-  // Planes keyed by a sign-canonical unit normal (to 1e-3) and offset (to 1 mm).
-  std::vector<std::pair<std::array<int64_t, 4>, size_t>> plane(nt);
-  std::vector<Vec3> normal(nt);
-  for (size_t k = 0; k < nt; ++k) {
-    Vec3 n = (corner(k, 1) - corner(k, 0)).cross(corner(k, 2) - corner(k, 0));
-    n = n.norm() > 0 ? Vec3(n.normalized()) : Vec3::Zero();
-    const int lead = std::abs(n.x()) > 0.5 ? 0 : (std::abs(n.y()) > 0.5 ? 1 : 2);
-    if (n[lead] < 0) n = -n;
-    normal[k] = n;
-    plane[k] = {{std::llround(1000 * n.x()), std::llround(1000 * n.y()), std::llround(1000 * n.z()),
-                 std::llround(1000 * n.dot(corner(k, 0)))},
-                k};
-  }
-  std::sort(plane.begin(), plane.end());
-  std::vector<bool> internal(nt, false);
-  for (size_t a = 0; a < nt;) {
-    size_t b = a;
-    while (b < nt && plane[b].first == plane[a].first) ++b;
-    for (size_t i = a; i < b; ++i) {
-      const size_t f = plane[i].second;
-      if (normal[f].isZero()) continue;
-      const Vec3 c = (corner(f, 0) + corner(f, 1) + corner(f, 2)) / 3;
-      for (size_t j = a; j < b && !internal[f]; ++j) {
-        const size_t g = plane[j].second;
-        if (g == f) continue;
-        // Strictly inside g: same side of all three edges, with a margin of 1 mm.
-        const Vec3 p0 = corner(g, 0), p1 = corner(g, 1), p2 = corner(g, 2);
-        const Vec3 ng = (p1 - p0).cross(p2 - p0);
-        if (ng.norm() <= 0) continue;
-        const Vec3 u = ng.normalized();
-        const double e0 = (p1 - p0).cross(c - p0).dot(u) / (p1 - p0).norm();
-        const double e1 = (p2 - p1).cross(c - p1).dot(u) / (p2 - p1).norm();
-        const double e2 = (p0 - p2).cross(c - p2).dot(u) / (p0 - p2).norm();
-        internal[f] = e0 > 1e-3 && e1 > 1e-3 && e2 > 1e-3;
-      }
-    }
-    a = b;
-  }
-  return internal;
-}
-
 struct FloeDraw {
   GLint first = 0, count = 0;            // triangles in the vertex arrays: the top face, then 6 per side quad
   GLint top_count = 0;                   // vertices of the top face
@@ -352,7 +304,7 @@ struct SceneRenderer::Impl {
       for (int j = 0; j < 3; ++j)
         FLOESIM_REQUIRE(t[3 * k + j] >= 0 && static_cast<size_t>(t[3 * k + j]) < nv, source, ": hull triangle ", k,
                         " uses vertex ", t[3 * k + j], " of ", nv);
-    const std::vector<bool> internal = internal_faces(v, t);
+    const std::vector<bool> internal = hull_internal_faces(v, t);
     hull_first = vertex_count();
     for (size_t k = 0; k < nt; ++k) {
       if (internal[k]) continue;
@@ -636,6 +588,52 @@ struct SceneRenderer::Impl {
     }
   }
 };
+
+std::vector<bool> hull_internal_faces(const std::vector<double>& v, const std::vector<int32_t>& t) {
+  const size_t nt = t.size() / 3;
+  auto corner = [&](size_t k, int j) { return Eigen::Vector3d(&v[3 * static_cast<size_t>(t[3 * k + j])]); };
+  // Planes keyed by a sign-canonical unit normal (to 1e-3) and offset (to 1 mm).
+  std::vector<std::pair<std::array<int64_t, 4>, size_t>> plane(nt);
+  std::vector<Eigen::Vector3d> normal(nt);
+  for (size_t k = 0; k < nt; ++k) {
+    Eigen::Vector3d n = (corner(k, 1) - corner(k, 0)).cross(corner(k, 2) - corner(k, 0));
+    n = n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
+    const int lead = std::abs(n.x()) > 0.5 ? 0 : (std::abs(n.y()) > 0.5 ? 1 : 2);
+    if (n[lead] < 0) n = -n;
+    normal[k] = n;
+    plane[k] = {{std::llround(1000 * n.x()), std::llround(1000 * n.y()), std::llround(1000 * n.z()),
+                 std::llround(1000 * n.dot(corner(k, 0)))},
+                k};
+  }
+  std::sort(plane.begin(), plane.end());
+  std::vector<bool> internal(nt, false);
+  for (size_t a = 0; a < nt;) {
+    size_t b = a;
+    while (b < nt && plane[b].first == plane[a].first) ++b;
+    for (size_t i = a; i < b; ++i) {
+      const size_t f = plane[i].second;
+      if (normal[f].isZero()) continue;
+      const Eigen::Vector3d c = (corner(f, 0) + corner(f, 1) + corner(f, 2)) / 3;
+      for (size_t j = a; j < b && !internal[f]; ++j) {
+        const size_t g = plane[j].second;
+        if (g == f) continue;
+        // Inside g or on its boundary (the centroid of one part's triangle may lie on the other part's diagonal);
+        // never true for a neighbour that only shares an edge, since a centroid is strictly inside its triangle.
+        const Eigen::Vector3d p0 = corner(g, 0), p1 = corner(g, 1), p2 = corner(g, 2);
+        const Eigen::Vector3d ng = (p1 - p0).cross(p2 - p0);
+        if (ng.norm() <= 0) continue;
+        const Eigen::Vector3d u = ng.normalized();
+        const double e0 = (p1 - p0).cross(c - p0).dot(u) / (p1 - p0).norm();
+        const double e1 = (p2 - p1).cross(c - p1).dot(u) / (p2 - p1).norm();
+        const double e2 = (p0 - p2).cross(c - p2).dot(u) / (p0 - p2).norm();
+        internal[f] = e0 > -1e-6 && e1 > -1e-6 && e2 > -1e-6;
+      }
+    }
+    a = b;
+  }
+  return internal;
+}
+
 
 SceneRenderer::SceneRenderer(const Results& r, const RenderOptions& o, const std::string& source)
     : impl_(std::make_unique<Impl>(r, o, source)) {}

@@ -1,9 +1,11 @@
 // Draws one results frame: water, floe slabs, the hull, seen from a camera that follows the vessel. All geometry
-// comes from the results file; the floe slabs and the hull are built once, in their body frames, and each body is
-// drawn with its pose for the frame (a matrix per floe, no per-frame geometry work).
+// comes from the results file; the floe slabs and the hull are built once, in their body frames. Per frame, the
+// floes inside the view are posed (rotation + translation of the prebuilt slab) into one batch drawn with a
+// single call, and the hull is drawn with its pose matrix.
 #pragma once
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -35,6 +37,13 @@ class SceneRenderer {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// A hull made of convex parts (floesim-hull, the simulator's collision model) has the faces between neighbouring
+// parts twice, once per part and triangulated differently. Inside the solid they are hidden, but they peek through
+// the hairline cracks of the deck as coloured dots, so the renderer drops them. A face is internal if its centroid
+// lies inside another coplanar triangle (either orientation): an outer surface never overlaps itself.
+// v: [V x 3] vertices, t: [T x 3] triangles; returns one flag per triangle.
+std::vector<bool> hull_internal_faces(const std::vector<double>& v, const std::vector<int32_t>& t);
 
 // The pixel at which the top view shows world point (x, y) in results frame `frame` (for tests and overlays):
 // the view is centred on the vessel, north up, top_width_m across.

@@ -212,3 +212,32 @@ TEST(Render, InconsistentResultsAreRefusedWithTheBodyNamed) {
     EXPECT_NE(std::string(e.what()).find("runs/x/results.h5"), std::string::npos) << e.what();
   }
 }
+
+TEST(Render, FacesSharedByTwoHullPartsAreFoundAndOuterFacesKept) {
+  // Two unit cubes side by side, x in [-1, 0] and [0, 1]; each closes its face at x = 0, triangulated along
+  // different diagonals (as convex parts written independently are).
+  std::vector<double> v;
+  std::vector<int32_t> t;
+  auto cube = [&](double x0, bool other_diagonal) {
+    const int32_t b = static_cast<int32_t>(v.size() / 3);
+    for (int i = 0; i < 8; ++i) v.insert(v.end(), {x0 + (i & 1), double((i >> 1) & 1), double((i >> 2) & 1)});
+    // Corner index = x + 2y + 4z. Faces as two triangles each; the x = x0 + 0/1 faces may use either diagonal.
+    const int32_t faces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
+    for (int f = 0; f < 6; ++f) {
+      const auto& q = faces[f];
+      if (other_diagonal && f < 2)
+        t.insert(t.end(), {b + q[0], b + q[1], b + q[3], b + q[1], b + q[2], b + q[3]});
+      else
+        t.insert(t.end(), {b + q[0], b + q[1], b + q[2], b + q[0], b + q[2], b + q[3]});
+    }
+  };
+  cube(-1, false);
+  cube(0, true);
+  const std::vector<bool> internal = hull_internal_faces(v, t);
+  ASSERT_EQ(internal.size(), 24u);
+  // Internal: cube A's x = +max face (face 1, triangles 2, 3) and cube B's x = min face (face 0, triangles 12, 13).
+  for (size_t k = 0; k < 24; ++k) {
+    const bool expected = k == 2 || k == 3 || k == 12 || k == 13;
+    EXPECT_EQ(internal[k], expected) << "triangle " << k;
+  }
+}
