@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <fstream>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -20,8 +19,8 @@ DigitiseResult digitise(const cv::Mat& gray, double s, const DigitiseOptions& o,
   DigitiseResult res;
   res.seg = segment_floes(gray, s, o, name);
   const PixelGrid g{gray.cols, gray.rows, s};
-  const std::vector<Polygon> outlines = polygonize_labels(res.seg.labels, res.seg.floes, g, o.simplify_tolerance_m,
-                                                          &res.polygons);
+  const std::vector<Polygon> outlines =
+      polygonize_labels(res.seg.labels, res.seg.floes, g, o.simplify_tolerance_m, &res.polygons);
   res.floes.width_m = g.width_m();
   res.floes.height_m = g.height_m();
   std::vector<double> areas;
@@ -35,9 +34,11 @@ DigitiseResult digitise(const cv::Mat& gray, double s, const DigitiseOptions& o,
     res.floes.floes.push_back(std::move(f));
   }
   const double ice_area = cv::countNonZero(res.seg.labels > 0) * s * s;
-  res.stats = floe_statistics(areas, ice_area, res.seg.valid_pixels * s * s, o.size_bins_per_decade,
-                              o.fit_min_diameter_m);
-  res.stats["image"] = {{"width_px", gray.cols}, {"height_px", gray.rows}, {"metres_per_pixel", s},
+  res.stats =
+      floe_statistics(areas, ice_area, res.seg.valid_pixels * s * s, o.size_bins_per_decade, o.fit_min_diameter_m);
+  res.stats["image"] = {{"width_px", gray.cols},
+                        {"height_px", gray.rows},
+                        {"metres_per_pixel", s},
                         {"valid_pixels", res.seg.valid_pixels}};
   res.stats["segmentation"] = {{"classes", res.seg.classes},
                                {"otsu_threshold", res.seg.otsu_threshold},
@@ -115,7 +116,8 @@ DigitiseResult run_digitise(const DigitiseRequest& req) {
   res.warnings.insert(res.warnings.begin(), load_notes.begin(), load_notes.end());
   if (truth) {
     const double tw = truth->width_m, th = truth->height_m;
-    if (tw > 0 && th > 0 && (std::abs(tw - res.floes.width_m) > 1e-6 * tw || std::abs(th - res.floes.height_m) > 1e-6 * th))
+    if (tw > 0 && th > 0 &&
+        (std::abs(tw - res.floes.width_m) > 1e-6 * tw || std::abs(th - res.floes.height_m) > 1e-6 * th))
       throw Error(req.truth.string() + ": the truth covers " + std::to_string(tw) + " x " + std::to_string(th) +
                   " m but the image covers " + std::to_string(res.floes.width_m) + " x " +
                   std::to_string(res.floes.height_m) + " m; wrong truth file or wrong --metres-per-pixel?");
@@ -125,7 +127,8 @@ DigitiseResult run_digitise(const DigitiseRequest& req) {
   // 3. Artefacts: all written to temporary names, then moved into place together.
   nlohmann::json config = {{"metres_per_pixel", req.metres_per_pixel}, {"options", options_to_json(o)}};
   std::vector<NamedInput> inputs{{"image", req.image}};
-  if (!req.config_file.empty() && std::filesystem::exists(req.config_file)) inputs.push_back({"config", req.config_file});
+  if (!req.config_file.empty() && std::filesystem::exists(req.config_file))
+    inputs.push_back({"config", req.config_file});
   if (!req.truth.empty()) inputs.push_back({"truth", req.truth});
   const nlohmann::json prov = make_provenance("floesim-digitise", inputs, config);
   res.floes.provenance = prov;

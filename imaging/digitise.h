@@ -15,11 +15,10 @@
 // a warning says so (stderr and stats.json).
 #pragma once
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "imaging/digitise_options.h"
 #include "imaging/polygons.h"
@@ -30,10 +29,10 @@
 namespace floesim::imaging {
 
 struct DigitiseResult {
-  FloeField floes;          // ids 1..N equal to the label values
-  Segmentation seg;         // labels (CV_32S), valid mask, diagnostics
+  FloeField floes;   // ids 1..N equal to the label values
+  Segmentation seg;  // labels (CV_32S), valid mask, diagnostics
   PolygonizeReport polygons;
-  nlohmann::json stats;     // stats.json without the provenance
+  nlohmann::json stats;  // stats.json without the provenance
   std::vector<std::string> warnings;
   std::optional<ScoreResult> score;
 };

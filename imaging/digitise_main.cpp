@@ -17,10 +17,13 @@ int main(int argc, char** argv) {
   app.add_option("--out", out, "output directory (floes.geojson, labels.png, overlay.png, stats.json)");
   app.add_option("--config", config, "JSON object of digitise options (see --help-config)");
   app.add_option("--truth", truth, "known floes (GeoJSON, e.g. floesim-synth's truth.geojson): writes score.json");
-  app.add_flag_callback("--help-config", [] {
-    std::cout << options_doc(imaging::DigitiseOptions{});
-    throw CLI::Success();
-  }, "print the options table and exit");
+  app.add_flag_callback(
+      "--help-config",
+      [] {
+        std::cout << options_doc(imaging::DigitiseOptions{});
+        throw CLI::Success();
+      },
+      "print the options table and exit");
   return run_stage(app, argc, argv, [&] {
     FLOESIM_REQUIRE(!image.empty(), "IMAGE is required (the photograph to digitise)");
     FLOESIM_REQUIRE(app.count("--metres-per-pixel") == 1,
@@ -41,8 +44,8 @@ int main(int argc, char** argv) {
     std::cout << "floesim-digitise: " << res.floes.floes.size() << " floes, ice concentration "
               << res.stats["ice_concentration"].get<double>() << " (" << secs << " s) -> " << out << "\n";
     if (res.score)
-      std::cout << "floesim-digitise: against the truth: F1 " << res.score->f1 << ", precision "
-                << res.score->precision << ", recall " << res.score->recall << ", mean IoU " << res.score->mean_iou
-                << ", concentration error " << res.score->concentration_error << "\n";
+      std::cout << "floesim-digitise: against the truth: F1 " << res.score->f1 << ", precision " << res.score->precision
+                << ", recall " << res.score->recall << ", mean IoU " << res.score->mean_iou << ", concentration error "
+                << res.score->concentration_error << "\n";
   });
 }

@@ -1,29 +1,34 @@
 // Options of digitise (one struct, strict JSON). Every threshold with a physical meaning is in metres or square
 // metres and converted through the image's pixel scale, so one configuration serves images of any resolution
-// showing the same kind of ice. Defaults were chosen on synthetic helicopter images (several seeds) at the SAMS
-// camera's 1.1794 m/px; for close-range imagery (cm per pixel) scale the lengths down with the floes.
+// showing the same kind of ice. Defaults were chosen by measurement on synthetic helicopter images at the SAMS
+// camera's 1.1794 m/px (seeds 1-8, also with 0.3 m gaps, noise 12, a 40% illumination ramp; see README.md),
+// not on one image; for close-range imagery (cm per pixel) scale the lengths down with the floes.
 #pragma once
 #include "pipeline/options.h"
 
 namespace floesim::imaging {
 
 struct DigitiseOptions {
-  double max_pixels = 100e6;            // larger images are refused before decoding (memory)
-  double illumination_scale_m = 150.0;  // Gaussian sigma of the smooth water and ice brightness estimates
-  double threshold_fraction = 0.45;     // ice where (I - water) / (ice - water) exceeds this (local levels)
-  double core_fraction = 0.75;          // floe cores (splitting seeds) are brighter than this, same scale
-  double min_contrast = 30.0;           // ice and water must differ by this many grey levels, else one class
-  double max_hole_area_m2 = 2000.0;     // water enclosed by one ice region up to this area is a melt pond (ice)
-  double opening_radius_m = 0.5;        // morphological opening: removes thin bridges and specks
-  double brash_cutoff_m2 = 10.0;        // connected ice pieces smaller than this are brash and dropped
-  double marker_dynamic_m = 1.5;        // a bump of the distance map must rise this much to seed its own floe
-  double min_marker_separation_m = 3.0; // seeds closer than this (within one ice piece) are one floe
-  double neck_ratio = 0.7;              // pieces joined by a neck wider than this ratio (see segment.h) are one
-  double min_floe_area_m2 = 10.0;       // split pieces smaller than this rejoin their neighbour; lone ones dropped
-  double simplify_tolerance_m = 0.5;    // Douglas-Peucker tolerance of the outlines
-  double thickness_m = 1.0;             // written to every floe (SAMS table: h = 1 m)
-  int size_bins_per_decade = 5;         // floe size distribution table: log-spaced bins of equivalent diameter
-  double fit_min_diameter_m = 0.0;      // power-law fit uses floes with D >= this (0: the smallest floe)
+  double max_pixels = 100e6;             // larger images are refused before decoding (memory)
+  double illumination_scale_m = 150.0;   // Gaussian sigma of the smooth water and ice brightness estimates
+  double threshold_fraction = 0.45;      // ice where (I - water) / (ice - water) exceeds this (local levels);
+                                         // below 0.5 because blur darkens corners and small floes
+  double core_fraction = 0.75;           // floe cores (splitting seeds): smoothed brightness above this fraction
+                                         // of their ice piece's bright level
+  double min_contrast = 30.0;            // ice and water must differ by this many grey levels, else one class
+  double max_hole_area_m2 = 2000.0;      // water enclosed by one ice region up to this area is a melt pond (ice)
+  double opening_radius_m = 0.5;         // morphological opening: removes bridges and specks thinner than ~2x;
+                                         // rounds to no opening at 1.18 m/px (it cut the corners of 5 m floes)
+  double brash_cutoff_m2 = 10.0;         // connected ice pieces smaller than this are brash and dropped
+  double marker_dynamic_m = 1.5;         // a bump of the distance map must rise this much to seed its own floe
+  double min_marker_separation_m = 3.0;  // seeds closer than this (within one ice piece) are one floe
+  double neck_ratio = 0.7;               // two pieces whose neck half-width reaches this fraction of the smaller
+                                         // one's inscribed radius are one floe with a dent (see segment.h)
+  double min_floe_area_m2 = 10.0;        // split pieces smaller than this rejoin their neighbour; lone ones dropped
+  double simplify_tolerance_m = 0.5;     // Douglas-Peucker tolerance of the outlines
+  double thickness_m = 1.0;              // written to every floe (SAMS table: h = 1 m)
+  int size_bins_per_decade = 5;          // floe size distribution table: log-spaced bins of equivalent diameter
+  double fit_min_diameter_m = 0.0;       // power-law fit uses floes with D >= this (0: the smallest floe)
 
   template <class V>
   void visit(V& v) {
@@ -33,23 +38,24 @@ struct DigitiseOptions {
     v.field("threshold_fraction", threshold_fraction, "-",
             "ice/water threshold between the local water (0) and ice (1) brightness", in_range(0.05, 0.95));
     v.field("core_fraction", core_fraction, "-",
-            "floe cores for splitting: brighter than this between local water (0) and ice (1)", in_range(0.05, 1.5));
+            "floe cores for splitting: smoothed brightness above this fraction of their ice piece's bright level",
+            in_range(0.05, 1.5));
     v.field("min_contrast", min_contrast, "grey", "least ice-water contrast; below it the image is one class",
             in_range(1, 255));
     v.field("max_hole_area_m2", max_hole_area_m2, "m^2", "largest enclosed water filled as a melt pond",
             non_negative());
     v.field("opening_radius_m", opening_radius_m, "m", "radius of the morphological opening", non_negative());
     v.field("brash_cutoff_m2", brash_cutoff_m2, "m^2", "ice pieces below this area are brash", non_negative());
-    v.field("marker_dynamic_m", marker_dynamic_m, "m",
-            "least rise of a distance-map maximum to seed a floe (h-maxima)", positive());
-    v.field("min_marker_separation_m", min_marker_separation_m, "m", "seeds closer than this are merged",
-            non_negative());
+    v.field("marker_dynamic_m", marker_dynamic_m, "m", "least rise of a distance-map maximum to seed a floe (h-maxima)",
+            positive());
+    v.field("min_marker_separation_m", min_marker_separation_m, "m",
+            "splitting seeds closer than this within one ice piece are one floe", non_negative());
     v.field("neck_ratio", neck_ratio, "-",
             "two pieces are one floe if their neck's half-width reaches this fraction of the smaller one's "
-            "inscribed radius", in_range(0, 10));
+            "inscribed radius",
+            in_range(0, 10));
     v.field("min_floe_area_m2", min_floe_area_m2, "m^2", "smallest floe kept after splitting", non_negative());
-    v.field("simplify_tolerance_m", simplify_tolerance_m, "m", "outline simplification tolerance",
-            non_negative());
+    v.field("simplify_tolerance_m", simplify_tolerance_m, "m", "outline simplification tolerance", non_negative());
     v.field("thickness_m", thickness_m, "m", "ice thickness written to every floe", positive());
     v.field("size_bins_per_decade", size_bins_per_decade, "-", "size distribution bins per decade of diameter",
             int_in_range(1, 50));

@@ -2,7 +2,6 @@
 
 #include <array>
 #include <fstream>
-
 #include <opencv2/imgcodecs.hpp>
 
 #include "pipeline/error.h"
@@ -10,7 +9,9 @@
 namespace floesim::imaging {
 
 namespace {
-uint32_t be32(const unsigned char* p) { return (uint32_t(p[0]) << 24) | (uint32_t(p[1]) << 16) | (uint32_t(p[2]) << 8) | p[3]; }
+uint32_t be32(const unsigned char* p) {
+  return (uint32_t(p[0]) << 24) | (uint32_t(p[1]) << 16) | (uint32_t(p[2]) << 8) | p[3];
+}
 uint32_t be16(const unsigned char* p) { return (uint32_t(p[0]) << 8) | p[1]; }
 }  // namespace
 
@@ -74,8 +75,8 @@ cv::Mat load_grayscale_image(const std::filesystem::path& file, double max_pixel
   FLOESIM_REQUIRE(!img.empty(), f,
                   ": cannot decode the image (truncated, corrupt or not an image format OpenCV reads); "
                   "re-export it as an 8-bit grayscale PNG");
-  FLOESIM_REQUIRE(double(img.rows) * double(img.cols) <= max_pixels, f, ": the image has ", img.cols, " x ",
-                  img.rows, " pixels, more than max_pixels = ", max_pixels, "; digitise it in tiles");
+  FLOESIM_REQUIRE(double(img.rows) * double(img.cols) <= max_pixels, f, ": the image has ", img.cols, " x ", img.rows,
+                  " pixels, more than max_pixels = ", max_pixels, "; digitise it in tiles");
   const int depth = img.depth();
   FLOESIM_REQUIRE(depth == CV_8U, f, ": is a ",
                   depth == CV_16U || depth == CV_16S ? "16-bit"
@@ -90,7 +91,8 @@ cv::Mat load_grayscale_image(const std::filesystem::path& file, double max_pixel
   std::vector<cv::Mat> planes;
   cv::split(img, planes);
   const bool grey = cv::countNonZero(planes[0] != planes[1]) == 0 && cv::countNonZero(planes[0] != planes[2]) == 0;
-  FLOESIM_REQUIRE(grey, f, ": is a colour image; digitise reads 8-bit grayscale and does not guess how colour maps "
+  FLOESIM_REQUIRE(grey, f,
+                  ": is a colour image; digitise reads 8-bit grayscale and does not guess how colour maps "
                   "to ice brightness. Convert it first, e.g. `convert in.png -colorspace Gray -depth 8 out.png` "
                   "(ImageMagick) or cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)");
   if (ch == 4)

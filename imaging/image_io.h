@@ -1,10 +1,9 @@
 // Reading the photograph digitise works on, with every refusal explained (file, what is wrong, the fix).
 #pragma once
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace floesim::imaging {
 

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-
 #include <opencv2/imgproc.hpp>
 
 #include "imaging/shapes.h"
@@ -12,7 +11,9 @@ namespace floesim::imaging {
 
 std::vector<cv::Point2d> trace_region_boundary(const cv::Mat& mask) {
   CV_Assert(mask.type() == CV_8UC1);
-  auto inside = [&](int c, int r) { return r >= 0 && c >= 0 && r < mask.rows && c < mask.cols && mask.at<uint8_t>(r, c); };
+  auto inside = [&](int c, int r) {
+    return r >= 0 && c >= 0 && r < mask.rows && c < mask.cols && mask.at<uint8_t>(r, c);
+  };
   int c0 = -1, r0 = -1;
   for (int r = 0; r < mask.rows && c0 < 0; ++r)
     for (int c = 0; c < mask.cols; ++c)
@@ -125,7 +126,8 @@ std::vector<Polygon> polygonize_labels(const cv::Mat& labels, int n, const Pixel
     std::vector<int> order(n);
     std::iota(order.begin(), order.end(), 1);
     for (int l = 1; l <= n; ++l) boxes[l] = bounding_box(out[l]);
-    std::sort(order.begin(), order.end(), [&](int a, int b) { return boxes[a].x0 < boxes[b].x0 || (boxes[a].x0 == boxes[b].x0 && a < b); });
+    std::sort(order.begin(), order.end(),
+              [&](int a, int b) { return boxes[a].x0 < boxes[b].x0 || (boxes[a].x0 == boxes[b].x0 && a < b); });
     std::vector<char> redo(n + 1, 0);
     int overlaps = 0;
     for (size_t i = 0; i < order.size(); ++i)

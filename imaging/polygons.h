@@ -8,9 +8,8 @@
 // overlap or touch after simplification fall back the same way (0.3 px, then the traced ring, which cannot
 // overlap its neighbour's because regions are never 8-adjacent).
 #pragma once
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "imaging/raster.h"
 

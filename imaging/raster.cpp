@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -43,7 +42,8 @@ void fill_polygon(cv::Mat& img, const Polygon& outline_m, const PixelGrid& g, in
       const cv::Point2d& a = v[i];
       const cv::Point2d& b = v[(i + 1) % n];
       // Half-open in y, so a vertex exactly on the scanline is counted once.
-      if ((a.y <= yc && yc < b.y) || (b.y <= yc && yc < a.y)) xs.push_back(a.x + (yc - a.y) * (b.x - a.x) / (b.y - a.y));
+      if ((a.y <= yc && yc < b.y) || (b.y <= yc && yc < a.y))
+        xs.push_back(a.x + (yc - a.y) * (b.x - a.x) / (b.y - a.y));
     }
     std::sort(xs.begin(), xs.end());
     for (size_t k = 0; k + 1 < xs.size(); k += 2) {

@@ -4,7 +4,6 @@
 // "Corner coordinates" (X, Y) are continuous pixel coordinates with (0, 0) the top-left corner of pixel (0, 0).
 #pragma once
 #include <filesystem>
-
 #include <opencv2/core.hpp>
 
 #include "pipeline/floes_io.h"

@@ -10,9 +10,9 @@ namespace floesim::imaging {
 struct ScoreResult {
   int predicted = 0, truth = 0, matched = 0;
   double precision = 0, recall = 0, f1 = 0;
-  double mean_iou = 0;                    // over the matched pairs
+  double mean_iou = 0;  // over the matched pairs
   double concentration_predicted = 0, concentration_truth = 0;
-  double concentration_error = 0;         // predicted - truth (fractions of the valid area)
+  double concentration_error = 0;  // predicted - truth (fractions of the valid area)
   nlohmann::json to_json() const;
 };
 

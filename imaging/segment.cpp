@@ -5,7 +5,6 @@
 #include <deque>
 #include <map>
 #include <numeric>
-
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/error.h"
@@ -338,7 +337,15 @@ Segmentation segment_floes(const cv::Mat& gray, double s, const DigitiseOptions&
   hist[0] = 0;
   const int t = otsu(hist);
   double n0 = 0, s0 = 0, n1 = 0, s1 = 0;
-  for (int i = 1; i < 256; ++i) (i <= t ? n0 : n1) += hist[i], (i <= t ? s0 : s1) += i * hist[i];
+  for (int i = 1; i < 256; ++i) {
+    if (i <= t) {
+      n0 += hist[i];
+      s0 += i * hist[i];
+    } else {
+      n1 += hist[i];
+      s1 += i * hist[i];
+    }
+  }
   seg.otsu_threshold = t;
   seg.water_grey = n0 > 0 ? s0 / n0 : 0;
   seg.ice_grey = n1 > 0 ? s1 / n1 : 0;
@@ -351,8 +358,9 @@ Segmentation segment_floes(const cv::Mat& gray, double s, const DigitiseOptions&
     for (int i = 1; i < 256; ++i) sum += i * hist[i];
     const double mean = sum / static_cast<double>(seg.valid_pixels);
     char buf[200];
-    std::snprintf(buf, sizeof buf, "ice-water contrast %.1f grey levels < min_contrast %.1f, mean grey %.1f: ",
-                  contrast, o.min_contrast, mean);
+    std::snprintf(buf, sizeof buf,
+                  "ice-water contrast %.1f grey levels < min_contrast %.1f, mean grey %.1f: ", contrast, o.min_contrast,
+                  mean);
     if (mean < 128) {
       seg.classes = "no_ice";
       seg.warnings.push_back(name + ": " + buf + "no ice found; the result has no floes");
@@ -406,8 +414,8 @@ Segmentation segment_floes(const cv::Mat& gray, double s, const DigitiseOptions&
     //    core_fraction, loses it even where blur bridged the gap) and the neck of the outline (h-maxima of the
     //    core's distance map). The flooding relief is the core distance inside the core and the normalised
     //    brightness below it, so boundaries run along the darkest pixels between cores.
-    // The core is taken on a lightly smoothed brightness so sensor noise does not fragment it, and relative to
-    // the bright level of its own ice piece (95th percentile), so a darker floe has a core too.
+    //    The core is taken on a lightly smoothed brightness so sensor noise does not fragment it, and relative
+    //    to the bright level of its own ice piece (95th percentile), so a darker floe has a core too.
     cv::Mat norm_s;
     cv::GaussianBlur(norm, norm_s, cv::Size(0, 0), 1.0);
     cv::Mat piece;
@@ -480,7 +488,8 @@ Segmentation segment_floes(const cv::Mat& gray, double s, const DigitiseOptions&
     if (sep_px > 0) {
       std::vector<int> order(n_seeds);
       std::iota(order.begin(), order.end(), 1);
-      std::sort(order.begin(), order.end(), [&](int a, int b) { return top[a].x < top[b].x || (top[a].x == top[b].x && a < b); });
+      std::sort(order.begin(), order.end(),
+                [&](int a, int b) { return top[a].x < top[b].x || (top[a].x == top[b].x && a < b); });
       for (size_t i = 0; i < order.size(); ++i)
         for (size_t j = i + 1; j < order.size() && top[order[j]].x - top[order[i]].x < sep_px; ++j) {
           const cv::Point d = top[order[j]] - top[order[i]];

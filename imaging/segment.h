@@ -7,34 +7,38 @@
 //      split). An image whose classes differ by less than min_contrast is one class: all ice or no ice.
 //   3. cleanup: enclosed water up to max_hole_area_m2 is filled (melt ponds), a morphological opening of
 //      opening_radius_m removes thin bridges and specks, connected pieces below brash_cutoff_m2 are dropped.
-//   4. splitting of touching floes: Euclidean distance transform; seeds are its h-maxima with
-//      h = marker_dynamic_m (a bump must rise that much to be a floe of its own), seeds closer than
-//      min_marker_separation_m within one piece merged; marker-based watershed flooding from the seeds
-//      (highest distance first) with one-pixel boundaries; pieces below min_floe_area_m2 rejoin the neighbour
-//      they share the longest boundary with and the flooding is repeated.
+//   4. splitting of touching floes, with two cues. Intensity: the core of each floe (smoothed normalised
+//      brightness above core_fraction of its ice piece's bright level) loses the dark line between floes even
+//      where blur bridged the gap. Shape: seeds are the h-maxima of the core's distance map with
+//      h = marker_dynamic_m (a bump must rise that much to be a floe of its own); seeds closer than
+//      min_marker_separation_m within one piece merge; a piece without core is seeded at its deepest pixel.
+//      Marker-based watershed (hierarchical queue) floods the ice from the seeds over the relief "core distance
+//      inside the core, brightness below it", so boundaries follow necks and the darkest pixels between cores.
+//      Then pieces rejoin and the flooding is repeated: two pieces whose shared boundary is not a neck (its
+//      highest core distance reaches neck_ratio of the smaller piece's inscribed radius) are one floe with a
+//      dent; a piece below min_floe_area_m2 joins the neighbour it shares the longest boundary with.
 //   5. regions: holes of each region filled (a region enclosed by another joins it), each region reduced to its
 //      largest 4-connected part, regions never 8-adjacent, lone regions below min_floe_area_m2 dropped,
 //      numbered 1..N in raster order of their first pixel.
 #pragma once
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "imaging/digitise_options.h"
 
 namespace floesim::imaging {
 
 struct Segmentation {
-  cv::Mat labels;            // CV_32S: 0 = no floe, k = floe k (see step 5 for the guarantees)
+  cv::Mat labels;  // CV_32S: 0 = no floe, k = floe k (see step 5 for the guarantees)
   int floes = 0;
-  cv::Mat valid;             // CV_8U, 255 where the pixel is data (non-zero)
+  cv::Mat valid;  // CV_8U, 255 where the pixel is data (non-zero)
   long long valid_pixels = 0;
-  std::string classes;       // "mixed", "no_ice" or "all_ice"
-  double otsu_threshold = 0; // first global split (grey level)
+  std::string classes;                  // "mixed", "no_ice" or "all_ice"
+  double otsu_threshold = 0;            // first global split (grey level)
   double water_grey = 0, ice_grey = 0;  // mean grey levels of the two classes (first split)
-  int seeds = 0;             // watershed seeds after merging close ones
-  int merged_pieces = 0;     // split pieces below min_floe_area_m2 merged into a neighbour
+  int seeds = 0;                        // watershed seeds after merging close ones
+  int merged_pieces = 0;                // split pieces below min_floe_area_m2 merged into a neighbour
   std::vector<std::string> warnings;
 };
 

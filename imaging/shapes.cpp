@@ -38,9 +38,8 @@ BBox bounding_box(const Polygon& p) {
 }
 
 Polygon convex_hull(Polygon pts) {
-  std::sort(pts.begin(), pts.end(), [](const Vec2& a, const Vec2& b) {
-    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
-  });
+  std::sort(pts.begin(), pts.end(),
+            [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
   pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
   if (pts.size() < 3) return pts;
   Polygon h(2 * pts.size());
@@ -132,10 +131,17 @@ Polygon clip_to_rect(const Polygon& p, double x0, double y0, double x1, double y
     };
   };
   Polygon r = p;
-  r = pass(r, [x0](const Vec2& v) { return v.x() >= x0; }, lerp_x(x0));
-  if (r.size() >= 3) r = pass(r, [x1](const Vec2& v) { return v.x() <= x1; }, lerp_x(x1));
-  if (r.size() >= 3) r = pass(r, [y0](const Vec2& v) { return v.y() >= y0; }, lerp_y(y0));
-  if (r.size() >= 3) r = pass(r, [y1](const Vec2& v) { return v.y() <= y1; }, lerp_y(y1));
+  r = pass(
+      r, [x0](const Vec2& v) { return v.x() >= x0; }, lerp_x(x0));
+  if (r.size() >= 3)
+    r = pass(
+        r, [x1](const Vec2& v) { return v.x() <= x1; }, lerp_x(x1));
+  if (r.size() >= 3)
+    r = pass(
+        r, [y0](const Vec2& v) { return v.y() >= y0; }, lerp_y(y0));
+  if (r.size() >= 3)
+    r = pass(
+        r, [y1](const Vec2& v) { return v.y() <= y1; }, lerp_y(y1));
   if (r.size() < 3) return {};
   r = clean_polygon(r, 1e-9);
   if (r.size() < 3 || std::abs(signed_area(r)) <= 0) return {};

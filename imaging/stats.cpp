@@ -80,7 +80,8 @@ nlohmann::json floe_statistics(const std::vector<double>& areas_m2, double ice_a
     const int k1 = static_cast<int>(std::floor(std::log10(d.back()) * bins_per_decade));
     size_t i = 0;
     for (int k = k0; k <= k1; ++k) {
-      const double lo = std::pow(10.0, double(k) / bins_per_decade), hi = std::pow(10.0, double(k + 1) / bins_per_decade);
+      const double lo = std::pow(10.0, double(k) / bins_per_decade),
+                   hi = std::pow(10.0, double(k + 1) / bins_per_decade);
       int count = 0;
       while (i < n && (d[i] < hi || k == k1)) ++count, ++i;
       bins.push_back({{"d_min_m", lo},
@@ -96,12 +97,12 @@ nlohmann::json floe_statistics(const std::vector<double>& areas_m2, double ice_a
 
   const double dmin = fit_min_diameter_m > 0 ? fit_min_diameter_m : (n ? d.front() : 0.0);
   auto fit_json = [](const PowerLawFit& f) {
-    return nlohmann::json{{"n", f.n},
-                          {"d_min_m", f.d_min},
-                          {"d_max_m", std::isfinite(f.d_max) ? nlohmann::json(f.d_max) : nlohmann::json(nullptr)},
-                          {"alpha", std::isfinite(f.alpha) ? nlohmann::json(f.alpha) : nlohmann::json(nullptr)},
-                          {"alpha_stderr", std::isfinite(f.alpha_stderr) ? nlohmann::json(f.alpha_stderr)
-                                                                          : nlohmann::json(nullptr)}};
+    return nlohmann::json{
+        {"n", f.n},
+        {"d_min_m", f.d_min},
+        {"d_max_m", std::isfinite(f.d_max) ? nlohmann::json(f.d_max) : nlohmann::json(nullptr)},
+        {"alpha", std::isfinite(f.alpha) ? nlohmann::json(f.alpha) : nlohmann::json(nullptr)},
+        {"alpha_stderr", std::isfinite(f.alpha_stderr) ? nlohmann::json(f.alpha_stderr) : nlohmann::json(nullptr)}};
   };
   nlohmann::json pl;
   pl["model"] = "n(D) ~ D^-alpha for the equivalent diameter D";

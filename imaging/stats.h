@@ -1,9 +1,8 @@
 // Floe statistics: the size distribution table and power-law fits of it.
 #pragma once
 #include <limits>
-#include <vector>
-
 #include <nlohmann/json.hpp>
+#include <vector>
 
 namespace floesim::imaging {
 

@@ -3,10 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <random>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <random>
 
 #include "imaging/raster.h"
 #include "imaging/shapes.h"
@@ -332,8 +331,8 @@ SynthResult synthesize(const SynthOptions& o) {
                            " floes found no free position after " + std::to_string(o.placement_attempts) +
                            " attempts (lower concentration or min_gap_m, or raise placement_attempts)");
   if (std::abs(res.concentration - o.concentration) > 0.03)
-    res.warnings.push_back("concentration in the image is " + std::to_string(res.concentration) +
-                           " for a target of " + std::to_string(o.concentration));
+    res.warnings.push_back("concentration in the image is " + std::to_string(res.concentration) + " for a target of " +
+                           std::to_string(o.concentration));
   return res;
 }
 
@@ -348,12 +347,9 @@ SynthResult run_synth(const SynthOptions& o, const std::filesystem::path& out_di
   res.truth.provenance = make_provenance("floesim-synth", {}, options_to_json(o));
   res.truth.provenance["outputs"] = {{"image.png", sha256_file(image.tmp())},
                                      {"truth_labels.png", sha256_file(labels.tmp())}};
-  res.truth.provenance["summary"] = {{"floes", res.truth.floes.size()},
-                                     {"concentration", res.concentration},
-                                     {"rejected_floes", res.rejected_floes},
-                                     {"hidden_floes", res.hidden_floes},
-                                     {"brash_fragments", res.brash_fragments},
-                                     {"ponds", res.ponds}};
+  res.truth.provenance["summary"] = {{"floes", res.truth.floes.size()},        {"concentration", res.concentration},
+                                     {"rejected_floes", res.rejected_floes},   {"hidden_floes", res.hidden_floes},
+                                     {"brash_fragments", res.brash_fragments}, {"ponds", res.ponds}};
   AtomicFile truth(out_dir / "truth.geojson");
   {
     std::ofstream out(truth.tmp(), std::ios::binary);

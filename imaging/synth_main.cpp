@@ -11,17 +11,20 @@ int main(int argc, char** argv) {
   std::string config, out;
   app.add_option("--config", config, "JSON options (see --help-config); without it, the defaults");
   app.add_option("--out", out, "output directory (image.png, truth.geojson, truth_labels.png)");
-  app.add_flag_callback("--help-config", [] {
-    std::cout << options_doc(imaging::SynthOptions{});
-    throw CLI::Success();
-  }, "print the options table and exit");
+  app.add_flag_callback(
+      "--help-config",
+      [] {
+        std::cout << options_doc(imaging::SynthOptions{});
+        throw CLI::Success();
+      },
+      "print the options table and exit");
   return run_stage(app, argc, argv, [&] {
     FLOESIM_REQUIRE(!out.empty(), "--out DIR is required (the directory that receives the image and its truth)");
-    const auto opts = config.empty() ? imaging::SynthOptions{}
-                                     : read_options<imaging::SynthOptions>(load_json_file(config), config);
+    const auto opts =
+        config.empty() ? imaging::SynthOptions{} : read_options<imaging::SynthOptions>(load_json_file(config), config);
     const auto res = imaging::run_synth(opts, out);
     for (const auto& w : res.warnings) std::cerr << "floesim-synth: warning: " << w << "\n";
-    std::cout << "floesim-synth: " << res.truth.floes.size() << " floes, concentration " << res.concentration
-              << ", " << res.brash_fragments << " brash fragments, " << res.ponds << " ponds -> " << out << "\n";
+    std::cout << "floesim-synth: " << res.truth.floes.size() << " floes, concentration " << res.concentration << ", "
+              << res.brash_fragments << " brash fragments, " << res.ponds << " ponds -> " << out << "\n";
   });
 }

@@ -1,14 +1,14 @@
 // Digitise: scored against the synthetic truth (F1 with IoU >= 0.5 matching, concentration), artefacts consistent
 // with each other (labels <-> polygons <-> stats), the pieces (boundary tracing, scoring) on known answers, and a
 // sanity run on real photographs.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <fstream>
 #include <map>
-#include <set>
-
-#include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <set>
 
 #include "imaging/digitise.h"
 #include "imaging/polygons.h"
@@ -163,7 +163,8 @@ TEST(DigitiseSynthetic, ArtefactsAgreeWithEachOther) {
     ASSERT_TRUE(pixels.count(f.id)) << "feature " << f.id << " has no label pixels";
     const double a_pix = pixels[f.id] * s * s;
     double perimeter = 0;
-    for (size_t i = 0; i < f.outline.size(); ++i) perimeter += (f.outline[(i + 1) % f.outline.size()] - f.outline[i]).norm();
+    for (size_t i = 0; i < f.outline.size(); ++i)
+      perimeter += (f.outline[(i + 1) % f.outline.size()] - f.outline[i]).norm();
     EXPECT_LE(std::abs(f.area_m2 - a_pix), 0.5 * s * s + perimeter * tol) << "feature " << f.id;
     if (pixels[f.id] >= 200) {
       EXPECT_NEAR(f.area_m2, a_pix, 0.03 * a_pix) << "feature " << f.id;
@@ -272,9 +273,9 @@ TEST(DigitiseReal, PasserottiCloseRangeImage) {
   req.image = image;
   req.metres_per_pixel = 0.05;
   req.out_dir = d.path;
-  req.config = {{"illumination_scale_m", 6.0},    {"max_hole_area_m2", 4.0},      {"opening_radius_m", 0.1},
-                {"brash_cutoff_m2", 0.05},        {"marker_dynamic_m", 0.1},      {"min_marker_separation_m", 0.15},
-                {"min_floe_area_m2", 0.1},        {"simplify_tolerance_m", 0.03}};
+  req.config = {{"illumination_scale_m", 6.0}, {"max_hole_area_m2", 4.0},     {"opening_radius_m", 0.1},
+                {"brash_cutoff_m2", 0.05},     {"marker_dynamic_m", 0.1},     {"min_marker_separation_m", 0.15},
+                {"min_floe_area_m2", 0.1},     {"simplify_tolerance_m", 0.03}};
   const DigitiseResult res = run_digitise(req);
   const double conc = res.stats["ice_concentration"].get<double>();
   EXPECT_GT(conc, 0.2);

@@ -1,10 +1,10 @@
 // Bad input to digitise and synth: each case is a floesim::Error whose message names the file, key or value and
 // the fix, and nothing is written to the output directory.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <fstream>
 #include <limits>
-
-#include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -41,7 +41,8 @@ class DigitiseBadInput : public ::testing::Test {
       ADD_FAILURE() << "expected an error";
     } catch (const Error& e) {
       const std::string msg = e.what();
-      for (const auto& n : needles) EXPECT_NE(msg.find(n), std::string::npos) << "message lacks \"" << n << "\": " << msg;
+      for (const auto& n : needles)
+        EXPECT_NE(msg.find(n), std::string::npos) << "message lacks \"" << n << "\": " << msg;
     }
     EXPECT_TRUE(test::list_dir(out_).empty()) << "files were left in the output directory";
   }
@@ -56,7 +57,9 @@ TEST_F(DigitiseBadInput, TheGoodImageWorks) {
   EXPECT_EQ(test::list_dir(out_).size(), 4u);
 }
 
-TEST_F(DigitiseBadInput, MissingFile) { expect_refused(request(dir_.path / "nope.png"), {"nope.png", "does not exist"}); }
+TEST_F(DigitiseBadInput, MissingFile) {
+  expect_refused(request(dir_.path / "nope.png"), {"nope.png", "does not exist"});
+}
 
 TEST_F(DigitiseBadInput, NotAnImage) {
   const auto f = dir_.path / "text.png";
@@ -127,8 +130,8 @@ TEST_F(DigitiseBadInput, UnknownAndInvalidConfigKeys) {
   DigitiseRequest r = request(good_);
   r.config_file = dir_.path / "digitise.json";
   r.config = {{"brash_cutof_m2", 3.0}, {"min_floe_area_m2", -1.0}};
-  expect_refused(r, {"digitise.json", "brash_cutof_m2", "not a known key", "brash_cutoff_m2", "min_floe_area_m2",
-                     "must be >= 0"});
+  expect_refused(
+      r, {"digitise.json", "brash_cutof_m2", "not a known key", "brash_cutoff_m2", "min_floe_area_m2", "must be >= 0"});
   r.config = {{"simplify_tolerance_m", "half a metre"}};
   expect_refused(r, {"simplify_tolerance_m", "wrong type"});
 }

@@ -1,11 +1,11 @@
 // The synthetic helicopter image: reproducible, the requested concentration and size distribution, and a truth
 // that digitise can be scored against (simple CCW non-overlapping polygons inside the image, labels that match).
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <fstream>
-#include <sstream>
-
-#include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
+#include <sstream>
 
 #include "imaging/raster.h"
 #include "imaging/shapes.h"
@@ -60,8 +60,7 @@ TEST(Synth, SizeDistributionExponent) {
     const SynthResult r = synthesize(o);
     const PowerLawFit f = fit_power_law(r.placed_diameters_m, o.min_diameter_m, o.max_diameter_m);
     ASSERT_GT(f.n, 500);
-    EXPECT_NEAR(f.alpha, alpha, std::max(0.08, 4 * f.alpha_stderr))
-        << "n = " << f.n << ", stderr " << f.alpha_stderr;
+    EXPECT_NEAR(f.alpha, alpha, std::max(0.08, 4 * f.alpha_stderr)) << "n = " << f.n << ", stderr " << f.alpha_stderr;
     // The untruncated estimator is biased high for a range of only 30x (the reason for the truncated one).
     const PowerLawFit u = fit_power_law(r.placed_diameters_m, o.min_diameter_m);
     EXPECT_GT(u.alpha, f.alpha);

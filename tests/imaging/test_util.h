@@ -1,12 +1,11 @@
 // Helpers shared by the imaging tests: a scratch directory per test and file listing.
 #pragma once
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 namespace floesim::imaging::test {
 
@@ -15,9 +14,8 @@ struct ScratchDir {
   std::filesystem::path path;
   ScratchDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path = std::filesystem::temp_directory_path() /
-           ("floesim_imaging_" + std::string(info->test_suite_name()) + "_" + info->name() + "_" +
-            std::to_string(::getpid()));
+    path = std::filesystem::temp_directory_path() / ("floesim_imaging_" + std::string(info->test_suite_name()) + "_" +
+                                                     info->name() + "_" + std::to_string(::getpid()));
     std::filesystem::remove_all(path);
     std::filesystem::create_directories(path);
   }
