@@ -75,6 +75,10 @@ int main(int argc, char** argv) {
   o.width_px = argc > 4 ? std::stoi(argv[4]) : 1280;
   o.height_px = argc > 5 ? std::stoi(argv[5]) : 720;
   o.supersample = argc > 6 ? std::stoi(argv[6]) : 2;
+  if (frames < 1 || n_floes < 1) {
+    std::cerr << "render_bench: frames and floes must be >= 1\n";
+    return 2;
+  }
   ensure_directory(dir);
 
   // Floes on a jittered grid ahead of and around the vessel (~70 % concentration), star-shaped outlines.
