@@ -118,7 +118,20 @@ struct CollisionWorld::Impl {
   }
 
   // Builds the contacts of one touching pair (a < b by body) into out. Returns true for an edge contact.
-  bool manifold(const PairCandidate& pc, const fcl::Contactd& hint, Scratch& sc, std::vector<Contact>& out) {
+  // Face axes of least overlap on both parts (SAT over the face normals): separation sa, sb (> 0: apart).
+  struct FaceAxes {
+    int fa, fb;
+    double sa, sb;
+  };
+  FaceAxes face_axes(const PairCandidate& pc) const {
+    FaceAxes f;
+    f.fa = best_face(model.parts[pc.part_a], world[pc.part_a], world[pc.part_b], f.sa);
+    f.fb = best_face(model.parts[pc.part_b], world[pc.part_b], world[pc.part_a], f.sb);
+    return f;
+  }
+
+  bool manifold(const PairCandidate& pc, const FaceAxes& axes, const fcl::Contactd& hint, Scratch& sc,
+                std::vector<Contact>& out) {
     const ConvexPart& A = model.parts[pc.part_a];
     const ConvexPart& B = model.parts[pc.part_b];
     const PartWorld& wa = world[pc.part_a];
@@ -139,10 +152,9 @@ struct CollisionWorld::Impl {
       out.push_back(c);
     };
 
-    // 1. Face axes of least overlap on both parts (SAT over face normals).
-    double sa, sb;
-    const int fa = best_face(A, wa, wb, sa);
-    const int fb = best_face(B, wb, wa, sb);
+    // 1. Face axes of least overlap on both parts.
+    const double sa = axes.sa, sb = axes.sb;
+    const int fa = axes.fa, fb = axes.fb;
     const double face_overlap = -std::max(sa, sb);
     if (fa < 0 && fb < 0) {  // cannot happen for closed parts; keep FCL's point rather than fail
       emit(hint.pos, hint.normal, -std::max(0.0, hint.penetration_depth));
@@ -355,12 +367,15 @@ void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out
     req.gjk_solver_type = fcl::GST_LIBCCD;
     for (int i = begin; i < end; ++i) {
       const PairCandidate& pc = m.pairs[i];
+      // A separating face axis proves the parts apart: most box-overlapping neighbours end here, before GJK.
+      const Impl::FaceAxes axes = m.face_axes(pc);
+      if (axes.sa > 0 || axes.sb > 0) continue;
       fcl::CollisionResultd res;
       fcl::collide(m.objects[pc.part_a].get(), m.objects[pc.part_b].get(), req, res);
       if (!res.isCollision() || res.numContacts() == 0) continue;
       ++sc.hits;
       // FCL's normal points from its first object to its second: part_a to part_b here.
-      if (m.manifold(pc, res.getContact(0), sc, sc.contacts)) ++sc.edges;
+      if (m.manifold(pc, axes, res.getContact(0), sc, sc.contacts)) ++sc.edges;
     }
   }, 8);
   // Workers hold contiguous, increasing ranges of pairs: concatenating in worker order keeps the sorted order.

@@ -51,7 +51,6 @@ Wrench floe_water_drag(const Model& m, const Body& b, const BodyKinematics& k, F
   const double half_rho = 0.5 * m.options.water.density_kg_m3;
   s.vertices.resize(b.drag_vertices.size());
   for (size_t i = 0; i < b.drag_vertices.size(); ++i) s.vertices[i] = k.x + k.R * b.drag_vertices[i];
-  Vec3 poly[64];
   for (const DragFace& f : b.drag_faces) {
     // Submerged part of the face (full, none, or clipped at the water plane).
     bool all_below = true, any_below = false;
@@ -62,9 +61,9 @@ Wrench floe_water_drag(const Model& m, const Body& b, const BodyKinematics& k, F
     }
     if (!any_below) continue;
     AreaCentroid ac;
-    if (all_below && f.count <= 64) {
-      for (int i = 0; i < f.count; ++i) poly[i] = s.vertices[b.drag_face_index[f.first + i]];
-      ac = polygon_area_centroid(poly, f.count);
+    if (all_below) {
+      ac.area = f.area;
+      ac.centroid = k.x + k.R * f.centroid;
     } else {
       // Gather the face's vertices, then clip (the top/bottom faces of large floes can have many vertices).
       s.face.clear();

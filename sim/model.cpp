@@ -511,6 +511,11 @@ Model build_model(const FloeField& field, const HullModel* hull, const SimulateO
       df.first = static_cast<int>(b.drag_face_index.size());
       df.count = static_cast<int>(idx.size());
       df.normal = nrm;
+      std::vector<Vec3> pts;
+      for (int i : idx) pts.push_back(b.drag_vertices[i]);
+      const AreaCentroid ac = polygon_area_centroid(pts.data(), static_cast<int>(pts.size()));
+      df.area = ac.area;
+      df.centroid = ac.centroid;
       b.drag_face_index.insert(b.drag_face_index.end(), idx.begin(), idx.end());
       b.drag_faces.push_back(df);
     };

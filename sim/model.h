@@ -35,6 +35,8 @@ enum class BodyKind : uint8_t { vessel, floe };
 struct DragFace {
   int first = 0, count = 0;  // into Body::drag_face_index
   Vec3 normal = Vec3::Zero();  // outward, body frame
+  double area = 0;             // m^2
+  Vec3 centroid = Vec3::Zero();  // body frame (used as is when the whole face is under water)
 };
 
 struct Body {

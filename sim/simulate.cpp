@@ -91,7 +91,7 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
   r.state_quaternion.reserve(frames * nb * 4);
 
   const auto t0 = std::chrono::steady_clock::now();
-  double record_s = 0, awake_sum = 0, contact_sum = 0, iter_sum = 0;
+  double record_s = 0, awake_sum = 0, contact_sum = 0, iter_sum = 0, pair_sum = 0, hit_sum = 0, edge_sum = 0;
   const int v = model.vessel;
   for (long k = 1; k <= steps; ++k) {
     world.step();
@@ -120,6 +120,9 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
     awake_sum += rep.awake_floes;
     contact_sum += rep.contacts;
     iter_sum += rep.solve.iterations;
+    pair_sum += world.collision_stats().broadphase_pairs;
+    hit_sum += world.collision_stats().narrowphase_hits;
+    edge_sum += world.collision_stats().edge_contacts;
     // Frames at t = k * output_interval (k >= 1): all bodies, vessel first (body id 0).
     if (k % every == 0) {
       r.frame_time_s.push_back(s.time_s);
@@ -148,6 +151,9 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
   stats.mean_awake_floes = awake_sum / steps;
   stats.mean_contacts = contact_sum / steps;
   stats.mean_iterations = iter_sum / steps;
+  stats.mean_pairs = pair_sum / steps;
+  stats.mean_touching = hit_sum / steps;
+  stats.mean_edge_pairs = edge_sum / steps;
 
   // Geometry: floe outlines in the body frame with their thickness; the hull surface in the vessel body frame.
   r.floe_vertex_offset.push_back(0);
@@ -278,7 +284,8 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   const Model model = build_model(field, &hull, o);
 
   std::ostringstream out;
-  out << "floesim-simulate: " << model.floe_count() << " floes (" << model.removed_floe_ids.size()
+  out << "floesim-simulate: " << model.floe_count() << " floes in " << model.parts.size() << " convex parts ("
+      << model.removed_floe_ids.size()
       << " removed: they overlapped the vessel's initial footprint";
   if (model.small_overlaps) out << "; " << model.small_overlaps << " small floe-floe overlaps left to the solver";
   out << "), vessel " << model.vessel_info.mass_kg / 1e3 << " t, L_wl " << model.vessel_info.length_wl_m
@@ -307,6 +314,8 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
       << ms << " ms/step, " << o.duration_s / stats.wall_s << " simulated s per wall s\n";
   rep << "mean awake floes " << stats.mean_awake_floes << ", mean contacts " << stats.mean_contacts
       << ", mean solver sweeps " << stats.mean_iterations << "\n";
+  rep << "mean part pairs per step: " << stats.mean_pairs << " from the broad phase, " << stats.mean_touching
+      << " touching (" << stats.mean_edge_pairs << " edge-on-edge, single point)\n";
   rep << "stage times (ms/step):";
   for (int i = 0; i <= kStageCount; ++i)
     rep << " " << (i < kStageCount ? stage_name(i) : "record") << " " << std::setprecision(3)

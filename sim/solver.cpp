@@ -85,7 +85,7 @@ void prepare_contacts(const Model& model, const SolverBodies& sb, State& state, 
     c.pn = std::clamp(best->impulse.dot(c.normal), 0.0, c.max_normal_impulse);
     c.pt1 = best->impulse.dot(c.t1);
     c.pt2 = best->impulse.dot(c.t2);
-    const double lim = c.mu * c.pn, pt = std::hypot(c.pt1, c.pt2);
+    const double lim = c.mu * c.pn, pt = std::sqrt(c.pt1 * c.pt1 + c.pt2 * c.pt2);
     if (pt > lim) {
       const double s = pt > 0 ? lim / pt : 0.0;
       c.pt1 *= s;
@@ -118,7 +118,7 @@ SolverReport solve_contacts(const Model& model, const SolverBodies& sb, State& s
       const double lim = c.mu * c.pn;
       const double v1 = rel_velocity(state, c, c.t1), v2 = rel_velocity(state, c, c.t2);
       double p1 = c.pt1 - c.mass_t1 * v1, p2 = c.pt2 - c.mass_t2 * v2;
-      const double pt = std::hypot(p1, p2);
+      const double pt = std::sqrt(p1 * p1 + p2 * p2);
       if (pt > lim) {
         const double s = pt > 0 ? lim / pt : 0.0;
         p1 *= s;
