@@ -22,7 +22,7 @@ struct DigitiseOptions {
   double brash_cutoff_m2 = 10.0;         // connected ice pieces smaller than this are brash and dropped
   double marker_dynamic_m = 1.5;         // a bump of the distance map must rise this much to seed its own floe
   double min_marker_separation_m = 3.0;  // seeds closer than this (within one ice piece) are one floe
-  double neck_ratio = 0.7;               // two pieces whose neck half-width reaches this fraction of the smaller
+  double neck_ratio = 0.85;              // two pieces whose neck half-width reaches this fraction of the smaller
                                          // one's inscribed radius are one floe with a dent (see segment.h)
   double min_floe_area_m2 = 10.0;        // split pieces smaller than this rejoin their neighbour; lone ones dropped
   double simplify_tolerance_m = 0.5;     // Douglas-Peucker tolerance of the outlines

@@ -68,8 +68,9 @@ ScoreResult score_against_truth(const cv::Mat& labels_in, const FloeField& truth
   }
   res.predicted = static_cast<int>(area_p.size());
   res.truth = static_cast<int>(truth.floes.size());
-  res.precision = res.predicted ? double(res.matched) / res.predicted : 0.0;
-  res.recall = res.truth ? double(res.matched) / res.truth : 0.0;
+  // Nothing to find and nothing found is perfect agreement, not a score of zero.
+  res.precision = res.predicted ? double(res.matched) / res.predicted : (res.truth ? 0.0 : 1.0);
+  res.recall = res.truth ? double(res.matched) / res.truth : (res.predicted ? 0.0 : 1.0);
   res.f1 = res.precision + res.recall > 0 ? 2 * res.precision * res.recall / (res.precision + res.recall) : 0.0;
   res.mean_iou = res.matched ? iou_sum / res.matched : 0.0;
   res.concentration_predicted = n_valid ? double(n_p) / n_valid : 0.0;

@@ -19,7 +19,8 @@ struct ScoreResult {
 // The truth polygons are rasterised on the label image's grid (pixel-centre rule, raster.h). Predicted regions
 // and truth floes are matched one-to-one, greedily by decreasing IoU (ties: lower ids first); a pair matches when
 // IoU >= min_iou (0.5 makes the matching unique anyway). Concentrations are pixel fractions of the valid area
-// (`valid`: CV_8U, non-zero = data; empty = the whole image). labels: CV_32S or CV_16U.
+// (`valid`: CV_8U, non-zero = data; empty = the whole image). labels: CV_32S or CV_16U. With no truth floe and
+// no predicted region, precision, recall and F1 are 1 (nothing to find, nothing found).
 ScoreResult score_against_truth(const cv::Mat& labels, const FloeField& truth, double metres_per_pixel,
                                 const cv::Mat& valid = cv::Mat(), double min_iou = 0.5);
 

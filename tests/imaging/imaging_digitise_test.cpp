@@ -72,6 +72,9 @@ TEST(Score, PerfectAndDegradedPredictions) {
   const ScoreResult s2 = score_against_truth(merged, syn.truth, s);
   EXPECT_LE(s2.matched, perfect.truth - 1);
   EXPECT_EQ(s2.predicted, perfect.truth - 1);
+  // Open water predicted as open water: perfect.
+  const ScoreResult empty = score_against_truth(cv::Mat(50, 50, CV_32S, cv::Scalar(0)), FloeField{}, s);
+  EXPECT_DOUBLE_EQ(empty.f1, 1.0);
 }
 
 TEST(PowerLaw, RecoversTheExponentOfAKnownSample) {
