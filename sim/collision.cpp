@@ -31,6 +31,7 @@ struct PartWorld {
   std::vector<Vec3> v;        // vertices
   std::vector<Vec3> n;        // face normals
   std::vector<double> d;      // face plane offsets n.x
+  Vec3 lo, hi;                // exact box
 };
 
 struct PairCandidate {
@@ -69,7 +70,10 @@ struct CollisionWorld::Impl {
 
   Impl(const Model& m, ThreadPool& p) : model(m), pool(p), scratch(p.threads()) {}
 
-  void place_part(int p, const Vec3& x, const Quat& q) {
+  // Moves part p to the pose (x, q). Returns true when its box in the tree must change: the tree holds a box
+  // enlarged by kTreeMargin (Box2D's fat boxes), so that small motions do not re-insert the leaf every step.
+  static constexpr double kTreeMargin = 0.1;  // m
+  bool place_part(int p, const Vec3& x, const Quat& q) {
     const ConvexPart& cp = model.parts[p];
     PartWorld& w = world[p];
     const Mat3 R = q.toRotationMatrix();
@@ -83,8 +87,13 @@ struct CollisionWorld::Impl {
       w.n[f] = R * cp.face_normal[f];
       w.d[f] = w.n[f].dot(w.v[cp.faces[f][0]]);
     }
+    w.lo = lo;
+    w.hi = hi;
     objects[p]->setTransform(R, x);
-    objects[p]->set_aabb(lo, hi);
+    const fcl::AABBd& fat = objects[p]->getAABB();
+    if ((lo.array() >= fat.min_.array()).all() && (hi.array() <= fat.max_.array()).all()) return false;
+    objects[p]->set_aabb(lo - Vec3::Constant(kTreeMargin), hi + Vec3::Constant(kTreeMargin));
+    return true;
   }
 
   static bool broadphase_callback(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) {
@@ -93,9 +102,11 @@ struct CollisionWorld::Impl {
     int b1 = self->model.parts[p1].body, b2 = self->model.parts[p2].body;
     if (b1 == b2) return false;
     if (!self->state->awake[b1] && !self->state->awake[b2]) return false;
-    // The tree keeps a leaf's old box while the new one fits inside it (FCL's HierarchyTree::update), so its pairs
-    // depend on the history; the exact boxes make the candidate set a function of the current poses only.
-    if (!o1->getAABB().overlap(o2->getAABB())) return false;
+    // The tree's boxes are enlarged and depend on the history of the leaf; the exact boxes make the candidate set a
+    // function of the current poses only.
+    const PartWorld& w1 = self->world[p1];
+    const PartWorld& w2 = self->world[p2];
+    if ((w1.lo.array() > w2.hi.array()).any() || (w2.lo.array() > w1.hi.array()).any()) return false;
     PairCandidate c = b1 < b2 ? PairCandidate{b1, p1, b2, p2} : PairCandidate{b2, p2, b1, p1};
     self->pairs.push_back(c);
     return false;  // keep going
@@ -323,8 +334,8 @@ void CollisionWorld::update_bodies(const State& state, const std::vector<int>& m
   for (int b : moved) {
     const Body& body = m.model.bodies[b];
     for (int p = body.first_part; p < body.first_part + body.part_count; ++p) {
-      m.place_part(p, state.position[b], state.orientation[b]);
-      (m.in_awake_tree[b] ? m.moved_awake : m.moved_sleeping).push_back(m.objects[p].get());
+      if (m.place_part(p, state.position[b], state.orientation[b]))
+        (m.in_awake_tree[b] ? m.moved_awake : m.moved_sleeping).push_back(m.objects[p].get());
     }
   }
   if (!m.moved_awake.empty()) m.awake_tree.update(m.moved_awake);

@@ -19,8 +19,37 @@ Wrench gravity_force(const Model& m, const Body& b) {
   return w;
 }
 
+bool prism_submerged(const Body& b, const BodyKinematics& k, double& volume, Vec3& centroid) {
+  // A floe is a prism along its body z (section A about its centroid, height h). With the water plane written in
+  // the body frame as m.p = c (m = R^T z, c = -x_z), a column at (x, y) is under water over the length
+  // l(x, y) = l0 - a x - b y from the bottom (a = m_x/m_z, b = m_y/m_z). While the plane cuts only the side walls
+  // (0 <= l <= h everywhere), volume and centre of buoyancy follow from the section's area and second moments.
+  if (b.kind != BodyKind::floe || b.section_area <= 0) return false;
+  const Vec3 mv = k.R.row(2).transpose();
+  if (mv.z() < 0.5) return false;  // tilted beyond 60 degrees: clip the mesh
+  const double h = b.thickness_m, A = b.section_area;
+  const double a = mv.x() / mv.z(), bb = mv.y() / mv.z();
+  const double l0 = -k.x.z() / mv.z() + h / 2;
+  const double spread = b.section_radius * std::sqrt(a * a + bb * bb);
+  if (l0 - spread < 0 || l0 + spread > h) return false;
+  volume = A * l0;
+  const double mx = -a * b.section_sxx - bb * b.section_sxy;
+  const double my = -a * b.section_sxy - bb * b.section_syy;
+  const double l2 = A * l0 * l0 + a * a * b.section_sxx + 2 * a * bb * b.section_sxy + bb * bb * b.section_syy;
+  const double ms = 0.5 * (l2 - h * volume);
+  centroid = k.x + k.R * Vec3(mx / volume, my / volume, ms / volume);
+  return true;
+}
+
 Wrench buoyancy_force(const Model& m, const Body& b, const BodyKinematics& k, ForceScratch& s) {
   Wrench w;
+  const double g = -m.gravity.z();
+  double volume;
+  Vec3 centre;
+  if (prism_submerged(b, k, volume, centre)) {
+    w.add_at(Vec3(0, 0, m.options.water.density_kg_m3 * g * volume), centre - k.x);
+    return w;
+  }
   const auto& mv = b.buoyancy_mesh.vertices;
   s.vertices.resize(mv.size());
   bool any_below = false;
@@ -31,7 +60,6 @@ Wrench buoyancy_force(const Model& m, const Body& b, const BodyKinematics& k, Fo
   if (!any_below) return w;
   const Submerged sub = submerged_part(s.vertices, b.buoyancy_mesh.triangles, 0.0);
   if (sub.volume <= 0) return w;
-  const double g = -m.gravity.z();
   w.add_at(Vec3(0, 0, m.options.water.density_kg_m3 * g * sub.volume), sub.centroid - k.x);
   return w;
 }
@@ -64,6 +92,11 @@ Wrench floe_water_drag(const Model& m, const Body& b, const BodyKinematics& k, F
     if (all_below) {
       ac.area = f.area;
       ac.centroid = k.x + k.R * f.centroid;
+    } else if (f.count <= 8) {
+      // Side walls (quads) cut by the waterline: clipped on the stack.
+      Vec3 in[8], out[9];
+      for (int i = 0; i < f.count; ++i) in[i] = s.vertices[b.drag_face_index[f.first + i]];
+      ac = polygon_area_centroid(out, clip_polygon_z(in, f.count, 0.0, true, out));
     } else {
       // Gather the face's vertices, then clip (the top/bottom faces of large floes can have many vertices).
       s.face.clear();

@@ -35,7 +35,11 @@ struct ForceScratch {
 };
 
 Wrench gravity_force(const Model& m, const Body& b);
-// rho_w g V_sub at the centre of buoyancy, from clipping the body's closed surface at z = 0.
+// Submerged volume and centre of buoyancy (world) of a floe slab in closed form, when the water plane cuts only
+// its side walls; false otherwise (then the mesh is clipped).
+bool prism_submerged(const Body& b, const BodyKinematics& k, double& volume, Vec3& centroid);
+// rho_w g V_sub at the centre of buoyancy: closed form for floe slabs cut through their sides, else from clipping
+// the body's closed surface at z = 0.
 Wrench buoyancy_force(const Model& m, const Body& b, const BodyKinematics& k, ForceScratch& s);
 // Linear heave (world z) and roll/pitch (body x, y) damping from the damping ratios.
 Wrench hydrostatic_damping(const Model& m, const Body& b, const BodyKinematics& k);

@@ -55,6 +55,21 @@ inline void clip_polygon_z(const Vec3* p, int n, double z0, bool below, std::vec
   }
 }
 
+// The same into a caller's array of at least n + 1 points (a convex polygon gains at most one vertex); returns
+// the count.
+inline int clip_polygon_z(const Vec3* p, int n, double z0, bool below, Vec3* out) {
+  int k = 0;
+  for (int i = 0; i < n; ++i) {
+    const Vec3& a = p[i];
+    const Vec3& b = p[i + 1 == n ? 0 : i + 1];
+    const bool ia = below ? a.z() <= z0 : a.z() >= z0;
+    const bool ib = below ? b.z() <= z0 : b.z() >= z0;
+    if (ia) out[k++] = a;
+    if (ia != ib) out[k++] = a + ((z0 - a.z()) / (b.z() - a.z())) * (b - a);
+  }
+  return k;
+}
+
 // 2D cross product of (b - a) and (c - a).
 inline double cross2(const Vec2& a, const Vec2& b, const Vec2& c) {
   return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());

@@ -485,6 +485,17 @@ Model build_model(const FloeField& field, const HullModel* hull, const SimulateO
     b.thickness_m = h;
     for (const Vec2& v : fg.outline) b.outline.push_back(v - c);
     b.buoyancy_mesh = extrude_polygon(b.outline, -h / 2, h);
+    // Second moments of the section (Green's theorem over the CCW outline, which is centred on its centroid).
+    for (size_t i = 0; i < b.outline.size(); ++i) {
+      const Vec2& p = b.outline[i];
+      const Vec2& q = b.outline[(i + 1) % b.outline.size()];
+      const double cr = p.x() * q.y() - q.x() * p.y();
+      b.section_area += cr / 2;
+      b.section_sxx += cr * (p.x() * p.x() + p.x() * q.x() + q.x() * q.x()) / 12;
+      b.section_syy += cr * (p.y() * p.y() + p.y() * q.y() + q.y() * q.y()) / 12;
+      b.section_sxy += cr * (p.x() * q.y() + 2 * p.x() * p.y() + 2 * q.x() * q.y() + q.x() * p.y()) / 24;
+      b.section_radius = std::max(b.section_radius, p.norm());
+    }
     const MassProperties mp = mass_properties(b.buoyancy_mesh);
     FLOESIM_REQUIRE(mp.volume > 0, "floe ", f.id, ": internal: non-positive slab volume");
     b.mass_kg = rho_i * mp.volume;

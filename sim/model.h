@@ -53,6 +53,10 @@ struct Body {
   std::vector<DragFace> drag_faces;
   int top_face = -1;                   // index into drag_faces of the top face (wind on floes)
   double thickness_m = 0;              // floes
+  // Floes: plan-section properties about the centre of mass (exact prism buoyancy without clipping).
+  double section_area = 0;             // m^2
+  double section_sxx = 0, section_syy = 0, section_sxy = 0;  // integrals of x^2, y^2, xy over the section, m^4
+  double section_radius = 0;           // largest distance of an outline vertex from the centre, m
   Polygon outline;                     // floes: CCW outline in the body frame (x, y)
   // Linear damping coefficients from the hydrostatic stiffness at equilibrium and the damping ratios.
   double heave_damping = 0;            // N s/m, along world z

@@ -33,19 +33,13 @@ void push_body_wrench(std::vector<double>& col, const Mat3& R, const Wrench& w) 
 std::vector<double> moving_average(const std::vector<double>& x, size_t n) {
   std::vector<double> y;
   if (n == 0 || x.size() < n) return y;
+  // Each window summed afresh (no running-sum residue: a window of zeros averages to exactly 0); O(size x n)
+  // additions, a few tens of millions at most for the summary.
   y.reserve(x.size() - n + 1);
-  // Running sum, re-summed exactly every window to keep rounding from accumulating over long series.
-  double s = 0;
-  for (size_t i = 0; i < n; ++i) s += x[i];
-  y.push_back(s / n);
-  for (size_t i = n; i < x.size(); ++i) {
-    if ((i - n + 1) % n == 0) {
-      s = 0;
-      for (size_t k = i - n + 1; k <= i; ++k) s += x[k];
-    } else {
-      s += x[i] - x[i - n];
-    }
-    y.push_back(s / n);
+  for (size_t i = 0; i + n <= x.size(); ++i) {
+    double s = 0;
+    for (size_t k = i; k < i + n; ++k) s += x[k];
+    y.push_back(s / static_cast<double>(n));
   }
   return y;
 }
