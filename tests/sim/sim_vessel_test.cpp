@@ -78,6 +78,19 @@ TEST(SimVessel, TerminalSpeedUnderConstantThrust) {
   EXPECT_NEAR(u, 3.0, 0.003);
   EXPECT_NEAR(heading_of(R) * 180 / kPi, 30.0, 0.01);
   EXPECT_GT(R(2, 2), std::cos(0.2 * kPi / 180));  // no heel or trim beyond 0.2 deg
+
+  // The same thrust as a series (interpolated between its rows) gives the same motion.
+  const auto dir = testing::temp_dir("thrust_series");
+  std::ofstream(dir / "thrust.csv") << "time_s,thrust_N\n0," << r3 / 2 << "\n10," << r3 << "\n100," << r3 << "\n";
+  SimulateOptions os = o;
+  os.vessel.propulsion.mode = "thrust_series";
+  os.vessel.propulsion.thrust_file = (dir / "thrust.csv").string();
+  const Model ms = build_model(FloeField{}, &hull, os);
+  World ws(ms);
+  for (int i = 0; i < 500; ++i) ws.step();
+  EXPECT_NEAR(ws.report().thrust_n, 0.5 * r3 + 0.5 * r3 * (4.99 / 10), 1e-6 * r3);  // at t = 4.99 s
+  for (int i = 500; i < 3000; ++i) ws.step();
+  EXPECT_NEAR(surge_speed(ws), 3.0, 0.01);
 }
 
 // Speed mode: the PI controller brings the vessel from 1 to 2 m/s and settles at the open-water thrust (the
