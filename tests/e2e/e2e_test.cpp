@@ -95,7 +95,15 @@ TEST_F(TinyCase, FloeCountAgreesBetweenGeoJsonAndLabelImage) {
   EXPECT_EQ(ids.size(), floes.floes.size());
   for (const Floe& f : floes.floes) EXPECT_TRUE(ids.count(f.id)) << "floe " << f.id << " has no label pixels";
   const Json stats = load_json_file(run_ / "floes" / "stats.json");
-  EXPECT_EQ(stats.dump().find("nan"), std::string::npos);
+  EXPECT_EQ(stats["floe_count"].get<size_t>(), floes.floes.size());
+  // Concentration from the label image must equal the floe-pixel fraction of the valid (non-black) pixels.
+  int valid = 0, ice = 0;
+  for (int r = 0; r < labels.rows; ++r)
+    for (int c = 0; c < labels.cols; ++c) {
+      valid += image.at<uint8_t>(r, c) != 0;
+      ice += labels.at<uint16_t>(r, c) != 0;
+    }
+  EXPECT_NEAR(stats["ice_concentration"].get<double>(), double(ice) / valid, 1e-9);
 }
 
 TEST_F(TinyCase, SeriesFramesAndVideoAgreeWithTheSettings) {
