@@ -63,6 +63,7 @@ struct CollisionWorld::Impl {
   fcl::DynamicAABBTreeCollisionManagerd awake_tree, sleeping_tree;
   std::vector<uint8_t> in_awake_tree;  // per body
   std::vector<fcl::CollisionObjectd*> moved_awake, moved_sleeping;
+  std::vector<uint8_t> box_changed;    // per part, written by update_bodies
   std::vector<PairCandidate> pairs;
   const State* state = nullptr;  // during find_contacts (the broad-phase callback reads the awake flags)
   ThreadPool& pool;
@@ -331,12 +332,20 @@ void CollisionWorld::update_bodies(const State& state, const std::vector<int>& m
   Impl& m = *impl_;
   m.moved_awake.clear();
   m.moved_sleeping.clear();
+  // Poses in parallel (each part writes only its own data), tree updates in body order.
+  m.box_changed.resize(m.model.parts.size());
+  m.pool.parallel_for(static_cast<int>(moved.size()), [&](int begin, int end, int) {
+    for (int i = begin; i < end; ++i) {
+      const int b = moved[i];
+      const Body& body = m.model.bodies[b];
+      for (int p = body.first_part; p < body.first_part + body.part_count; ++p)
+        m.box_changed[p] = m.place_part(p, state.position[b], state.orientation[b]);
+    }
+  });
   for (int b : moved) {
     const Body& body = m.model.bodies[b];
-    for (int p = body.first_part; p < body.first_part + body.part_count; ++p) {
-      if (m.place_part(p, state.position[b], state.orientation[b]))
-        (m.in_awake_tree[b] ? m.moved_awake : m.moved_sleeping).push_back(m.objects[p].get());
-    }
+    for (int p = body.first_part; p < body.first_part + body.part_count; ++p)
+      if (m.box_changed[p]) (m.in_awake_tree[b] ? m.moved_awake : m.moved_sleeping).push_back(m.objects[p].get());
   }
   if (!m.moved_awake.empty()) m.awake_tree.update(m.moved_awake);
   if (!m.moved_sleeping.empty()) m.sleeping_tree.update(m.moved_sleeping);
