@@ -3,7 +3,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <cstdio>
 #include <fstream>
+#include <map>
 #include <iostream>
 #include <sstream>
 
@@ -258,8 +261,39 @@ std::vector<Artefact> prepare_run(const RunOptions& o) {
   return arts;
 }
 
+std::vector<StageTiming> stage_timings(const fs::path& run_dir, fs::file_time_type since) {
+  // The first output of each stage, in the order prepare_run lists them.
+  const std::vector<std::pair<std::string, std::string>> firsts = {
+      {"synth", "image/image.png"},   {"digitise", "floes/floes.geojson"}, {"hull", "hull/hull.obj"},
+      {"simulate", "sim/results.h5"}, {"plot", "plots/surge_ice_load.png"}, {"render", "video/transit.mp4"}};
+  std::map<std::string, double> last;  // output path -> wall seconds of its last build
+  std::ifstream log(run_dir / ".ninja_log");
+  std::string line;
+  while (std::getline(log, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream is(line);
+    long long start = 0, end = 0, mt = 0;
+    std::string path;
+    if (is >> start >> end >> mt) {
+      is >> std::ws;
+      std::getline(is, path, '\t');
+      last[path] = (end - start) / 1000.0;
+    }
+  }
+  std::vector<StageTiming> out;
+  for (auto& [stage, rel] : firsts) {
+    const fs::path p = run_dir / rel;
+    auto it = last.find(p.string());
+    if (it == last.end() || !fs::exists(p)) continue;
+    out.push_back({stage, fs::last_write_time(p) >= since, it->second});
+  }
+  return out;
+}
+
 int run_case(const RunOptions& o) {
   const auto arts = prepare_run(o);
+  // Outputs newer than this ran in this invocation (minus a margin for file systems with coarse times).
+  const auto started = fs::file_time_type::clock::now() - std::chrono::milliseconds(5);
   const fs::path run = fs::absolute(o.run_dir);
   std::vector<std::string> args = {FLOESIM_NINJA, "-C", run.string(), "-f", "build.ninja"};
   if (o.jobs > 0) args.push_back("-j" + std::to_string(o.jobs));
@@ -286,6 +320,13 @@ int run_case(const RunOptions& o) {
     return code;
   }
   if (!o.dry_run) {
+    std::cout << "\nStage wall times:\n";
+    for (const auto& t : stage_timings(run, started)) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%8.2f s", t.wall_s);
+      std::cout << "  " << t.stage << std::string(10 - std::min<size_t>(9, t.stage.size()), ' ')
+                << (t.ran ? buf : "   up to date") << "\n";
+    }
     std::cout << "\nArtefacts in " << run.string() << ":\n";
     for (auto& a : arts) std::cout << "  " << a.file << std::string(a.file.size() < 28 ? 28 - a.file.size() : 1, ' ') << a.content << "\n";
   }

@@ -22,6 +22,17 @@ struct Artefact {
   std::string stage, file, content;
 };
 
+struct StageTiming {
+  std::string stage;
+  bool ran = false;       // ran in this invocation (else it was up to date)
+  double wall_s = 0;      // from ninja's log
+};
+
+// Reads RUN/.ninja_log: the last recorded wall time of each stage, and whether its first output is newer than
+// `since` (it ran in this invocation).
+std::vector<StageTiming> stage_timings(const std::filesystem::path& run_dir,
+                                       std::filesystem::file_time_type since);
+
 // Builds RUN/build.ninja and RUN/config/*.json from CASE/case.json (strictly validated at the top level).
 // Returns the artefacts the run produces (for the closing table).
 std::vector<Artefact> prepare_run(const RunOptions& o);
