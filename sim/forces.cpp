@@ -73,13 +73,59 @@ Wrench hydrostatic_damping(const Model& m, const Body& b, const BodyKinematics& 
   return w;
 }
 
+namespace {
+// Form drag and skin friction on one submerged face (world normal n, area, centroid c), PHYSICS.md §3.2.
+inline Wrench face_drag(const Model& m, const BodyKinematics& k, const Vec3& n, double area, const Vec3& c, double cd,
+                        double cf, double half_rho) {
+  Wrench w;
+  const Vec3 r = c - k.x;
+  const Vec3 vrel = k.v + k.w.cross(r) - m.current;
+  const double vn = vrel.dot(n);
+  Vec3 force = Vec3::Zero();
+  if (vn > 0) force -= half_rho * cd * area * vn * vn * n;  // face advancing into the water
+  const Vec3 vt = vrel - vn * n;
+  force -= half_rho * cf * area * vt.norm() * vt;
+  w.add_at(force, r);
+  return w;
+}
+}  // namespace
+
 Wrench floe_water_drag(const Model& m, const Body& b, const BodyKinematics& k, ForceScratch& s) {
   Wrench w;
   const double cd = m.options.water.form_drag_cd, cf = m.options.water.skin_friction_cf;
   const double half_rho = 0.5 * m.options.water.density_kg_m3;
   s.vertices.resize(b.drag_vertices.size());
   for (size_t i = 0; i < b.drag_vertices.size(); ++i) s.vertices[i] = k.x + k.R * b.drag_vertices[i];
+  // Waterline points of the vertical edges (bottom ring vertex i, top ring vertex n + i) that cross the water
+  // plane: shared by the two side walls of each edge.
+  const int n = static_cast<int>(b.drag_vertices.size() / 2);
+  s.waterline.resize(n);
+  s.crosses.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const Vec3& lo = s.vertices[i];
+    const Vec3& hi = s.vertices[n + i];
+    const bool cross = lo.z() < 0 && hi.z() > 0;
+    s.crosses[i] = cross;
+    if (cross) s.waterline[i] = lo + (-lo.z() / (hi.z() - lo.z())) * (hi - lo);
+  }
   for (const DragFace& f : b.drag_faces) {
+    if (f.side >= 0) {
+      const int i = f.side, j = i + 1 == n ? 0 : i + 1;
+      if (s.crosses[i] && s.crosses[j]) {
+        // The usual case: both vertical edges cross the waterline; the submerged part is the quad
+        // (b_i, b_j, w_j, w_i), two triangles with signed areas along the face normal.
+        const Vec3 nw = k.R * f.normal;
+        const Vec3 &bi = s.vertices[i], &bj = s.vertices[j], &wi = s.waterline[i], &wj = s.waterline[j];
+        const double a1 = 0.5 * (bj - bi).cross(wj - bi).dot(nw), a2 = 0.5 * (wj - bi).cross(wi - bi).dot(nw);
+        const double area = a1 + a2;
+        if (area <= 0) continue;
+        const Vec3 c = (a1 * (bi + bj + wj) + a2 * (bi + wj + wi)) / (3 * area);
+        w += face_drag(m, k, nw, area, c, cd, cf, half_rho);
+        continue;
+      }
+    }
+    // Otherwise the general case below.
+
     // Submerged part of the face (full, none, or clipped at the water plane).
     bool all_below = true, any_below = false;
     for (int i = 0; i < f.count; ++i) {
@@ -99,21 +145,13 @@ Wrench floe_water_drag(const Model& m, const Body& b, const BodyKinematics& k, F
       ac = polygon_area_centroid(out, clip_polygon_z(in, f.count, 0.0, true, out));
     } else {
       // Gather the face's vertices, then clip (the top/bottom faces of large floes can have many vertices).
-      s.face.clear();
-      for (int i = 0; i < f.count; ++i) s.face.push_back(s.vertices[b.drag_face_index[f.first + i]]);
-      clip_polygon_z(s.face.data(), f.count, 0.0, true, s.cut);
-      ac = polygon_area_centroid(s.cut.data(), static_cast<int>(s.cut.size()));
+      s.big.clear();
+      for (int i = 0; i < f.count; ++i) s.big.push_back(s.vertices[b.drag_face_index[f.first + i]]);
+      clip_polygon_z(s.big.data(), f.count, 0.0, true, s.big_cut);
+      ac = polygon_area_centroid(s.big_cut.data(), static_cast<int>(s.big_cut.size()));
     }
     if (ac.area <= 0) continue;
-    const Vec3 n = k.R * f.normal;
-    const Vec3 r = ac.centroid - k.x;
-    const Vec3 vrel = k.v + k.w.cross(r) - m.current;
-    const double vn = vrel.dot(n);
-    Vec3 force = Vec3::Zero();
-    if (vn > 0) force -= half_rho * cd * ac.area * vn * vn * n;  // face advancing into the water
-    const Vec3 vt = vrel - vn * n;
-    force -= half_rho * cf * ac.area * vt.norm() * vt;
-    w.add_at(force, r);
+    w += face_drag(m, k, k.R * f.normal, ac.area, ac.centroid, cd, cf, half_rho);
   }
   return w;
 }
@@ -122,10 +160,10 @@ Wrench floe_wind_drag(const Model& m, const Body& b, const BodyKinematics& k, Fo
   Wrench w;
   if (m.wind.squaredNorm() == 0 || b.top_face < 0) return w;
   const DragFace& f = b.drag_faces[b.top_face];
-  s.face.clear();
-  for (int i = 0; i < f.count; ++i) s.face.push_back(k.x + k.R * b.drag_vertices[b.drag_face_index[f.first + i]]);
-  clip_polygon_z(s.face.data(), f.count, 0.0, false, s.cut);
-  const AreaCentroid ac = polygon_area_centroid(s.cut.data(), static_cast<int>(s.cut.size()));
+  s.big.clear();
+  for (int i = 0; i < f.count; ++i) s.big.push_back(k.x + k.R * b.drag_vertices[b.drag_face_index[f.first + i]]);
+  clip_polygon_z(s.big.data(), f.count, 0.0, false, s.big_cut);
+  const AreaCentroid ac = polygon_area_centroid(s.big_cut.data(), static_cast<int>(s.big_cut.size()));
   if (ac.area <= 0) return w;
   const Vec3 n = k.R * f.normal;
   const Vec3 r = ac.centroid - k.x;

@@ -31,7 +31,10 @@ struct BodyKinematics {
 
 // Reusable buffers of one worker (no allocation in the hot loop once warmed up).
 struct ForceScratch {
-  std::vector<Vec3> vertices, face, cut;
+  std::vector<Vec3> vertices;    // transformed vertices of the body
+  std::vector<Vec3> waterline;    // per vertical edge of a floe: where it crosses the water plane
+  std::vector<uint8_t> crosses;   // per vertical edge: 1 if it crosses the water plane
+  std::vector<Vec3> big, big_cut; // a large face and its clipped part
 };
 
 Wrench gravity_force(const Model& m, const Body& b);

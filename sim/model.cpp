@@ -541,6 +541,7 @@ Model build_model(const FloeField& field, const HullModel* hull, const SimulateO
       const Vec2 e = b.outline[j] - b.outline[i];
       const Vec3 nrm = Vec3(e.y(), -e.x(), 0).normalized();  // outward for a CCW ring
       add_face({i, j, n + j, n + i}, nrm);
+      b.drag_faces.back().side = i;
     }
     if (o.water.enabled)
       set_damping(b, o, o.water.floe_heave_damping_ratio, o.water.floe_roll_pitch_damping_ratio,

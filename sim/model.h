@@ -37,6 +37,7 @@ struct DragFace {
   Vec3 normal = Vec3::Zero();  // outward, body frame
   double area = 0;             // m^2
   Vec3 centroid = Vec3::Zero();  // body frame (used as is when the whole face is under water)
+  int side = -1;                 // side wall between ring vertices side and side + 1 (-1: top or bottom)
 };
 
 struct Body {
