@@ -155,6 +155,27 @@ TEST_F(TinyCase, ChangedRenderParameterRerunsOnlyRender) {
   EXPECT_NE(mtime(run_ / "video" / "transit.mp4"), t_video);
 }
 
+TEST_F(TinyCase, ChangedSimulateParameterRerunsSimulateAndEverythingDownstream) {
+  ASSERT_EQ(first_.code, 0) << first_.text;
+  const auto t_image = mtime(run_ / "image" / "image.png");
+  const auto t_floes = mtime(run_ / "floes" / "floes.geojson");
+  const auto t_hull = mtime(run_ / "hull" / "hull.obj");
+  const auto t_results = mtime(run_ / "sim" / "results.h5");
+  const auto t_plot = mtime(run_ / "plots" / "surge_ice_load.png");
+  const auto t_video = mtime(run_ / "video" / "transit.mp4");
+  Json c = case_json();
+  c["simulate"]["steady_start_s"] = c["simulate"]["steady_start_s"].get<double>() + 0.5;
+  write_case(c);
+  const RunOutput again = run_case(case_, run_);
+  ASSERT_EQ(again.code, 0) << again.text;
+  EXPECT_EQ(mtime(run_ / "image" / "image.png"), t_image);
+  EXPECT_EQ(mtime(run_ / "floes" / "floes.geojson"), t_floes);
+  EXPECT_EQ(mtime(run_ / "hull" / "hull.obj"), t_hull);
+  EXPECT_NE(mtime(run_ / "sim" / "results.h5"), t_results);
+  EXPECT_NE(mtime(run_ / "plots" / "surge_ice_load.png"), t_plot);
+  EXPECT_NE(mtime(run_ / "video" / "transit.mp4"), t_video);
+}
+
 TEST_F(TinyCase, FailedStageStopsAndLeavesNothingThatLooksComplete) {
   ASSERT_EQ(first_.code, 0) << first_.text;
   Json c = case_json();
