@@ -108,8 +108,17 @@ DigitiseResult run_digitise(const DigitiseRequest& req) {
   FLOESIM_REQUIRE(!req.out_dir.empty(), "--out: an output directory is required");
   std::vector<std::string> load_notes;
   const cv::Mat gray = load_grayscale_image(req.image, o.max_pixels, &load_notes);
+  FLOESIM_REQUIRE(req.truth.empty() || req.truth_mask.empty(),
+                  "--truth and --truth-mask: give one truth, the polygons or the mask");
   std::optional<FloeField> truth;
   if (!req.truth.empty()) truth = read_floes(req.truth);
+  cv::Mat truth_labels;
+  if (!req.truth_mask.empty()) {
+    truth_labels = load_label_image(req.truth_mask, "truth mask");
+    FLOESIM_REQUIRE(truth_labels.size() == gray.size(), req.truth_mask.string(), ": the mask is ", truth_labels.cols,
+                    " x ", truth_labels.rows, " px but the image is ", gray.cols, " x ", gray.rows,
+                    " px; a mask must be on the photograph's pixel grid");
+  }
 
   // 2. The computation.
   DigitiseResult res = digitise(gray, req.metres_per_pixel, o, req.image.string());
@@ -123,6 +132,8 @@ DigitiseResult run_digitise(const DigitiseRequest& req) {
                   std::to_string(res.floes.height_m) + " m; wrong truth file or wrong --metres-per-pixel?");
     res.score = score_against_truth(res.seg.labels, *truth, req.metres_per_pixel, res.seg.valid);
   }
+  if (!truth_labels.empty())
+    res.score = score_labels(res.seg.labels, truth_labels, req.metres_per_pixel, res.seg.valid, req.mask_score);
 
   // 3. Artefacts: all written to temporary names, then moved into place together.
   nlohmann::json config = {{"metres_per_pixel", req.metres_per_pixel}, {"options", options_to_json(o)}};
@@ -130,6 +141,7 @@ DigitiseResult run_digitise(const DigitiseRequest& req) {
   if (!req.config_file.empty() && std::filesystem::exists(req.config_file))
     inputs.push_back({"config", req.config_file});
   if (!req.truth.empty()) inputs.push_back({"truth", req.truth});
+  if (!req.truth_mask.empty()) inputs.push_back({"truth_mask", req.truth_mask});
   const nlohmann::json prov = make_provenance("floesim-digitise", inputs, config);
   res.floes.provenance = prov;
   res.stats["warnings"] = res.warnings;

@@ -7,7 +7,8 @@
 //   overlay.png    the photograph in colour with each floe's outline and id
 //   stats.json     count, concentration, size distribution table, power-law fits, diagnostics, warnings,
 //                  provenance
-//   score.json     only with a truth file: precision, recall, F1, mean IoU, concentration error
+//   score.json     only with a truth file (GeoJSON polygons, or a labelled mask): precision, recall, F1, mean
+//                  IoU, pixel IoU, concentration error, KS distance of the log-area distributions (score.h)
 //
 // Bad input (each a floesim::Error naming the file, key or value, and nothing written): see image_io.h for the
 // image; metres_per_pixel must be finite and > 0; unknown or invalid config keys. An image without ice, or
@@ -48,6 +49,9 @@ struct DigitiseRequest {
   nlohmann::json config = nlohmann::json::object();  // DigitiseOptions as JSON (strict)
   std::filesystem::path config_file;                 // where `config` came from (messages, provenance); may be empty
   std::filesystem::path truth;                       // optional truth floes GeoJSON: writes score.json
+  std::filesystem::path truth_mask;  // optional hand-labelled mask (or 16-bit truth labels): writes score.json
+                                     // with the protocol of score.h (ScoreOptions::labelled_mask())
+  ScoreOptions mask_score = ScoreOptions::labelled_mask();
 };
 
 // Reads and checks everything, digitises, writes the artefacts (see above).

@@ -10,13 +10,16 @@ int main(int argc, char** argv) {
   CLI::App app{"floesim-digitise: segment the floes of an 8-bit grayscale photograph into polygons in metres"};
   app.name("floesim-digitise");
   imaging::DigitiseRequest req;
-  std::string image, out, config, truth;
+  std::string image, out, config, truth, truth_mask;
   double s = 0;
   app.add_option("IMAGE", image, "8-bit grayscale image (pure black = no data)");
   app.add_option("--metres-per-pixel", s, "ground size of one pixel (m)");
   app.add_option("--out", out, "output directory (floes.geojson, labels.png, overlay.png, stats.json)");
   app.add_option("--config", config, "JSON object of digitise options (see --help-config)");
   app.add_option("--truth", truth, "known floes (GeoJSON, e.g. floesim-synth's truth.geojson): writes score.json");
+  app.add_option("--truth-mask", truth_mask,
+                 "hand-labelled floe mask on the image's grid (floes = 8-connected components; or 16-bit truth "
+                 "labels): writes score.json with the labelled-mask protocol (floes >= 1 m^2, edge floes dropped)");
   app.add_flag_callback(
       "--help-config",
       [] {
@@ -33,6 +36,7 @@ int main(int argc, char** argv) {
     req.metres_per_pixel = s;
     req.out_dir = out;
     req.truth = truth;
+    req.truth_mask = truth_mask;
     if (!config.empty()) {
       req.config_file = config;
       req.config = load_json_file(config);
@@ -45,7 +49,8 @@ int main(int argc, char** argv) {
               << res.stats["ice_concentration"].get<double>() << " (" << secs << " s) -> " << out << "\n";
     if (res.score)
       std::cout << "floesim-digitise: against the truth: F1 " << res.score->f1 << ", precision " << res.score->precision
-                << ", recall " << res.score->recall << ", mean IoU " << res.score->mean_iou << ", concentration error "
-                << res.score->concentration_error << "\n";
+                << ", recall " << res.score->recall << ", mean IoU " << res.score->mean_iou << ", pixel IoU "
+                << res.score->pixel_iou << ", concentration error " << res.score->concentration_error
+                << ", KS(log area) " << res.score->ks_log_area << "\n";
   });
 }
