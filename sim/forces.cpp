@@ -264,7 +264,7 @@ Wrench vessel_autopilot(const Model& m, const Body& b, const BodyKinematics& k, 
   const double wn = 2 * kPi / a.natural_period_s;
   const Vec3 ez = k.R.col(2);
   const double r = k.w.dot(ez);
-  const double izz = b.inertia(2, 2);
+  const double izz = b.inertia(2, 2) + b.added_inertia.z();  // the yaw inertia the moment acts against
   const double mz = std::clamp(-izz * (wn * wn * e + 2 * a.damping_ratio * wn * r), -a.max_moment_nm, a.max_moment_nm);
   w.torque = mz * ez;
   return w;

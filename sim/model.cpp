@@ -49,9 +49,10 @@ void set_damping(Body& b, const SimulateOptions& o, double zeta_heave, double ze
                                                         Vec3::UnitX(), rho_g));
   const double c55 = std::max(0.0, rotational_stiffness(b.buoyancy_mesh, b.initial_position, b.initial_orientation,
                                                         Vec3::UnitY(), rho_g));
-  b.heave_damping = 2 * zeta_heave * std::sqrt(c33 * b.mass_kg);
-  b.roll_damping = 2 * zeta_roll * std::sqrt(c44 * b.inertia(0, 0));
-  b.pitch_damping = 2 * zeta_pitch * std::sqrt(c55 * b.inertia(1, 1));
+  // Critical damping of the mass-spring system that moves: the heave added mass is part of its mass.
+  b.heave_damping = 2 * zeta_heave * std::sqrt(c33 * (b.mass_kg + b.added_mass.z()));
+  b.roll_damping = 2 * zeta_roll * std::sqrt(c44 * (b.inertia(0, 0) + b.added_inertia.x()));
+  b.pitch_damping = 2 * zeta_pitch * std::sqrt(c55 * (b.inertia(1, 1) + b.added_inertia.y()));
 }
 
 struct Aabb2 {
@@ -145,6 +146,16 @@ TriMesh shifted(const TriMesh& m, const Vec3& d) {
   TriMesh r = m;
   for (Vec3& v : r.vertices) v += d;
   return r;
+}
+
+// The inverses of the mass matrix with the added mass (translational per body axis, rotational as a tensor).
+void set_added_mass(Body& b, const Vec3& added_mass, const Vec3& added_inertia) {
+  b.added_mass = added_mass;
+  b.added_inertia = added_inertia;
+  for (int i = 0; i < 3; ++i) b.inv_mass_added[i] = 1 / (b.mass_kg + added_mass[i]);
+  Mat3 I = b.inertia;
+  I.diagonal() += added_inertia;
+  b.inv_inertia_added = I.inverse();
 }
 
 }  // namespace
@@ -418,8 +429,23 @@ Model build_model(const FloeField& field, const HullModel* hull, const SimulateO
     b.id = 0;
     b.mass_kg = mass;
     b.inv_mass = 1 / mass;
-    b.inertia = mass * vp.radii_of_gyration_m.cwiseProduct(vp.radii_of_gyration_m).asDiagonal();
+    const std::vector<double>& Ig = o.vessel.inertia_kg_m2;
+    if (Ig.empty()) {
+      b.inertia = mass * vp.radii_of_gyration_m.cwiseProduct(vp.radii_of_gyration_m).asDiagonal();
+    } else {
+      // Given outright (body axes about the centre of mass); the radii reported are those of its diagonal.
+      const double xy = Ig.size() == 6 ? Ig[3] : 0, xz = Ig.size() == 6 ? Ig[4] : 0, yz = Ig.size() == 6 ? Ig[5] : 0;
+      b.inertia << Ig[0], xy, xz, xy, Ig[1], yz, xz, yz, Ig[2];
+      vp.radii_of_gyration_m = (b.inertia.diagonal() / mass).cwiseSqrt();
+    }
     b.inv_inertia = b.inertia.inverse();
+    // Added mass in surge and sway and added inertia in yaw (PHYSICS.md §3.3), only with water. Heave, roll and
+    // pitch keep none: the vessel's hydrostatic periods are not what the ice loads depend on.
+    if (o.water.enabled)
+      set_added_mass(b, Vec3(o.vessel.surge_added_mass_ratio * mass, o.vessel.sway_added_mass_ratio * mass, 0),
+                     Vec3(0, 0, o.vessel.yaw_added_inertia_ratio * b.inertia(2, 2)));
+    else
+      set_added_mass(b, Vec3::Zero(), Vec3::Zero());
     b.buoyancy_mesh = shifted(surf, -com);
     const double heading = o.vessel.heading_deg * kPi / 180;
     b.initial_orientation = Quat(Eigen::AngleAxisd(heading, Vec3::UnitZ()));
@@ -502,6 +528,9 @@ Model build_model(const FloeField& field, const HullModel* hull, const SimulateO
     b.inv_mass = 1 / b.mass_kg;
     b.inertia = rho_i * mp.inertia;
     b.inv_inertia = b.inertia.inverse();
+    // Heave added mass along the floe's normal (body z), C_a33 x mass, only with water (PHYSICS.md §3.3).
+    set_added_mass(b, Vec3(0, 0, o.water.enabled ? o.water.floe_heave_added_mass_ratio * b.mass_kg : 0.0),
+                   Vec3::Zero());
     b.initial_position = Vec3(c.x(), c.y(), h / 2 - draught_ratio * h);
     b.initial_orientation = Quat::Identity();
     const int body_index = static_cast<int>(model.bodies.size());
@@ -549,7 +578,63 @@ Model build_model(const FloeField& field, const HullModel* hull, const SimulateO
     model.bodies.push_back(std::move(b));
   }
 
-  // 5. Thrust series (the caller resolved the path relative to the config file).
+  // 5. Domain walls: static boxes outside the sides of the domain rectangle, overlapping at the corners (two walls
+  // never collide with each other: both sleep). A floe or the vessel's start overlapping a wall is an error.
+  if (!o.domain.walls.empty()) {
+    const std::vector<double>& e = o.domain.extent_m;
+    FLOESIM_REQUIRE(!e.empty() || (field.width_m > 0 && field.height_m > 0),
+                    "domain.walls: the floes file gives no field extent (width_m, height_m): set domain.extent_m");
+    const double x0 = e.empty() ? 0.0 : e[0], y0 = e.empty() ? 0.0 : e[1];
+    const double x1 = e.empty() ? field.width_m : e[2], y1 = e.empty() ? field.height_m : e[3];
+    const double t = o.domain.wall_thickness_m;
+    // Tall enough for the vessel's keel and any floe: from 2 m below the deepest hull point to 10 m above water.
+    double zlo = -10, zhi = 10;
+    if (hull)
+      for (const Vec3& v : model.bodies[0].buoyancy_mesh.vertices)
+        zlo = std::min(zlo, model.bodies[0].initial_position.z() + v.z() - 2);
+    for (const std::string& side : o.domain.walls) {
+      Vec2 lo, hi;
+      if (side == "west") lo = {x0 - t, y0 - t}, hi = {x0, y1 + t};
+      else if (side == "east") lo = {x1, y0 - t}, hi = {x1 + t, y1 + t};
+      else if (side == "south") lo = {x0 - t, y0 - t}, hi = {x1 + t, y0};
+      else lo = {x0 - t, y1}, hi = {x1 + t, y1 + t};
+      const Polygon rect = {lo, Vec2(hi.x(), lo.y()), hi, Vec2(lo.x(), hi.y())};
+      const Aabb2 rbox{lo, hi};
+      std::ostringstream bad;
+      int nbad = 0;
+      for (size_t k = (hull ? 1 : 0); k < model.bodies.size(); ++k) {
+        const Body& fb = model.bodies[k];
+        if (fb.kind != BodyKind::floe) continue;
+        Polygon world;
+        for (const Vec2& v : fb.outline) world.push_back(v + fb.initial_position.head<2>());
+        if (!rbox.overlaps(bounds(world))) continue;
+        bool hit = false;
+        for (const Polygon& piece : convex_decompose(world)) hit = hit || convex_intersection_area(piece, rect) > 1e-9;
+        if (hit && nbad++ < 10) bad << " " << fb.id;
+      }
+      FLOESIM_REQUIRE(nbad == 0, "domain wall \"", side, "\" (outside the domain [", x0, ", ", y0, "] - [", x1, ", ",
+                      y1, "] m) overlaps ", nbad, " floe(s), ids", bad.str(), nbad > 10 ? " ..." : "",
+                      ": enlarge domain.extent_m or drop the wall");
+      for (const Polygon& fp : footprint)
+        FLOESIM_REQUIRE(convex_intersection_area(fp, rect) <= 1e-9, "domain wall \"", side,
+                        "\" overlaps the vessel's start (vessel.x_m, vessel.y_m): move the vessel into the domain");
+      Body b;
+      b.kind = BodyKind::wall;
+      b.id = -1 - model.wall_count;
+      const Vec2 c = 0.5 * (lo + hi);
+      b.initial_position = Vec3(c.x(), c.y(), 0.5 * (zlo + zhi));
+      Polygon local;
+      for (const Vec2& v : rect) local.push_back(v - c);
+      b.first_part = static_cast<int>(model.parts.size());
+      b.part_count = 1;
+      model.parts.push_back(make_convex_part(extrude_polygon(local, -0.5 * (zhi - zlo), zhi - zlo),
+                                             static_cast<int>(model.bodies.size())));
+      model.bodies.push_back(std::move(b));  // mass 0: inv_mass and inverse inertia stay 0 (immovable)
+      ++model.wall_count;
+    }
+  }
+
+  // 6. Thrust series (the caller resolved the path relative to the config file).
   if (hull && o.vessel.propulsion.mode == "thrust_series")
     read_thrust_series(o.vessel.propulsion.thrust_file, model.thrust_time_s, model.thrust_n);
   return model;

@@ -29,7 +29,8 @@ struct ConvexPart {
   double bounding_radius = 0;           // about the body origin (for cheap rejection tests)
 };
 
-enum class BodyKind : uint8_t { vessel, floe };
+// wall: a fixed body (infinite mass, never awake, no forces) bounding the domain (options.domain).
+enum class BodyKind : uint8_t { vessel, floe, wall };
 
 // One planar face of a floe slab for the drag model: indices into Body::drag_vertices.
 struct DragFace {
@@ -46,6 +47,13 @@ struct Body {
   double mass_kg = 0, inv_mass = 0;
   Mat3 inertia = Mat3::Zero();      // body frame, about the centre of mass, kg m^2
   Mat3 inv_inertia = Mat3::Zero();
+  // Added mass (PHYSICS.md §3.3), body axes: translational (surge, sway, heave; kg) and rotational (roll, pitch,
+  // yaw; kg m^2). It enters the mass matrix only (inertia against every force, contacts included), never the
+  // weight. Inverses with it: inv_mass_added (translational, body axes) and inv_inertia_added (body frame).
+  Vec3 added_mass = Vec3::Zero();
+  Vec3 added_inertia = Vec3::Zero();
+  Vec3 inv_mass_added = Vec3::Zero();   // 1 / (m + A_ii), body axes (0 for walls)
+  Mat3 inv_inertia_added = Mat3::Zero();  // (I + diag(added_inertia))^-1, body frame
   int first_part = 0, part_count = 0;  // into Model::parts
   TriMesh buoyancy_mesh;               // closed surface in the body frame, clipped at z = 0 for buoyancy
   // Drag model of floes: the slab's faces (top, bottom, sides) over a ring of vertices in the body frame.
@@ -92,11 +100,13 @@ struct Model {
   Vec3 wind = Vec3::Zero();           // air velocity, world
   std::vector<double> thrust_time_s, thrust_n;  // thrust_series mode
 
-  int floe_count() const { return static_cast<int>(bodies.size()) - (vessel >= 0 ? 1 : 0); }
+  int wall_count = 0;                 // domain walls, the last bodies
+  int floe_count() const { return static_cast<int>(bodies.size()) - (vessel >= 0 ? 1 : 0) - wall_count; }
 };
 
 // Builds the model. `hull` may be null (floes only). Checks the inputs (thickness, overlaps) and throws
-// floesim::Error naming the floe ids. Floes overlapping the vessel's initial footprint are removed.
+// floesim::Error naming the floe ids. Floes overlapping the vessel's initial footprint are removed. Domain walls
+// (options.domain) come last; a floe or the vessel overlapping one is an error.
 Model build_model(const FloeField& floes, const HullModel* hull, const SimulateOptions& options);
 
 // Reads a thrust series CSV ("time_s,thrust_N" header, strictly increasing times); errors name the line.

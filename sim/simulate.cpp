@@ -122,6 +122,7 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
       r.frame_time_s.push_back(s.time_s);
       for (size_t b = 0; b < nb; ++b) {
         const Body& body = model.bodies[b];
+        if (body.kind == BodyKind::wall) continue;  // fixed; not part of the results layout
         r.state_body_id.push_back(body.kind == BodyKind::vessel ? 0 : body.id);
         const Vec3& x = s.position[b];
         const Quat& qb = s.orientation[b];

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "pipeline/options.h"
 #include "sim/hull.h"
@@ -49,6 +50,8 @@ struct WaterOptions {
   double vessel_roll_damping_ratio = 0.08;
   double vessel_pitch_damping_ratio = 0.2;
   double kinematic_viscosity_m2ps = 1.83e-6;  // sea water at 0 degC (ITTC-57 Reynolds number)
+  double floe_heave_added_mass_ratio = 1.0;   // C_a33: floe heave added mass / floe mass (PHYSICS.md §3.3)
+  bool floes_start_with_current = false;      // floes start drifting with the current (else at rest)
   template <class V>
   void visit(V& v) {
     v.field("enabled", enabled, "-", "buoyancy, drag, damping and open-water resistance on (false: vacuum)");
@@ -73,6 +76,12 @@ struct WaterOptions {
             in_range(0, 2));
     v.field("kinematic_viscosity_m2ps", kinematic_viscosity_m2ps, "m^2/s", "water kinematic viscosity (ITTC-57)",
             positive());
+    v.field("floe_heave_added_mass_ratio", floe_heave_added_mass_ratio, "-",
+            "C_a33: floe heave added mass as a fraction of the floe mass, along the floe's normal, in the mass matrix "
+            "(implicit; PHYSICS.md 3.3 suggests 0.5-2)",
+            in_range(0, 10));
+    v.field("floes_start_with_current", floes_start_with_current, "-",
+            "floes start drifting with the current (an established drift) instead of at rest");
   }
 };
 
@@ -133,6 +142,10 @@ struct VesselOptions {
   double form_factor_k = 0.3;     // ITTC-57 form factor
   double roughness_ca = 0.0004;   // ITTC roughness allowance C_A
   double sway_drag_cd = 0.8;      // cross-flow drag coefficient (sway and yaw damping), on L_wl x draught
+  std::vector<double> inertia_kg_m2;   // given outright: [Ixx, Iyy, Izz] or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]
+  double surge_added_mass_ratio = 0.05;  // A11 / m (PHYSICS.md §3.3: 0.05-0.1)
+  double sway_added_mass_ratio = 0.5;    // A22 / m (0.5-1.0)
+  double yaw_added_inertia_ratio = 0.5;  // A66 / I_zz (0.5-1.0)
   PropulsionOptions propulsion;
   AutopilotOptions autopilot;
   template <class V>
@@ -150,6 +163,31 @@ struct VesselOptions {
     v.field("roughness_ca", roughness_ca, "-", "ITTC roughness allowance C_A", in_range(0, 0.01));
     v.field("sway_drag_cd", sway_drag_cd, "-", "cross-flow drag coefficient for sway and yaw damping",
             non_negative());
+    v.field("inertia_kg_m2", inertia_kg_m2, "kg m^2",
+            "inertia tensor about the centre of mass, body axes, given outright: [] (from the radii of gyration), "
+            "[Ixx, Iyy, Izz] or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] (products as tensor entries); overrides kxx_m..kzz_m",
+            Check<std::vector<double>>([](const std::vector<double>& I) -> std::string {
+              if (I.empty()) return "";
+              if (I.size() != 3 && I.size() != 6) return "must have 0, 3 or 6 values";
+              for (double x : I)
+                if (!std::isfinite(x)) return "must be finite numbers";
+              const double a = I[0], b = I[1], c = I[2];
+              if (!(a > 0 && b > 0 && c > 0)) return "Ixx, Iyy, Izz must be > 0";
+              if (a + b < c || b + c < a || a + c < b) return "violates the triangle inequality of a rigid body";
+              if (I.size() == 6) {  // positive definite: leading minors
+                const double xy = I[3], xz = I[4], yz = I[5];
+                const double m2 = a * b - xy * xy;
+                const double m3 = a * (b * c - yz * yz) - xy * (xy * c - yz * xz) + xz * (xy * yz - b * xz);
+                if (!(m2 > 0 && m3 > 0)) return "is not positive definite";
+              }
+              return "";
+            }));
+    v.field("surge_added_mass_ratio", surge_added_mass_ratio, "-",
+            "surge added mass A11 as a fraction of the vessel mass, in the mass matrix", in_range(0, 2));
+    v.field("sway_added_mass_ratio", sway_added_mass_ratio, "-",
+            "sway added mass A22 as a fraction of the vessel mass, in the mass matrix", in_range(0, 5));
+    v.field("yaw_added_inertia_ratio", yaw_added_inertia_ratio, "-",
+            "yaw added moment of inertia A66 as a fraction of the vessel's I_zz, in the mass matrix", in_range(0, 5));
     v.section("propulsion", propulsion, "how the vessel is driven");
     v.section("autopilot", autopilot, "heading hold");
   }
@@ -204,6 +242,39 @@ struct SolverOptions {
   }
 };
 
+// The simulation domain: optional fixed walls along the sides of a rectangle (a coast, fast ice or a basin), so
+// that floes driven by a current or wind pack against them instead of drifting away. Walls are static bodies with
+// rigid contacts (ice.mu_ice_ice); they are not written to the results.
+struct DomainOptions {
+  std::vector<std::string> walls;   // any of "west", "east", "south", "north"
+  std::vector<double> extent_m;     // [x_min, y_min, x_max, y_max]; empty: the floes file's extent [0, 0, w, h]
+  double wall_thickness_m = 20.0;
+  template <class V>
+  void visit(V& v) {
+    v.field("walls", walls, "-",
+            "fixed walls on these sides of the domain: any of \"west\", \"east\", \"south\", \"north\"",
+            Check<std::vector<std::string>>([](const std::vector<std::string>& w) -> std::string {
+              for (size_t i = 0; i < w.size(); ++i) {
+                if (w[i] != "west" && w[i] != "east" && w[i] != "south" && w[i] != "north")
+                  return "unknown side \"" + w[i] + "\" (known: west, east, south, north)";
+                for (size_t j = 0; j < i; ++j)
+                  if (w[j] == w[i]) return "side \"" + w[i] + "\" given twice";
+              }
+              return "";
+            }));
+    v.field("extent_m", extent_m, "m",
+            "domain rectangle [x_min, y_min, x_max, y_max] whose sides carry the walls; [] = the floes file's image "
+            "extent [0, 0, width_m, height_m]",
+            Check<std::vector<double>>([](const std::vector<double>& e) -> std::string {
+              if (e.empty()) return "";
+              if (e.size() != 4) return "must be [] or [x_min, y_min, x_max, y_max]";
+              if (!(e[2] > e[0] && e[3] > e[1])) return "needs x_max > x_min and y_max > y_min";
+              return "";
+            }));
+    v.field("wall_thickness_m", wall_thickness_m, "m", "thickness of each wall (outside the domain)", positive());
+  }
+};
+
 struct SleepOptions {
   bool enabled = true;
   double linear_mps = 0.02;      // a floe slower than this ...
@@ -242,6 +313,7 @@ struct SimulateOptions {
   VesselOptions vessel;
   WindOptions wind;
   SolverOptions solver;
+  DomainOptions domain;
   SleepOptions sleep;
   HealthOptions health;
   HullLoadOptions hull;
@@ -261,6 +333,7 @@ struct SimulateOptions {
     v.section("vessel", vessel, "vessel start, mass, resistance, propulsion, steering");
     v.section("wind", wind, "wind");
     v.section("solver", solver, "contact solver");
+    v.section("domain", domain, "fixed walls around the floe field (floes pack against them)");
     v.section("sleep", sleep, "sleeping of resting floes");
     v.section("health", health, "numerical health limits");
     v.section("hull", hull, "how the hull file is loaded (non-convex meshes)");

@@ -27,9 +27,9 @@ bool same_key(const CachedContact& c, const Contact& k) {
 // Applies an impulse p along the row (d, ia, ib) to the two bodies: a gets -p, b gets +p.
 inline void apply(State& s, const SolverBodies& sb, const Contact& c, const Vec3& d, const Vec3& ia, const Vec3& ib,
                   double p) {
-  s.velocity[c.body_a] -= (sb.inv_mass[c.body_a] * p) * d;
+  s.velocity[c.body_a] -= p * (sb.inv_mass[c.body_a] * d);
   s.angular_velocity[c.body_a] -= p * ia;
-  s.velocity[c.body_b] += (sb.inv_mass[c.body_b] * p) * d;
+  s.velocity[c.body_b] += p * (sb.inv_mass[c.body_b] * d);
   s.angular_velocity[c.body_b] += p * ib;
 }
 
@@ -53,12 +53,12 @@ void prepare_contacts(const Model& model, const SolverBodies& sb, State& state, 
     tangents(c.normal, c.t1, c.t2);
     const Mat3& Ia = sb.inv_inertia_world[c.body_a];
     const Mat3& Ib = sb.inv_inertia_world[c.body_b];
-    const double im = sb.inv_mass[c.body_a] + sb.inv_mass[c.body_b];
+    const Mat3 im = sb.inv_mass[c.body_a] + sb.inv_mass[c.body_b];  // translational part of W (added mass: a tensor)
     auto row = [&](const Vec3& d, Vec3& ia, Vec3& ib) {
       const Vec3 rad = c.ra.cross(d), rbd = c.rb.cross(d);
       ia = Ia * rad;
       ib = Ib * rbd;
-      const double w = im + rad.dot(ia) + rbd.dot(ib);
+      const double w = d.dot(im * d) + rad.dot(ia) + rbd.dot(ib);
       return w > 0 ? 1.0 / w : 0.0;
     };
     c.mass_n = row(c.normal, c.ia_n, c.ib_n);

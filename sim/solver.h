@@ -17,7 +17,7 @@ struct SolverReport {
 
 // Per-body data the solver needs (world frame), filled by the caller for the bodies of the step.
 struct SolverBodies {
-  std::vector<double> inv_mass;
+  std::vector<Mat3> inv_mass;           // translational inverse mass matrix, world (with the added mass, §3.3)
   std::vector<Mat3> inv_inertia_world;
 };
 

@@ -46,6 +46,10 @@ World::World(const Model& model) : model_(model), pool_(model.options.threads) {
   for (size_t b = 0; b < n; ++b) {
     state_.position[b] = model.bodies[b].initial_position;
     state_.orientation[b] = model.bodies[b].initial_orientation;
+    if (model.bodies[b].kind == BodyKind::wall) state_.awake[b] = 0;  // fixed: never integrated
+    // An established drift: floes start with the current's velocity (horizontal).
+    if (model.bodies[b].kind == BodyKind::floe && o.water.enabled && o.water.floes_start_with_current)
+      state_.velocity[b] = Vec3(model.current.x(), model.current.y(), 0);
   }
   if (model.vessel >= 0) {
     const int v = model.vessel;
@@ -54,9 +58,13 @@ World::World(const Model& model) : model_(model), pool_(model.options.threads) {
     state_.velocity[v] = o.vessel.initial_speed_mps * R.col(0) + Vec3(model.current.x(), model.current.y(), 0);
     state_.heading_ref_rad = heading_of(R);
   }
-  solver_bodies_.inv_mass.resize(n);
+  // Inverse mass matrices (world) as the solver sees them; the forces stage refreshes those of awake bodies.
+  solver_bodies_.inv_mass.assign(n, Mat3::Zero());
   solver_bodies_.inv_inertia_world.assign(n, Mat3::Zero());
-  for (size_t b = 0; b < n; ++b) solver_bodies_.inv_mass[b] = model.bodies[b].inv_mass;
+  for (size_t b = 0; b < n; ++b) {
+    const Mat3 R = state_.orientation[b].toRotationMatrix();
+    solver_bodies_.inv_mass[b] = R * model.bodies[b].inv_mass_added.asDiagonal() * R.transpose();
+  }
   external_.resize(n);
   in_contact_.assign(n, 0);
   scratch_.resize(pool_.threads());
@@ -73,6 +81,7 @@ void World::sync() {
 }
 
 void World::wake(int body) {
+  if (model_.bodies[body].kind == BodyKind::wall) return;  // fixed bodies never move
   state_.awake[body] = 1;
   state_.still_time_s[body] = 0;
 }
@@ -131,15 +140,22 @@ void World::stage_forces() {
     k.w = state_.angular_velocity[b];
     return k;
   };
-  // Per body: external wrench, world inverse inertia, then the predicted velocities v* = v + dt M^-1 f.
+  // Per body: external wrench, world inverse mass matrices, then the predicted velocities v* = v + dt M^-1 f.
+  // M holds the added mass (PHYSICS.md §3.3: a33 of floes along their normal, surge/sway/yaw of the vessel), so it
+  // acts against every force, the contact impulses of the solver included (the solver uses the same M^-1): the
+  // added mass is implicit, not an explicit force. The added mass's Coriolis/Munk terms are neglected.
   auto advance = [&](int b, const BodyKinematics& k, const Wrench& w) {
     const Body& body = model_.bodies[b];
-    const Mat3 Iw = k.R * body.inertia * k.R.transpose();
-    const Mat3 Iinv = k.R * body.inv_inertia * k.R.transpose();
+    Mat3 Ib = body.inertia;
+    Ib.diagonal() += body.added_inertia;
+    const Mat3 Iw = k.R * Ib * k.R.transpose();
+    const Mat3 Iinv = k.R * body.inv_inertia_added * k.R.transpose();
+    const Mat3 Minv = k.R * body.inv_mass_added.asDiagonal() * k.R.transpose();
     solver_bodies_.inv_inertia_world[b] = Iinv;
+    solver_bodies_.inv_mass[b] = Minv;
     external_[b] = w;
     // Gyroscopic term w x (I w), explicit.
-    state_.velocity[b] += dt * body.inv_mass * w.force;
+    state_.velocity[b] += dt * (Minv * w.force);
     state_.angular_velocity[b] += dt * (Iinv * (w.torque - k.w.cross(Iw * k.w)));
   };
   // The vessel on this thread (its controllers keep state).

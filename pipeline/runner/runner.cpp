@@ -83,13 +83,20 @@ std::vector<Artefact> prepare_run(const RunOptions& o) {
   FLOESIM_REQUIRE(fs::is_directory(o.case_dir), o.case_dir.string(), ": not a case folder (expected a folder holding case.json)");
   const Json c = load_json_file(case_file);
   FLOESIM_REQUIRE(c.is_object(), cf, ": the top level must be an object");
-  const std::vector<std::string> known = {"description", "image", "digitise", "hull", "simulate", "render", "plot"};
+  const std::vector<std::string> known = {"description", "image", "digitise", "floes", "hull", "simulate", "render",
+                                          "plot"};
   for (auto it = c.begin(); it != c.end(); ++it) {
     bool ok = false;
     for (auto& k : known) ok = ok || k == it.key();
     FLOESIM_REQUIRE(ok, cf, ": unknown key \"", it.key(),
-                    "\" (known: description, image, digitise, hull, simulate, render, plot)");
+                    "\" (known: description, image, digitise, floes, hull, simulate, render, plot)");
   }
+  // Floes come from a photo (image + digitise) or directly from a floes GeoJSON the case owns ("floes": {"file"}).
+  FLOESIM_REQUIRE(c.contains("image") != c.contains("floes"), cf,
+                  ": give exactly one of \"image\" (a photo or synthetic image, digitised into floes) or \"floes\" "
+                  "({\"file\": \"floes.geojson\"}: floe polygons given directly)");
+  FLOESIM_REQUIRE(!(c.contains("floes") && c.contains("digitise")), cf,
+                  ": \"digitise\" has no effect with \"floes\" (the floes are given directly): remove it");
 
   const fs::path run = fs::absolute(o.run_dir);
   const fs::path bin = o.bin_dir.empty() ? self_dir() : fs::absolute(o.bin_dir);
@@ -111,53 +118,63 @@ std::vector<Artefact> prepare_run(const RunOptions& o) {
   std::vector<Stage> stages;
   std::vector<Artefact> arts;
 
-  // --- image: a photo the case owns, or a synthetic one made from known floes ---
-  const Json& image = require_object(c, "image", cf);
-  for (auto it = image.begin(); it != image.end(); ++it)
-    FLOESIM_REQUIRE(it.key() == "metres_per_pixel" || it.key() == "synthetic" || it.key() == "file", cf,
-                    ": unknown key image.", it.key(), " (known: metres_per_pixel, file, synthetic)");
-  FLOESIM_REQUIRE(image.contains("metres_per_pixel") && image["metres_per_pixel"].is_number() &&
-                      image["metres_per_pixel"].get<double>() > 0,
-                  cf, ": image.metres_per_pixel must be a number > 0 (the ground size of one pixel)");
-  const double mpp = image["metres_per_pixel"].get<double>();
-  FLOESIM_REQUIRE(image.contains("synthetic") != image.contains("file"), cf,
-                  ": image needs exactly one of \"file\" (a photo) or \"synthetic\" (options for floesim-synth)");
-  fs::path image_png;
-  if (image.contains("synthetic")) {
-    Json s = image["synthetic"];
-    FLOESIM_REQUIRE(s.is_object(), cf, ": image.synthetic must be an object");
-    FLOESIM_REQUIRE(!s.contains("metres_per_pixel"), cf,
-                    ": image.synthetic.metres_per_pixel: set the scale once, in image.metres_per_pixel");
-    s["metres_per_pixel"] = mpp;
-    const fs::path dir = run / "image";
-    image_png = dir / "image.png";
-    Stage st{"synth", "synthetic helicopter image from known floes", {stage_config("synth", s)},
-             {image_png, dir / "truth.geojson", dir / "truth_labels.png"}, bin / "floesim-synth", ""};
-    st.args = "--config " + sh(st.inputs[0]) + " --out " + sh(dir);
-    stages.push_back(st);
-    arts.push_back({"synth", "image/image.png", "synthetic helicopter image (8-bit grey)"});
-    arts.push_back({"synth", "image/truth.geojson", "the true floe polygons (m)"});
+  // --- floes given directly: the case's GeoJSON goes to simulate as it is (no image, no digitise stage) ---
+  fs::path floes_file;
+  if (c.contains("floes")) {
+    const Json& fl = require_object(c, "floes", cf);
+    for (auto it = fl.begin(); it != fl.end(); ++it)
+      FLOESIM_REQUIRE(it.key() == "file", cf, ": unknown key floes.", it.key(), " (known: file)");
+    floes_file = case_input(fl, "file", "floes");
   } else {
-    image_png = case_input(image, "file", "image");
-  }
+    // --- image: a photo the case owns, or a synthetic one made from known floes ---
+    const Json& image = require_object(c, "image", cf);
+    for (auto it = image.begin(); it != image.end(); ++it)
+      FLOESIM_REQUIRE(it.key() == "metres_per_pixel" || it.key() == "synthetic" || it.key() == "file", cf,
+                      ": unknown key image.", it.key(), " (known: metres_per_pixel, file, synthetic)");
+    FLOESIM_REQUIRE(image.contains("metres_per_pixel") && image["metres_per_pixel"].is_number() &&
+                        image["metres_per_pixel"].get<double>() > 0,
+                    cf, ": image.metres_per_pixel must be a number > 0 (the ground size of one pixel)");
+    const double mpp = image["metres_per_pixel"].get<double>();
+    FLOESIM_REQUIRE(image.contains("synthetic") != image.contains("file"), cf,
+                    ": image needs exactly one of \"file\" (a photo) or \"synthetic\" (options for floesim-synth)");
+    fs::path image_png;
+    if (image.contains("synthetic")) {
+      Json s = image["synthetic"];
+      FLOESIM_REQUIRE(s.is_object(), cf, ": image.synthetic must be an object");
+      FLOESIM_REQUIRE(!s.contains("metres_per_pixel"), cf,
+                      ": image.synthetic.metres_per_pixel: set the scale once, in image.metres_per_pixel");
+      s["metres_per_pixel"] = mpp;
+      const fs::path dir = run / "image";
+      image_png = dir / "image.png";
+      Stage st{"synth", "synthetic helicopter image from known floes", {stage_config("synth", s)},
+               {image_png, dir / "truth.geojson", dir / "truth_labels.png"}, bin / "floesim-synth", ""};
+      st.args = "--config " + sh(st.inputs[0]) + " --out " + sh(dir);
+      stages.push_back(st);
+      arts.push_back({"synth", "image/image.png", "synthetic helicopter image (8-bit grey)"});
+      arts.push_back({"synth", "image/truth.geojson", "the true floe polygons (m)"});
+    } else {
+      image_png = case_input(image, "file", "image");
+    }
 
-  // --- digitise ---
-  {
-    Json d = c.contains("digitise") ? c["digitise"] : Json::object();
-    FLOESIM_REQUIRE(d.is_object(), cf, ": digitise must be an object");
-    const fs::path dir = run / "floes";
-    Stage st{"digitise", "floe segmentation and polygons", {image_png, stage_config("digitise", d)},
-             {dir / "floes.geojson", dir / "labels.png", dir / "overlay.png", dir / "stats.json"},
-             bin / "floesim-digitise", ""};
-    std::ostringstream mp;
-    mp.precision(17);
-    mp << mpp;
-    st.args = sh(image_png) + " --metres-per-pixel " + mp.str() + " --config " + sh(st.inputs[1]) + " --out " + sh(dir);
-    stages.push_back(st);
-    arts.push_back({"digitise", "floes/floes.geojson", "floe polygons, m (GeoJSON)"});
-    arts.push_back({"digitise", "floes/labels.png", "16-bit label image, k = floe id"});
-    arts.push_back({"digitise", "floes/overlay.png", "outlines on the photo"});
-    arts.push_back({"digitise", "floes/stats.json", "count, concentration, size distribution"});
+    // --- digitise ---
+    {
+      Json d = c.contains("digitise") ? c["digitise"] : Json::object();
+      FLOESIM_REQUIRE(d.is_object(), cf, ": digitise must be an object");
+      const fs::path dir = run / "floes";
+      Stage st{"digitise", "floe segmentation and polygons", {image_png, stage_config("digitise", d)},
+               {dir / "floes.geojson", dir / "labels.png", dir / "overlay.png", dir / "stats.json"},
+               bin / "floesim-digitise", ""};
+      std::ostringstream mp;
+      mp.precision(17);
+      mp << mpp;
+      st.args = sh(image_png) + " --metres-per-pixel " + mp.str() + " --config " + sh(st.inputs[1]) + " --out " + sh(dir);
+      stages.push_back(st);
+      arts.push_back({"digitise", "floes/floes.geojson", "floe polygons, m (GeoJSON)"});
+      arts.push_back({"digitise", "floes/labels.png", "16-bit label image, k = floe id"});
+      arts.push_back({"digitise", "floes/overlay.png", "outlines on the photo"});
+      arts.push_back({"digitise", "floes/stats.json", "count, concentration, size distribution"});
+      floes_file = dir / "floes.geojson";
+    }
   }
 
   // --- hull: a user's mesh, or the parametric icebreaker ---
@@ -187,7 +204,7 @@ std::vector<Artefact> prepare_run(const RunOptions& o) {
     FLOESIM_REQUIRE(s.is_object(), cf, ": simulate must be an object");
     const fs::path dir = run / "sim";
     results = dir / "results.h5";
-    const fs::path floes = run / "floes" / "floes.geojson";
+    const fs::path floes = floes_file;
     Stage st{"simulate", "vessel transit simulation", {floes, hull_obj, stage_config("simulate", s)},
              {results, dir / "summary.json"}, bin / "floesim-simulate", ""};
     // A thrust time series named in the case is an input too.
