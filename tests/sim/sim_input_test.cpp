@@ -5,6 +5,7 @@
 
 #include "pipeline/error.h"
 #include "sim/simulate.h"
+#include "sim/world.h"
 #include "sim_fixtures.h"
 
 namespace floesim::sim {
@@ -92,6 +93,92 @@ TEST(SimInput, StageWritesNothingOnError) {
   std::ofstream(dir / "sim.json") << R"({"duration_s": 1.0, "steady_start_s": 0.5, "solver": {"iteratons": 5}})";
   expect_error([&] { run_simulate(dir / "floes.geojson", dir / "hull.obj", dir / "sim.json", dir / "out"); },
                {"solver.iteratons"});
+}
+
+
+// Each bad input of issue #4 through the stage itself: a clear error naming the file and the item, and no
+// results.h5 or summary.json written.
+TEST(SimInput, BadInputsNameFileAndItemAndWriteNothing) {
+  const auto dir = temp_dir("bad_inputs");
+  HullGeneratorOptions g;
+  g.sections = 6;
+  write_obj(dir / "hull.obj", generate_hull(g), "test hull");
+  FloeField good;
+  good.floes = {rect_floe(1, 100, 0, 10, 10, 1.0)};
+  write_floes(dir / "floes.geojson", good);
+  std::ofstream(dir / "sim.json") << R"({"duration_s": 1.0, "steady_start_s": 0.5})";
+  auto run = [&](const std::string& floes, const std::string& hull, const std::string& cfg,
+                 std::initializer_list<const char*> pieces) {
+    std::filesystem::remove_all(dir / "out");
+    expect_error([&] { run_simulate(dir / floes, dir / hull, dir / cfg, dir / "out"); }, pieces);
+    EXPECT_FALSE(std::filesystem::exists(dir / "out" / "results.h5"));
+    EXPECT_FALSE(std::filesystem::exists(dir / "out" / "summary.json"));
+  };
+  // A hull that is not closed (a box missing its lid).
+  std::ofstream(dir / "open.obj") << "o box\nv 0 0 -1\nv 1 0 -1\nv 1 1 -1\nv 0 1 -1\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                                     "f 1 3 2\nf 1 4 3\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\n"
+                                     "f 4 1 5\nf 4 5 8\n";
+  run("floes.geojson", "open.obj", "sim.json", {"open.obj", "not closed"});
+  // A floe polygon that intersects itself (a bow tie), in the file: named by file and feature.
+  std::ofstream(dir / "bowtie.geojson")
+      << R"({"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {"id": 3, "thickness_m": 1},
+           "geometry": {"type": "Polygon", "coordinates": [[[100, 0], [110, 10], [110, 0], [100, 10], [100, 0]]]}}]})";
+  run("bowtie.geojson", "hull.obj", "sim.json", {"bowtie.geojson", "intersects itself"});
+  // Two floes overlapping each other.
+  FloeField overlap;
+  overlap.floes = {rect_floe(1, 100, 0, 10, 10, 1.0), rect_floe(2, 105, 5, 10, 10, 1.0)};
+  write_floes(dir / "overlap.geojson", overlap);
+  run("overlap.geojson", "hull.obj", "sim.json", {"floes 1 and 2 overlap"});
+  // A negative thickness in the file.
+  std::ofstream(dir / "thin.geojson")
+      << R"({"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {"id": 5, "thickness_m": -1},
+           "geometry": {"type": "Polygon", "coordinates": [[[100, 0], [110, 0], [110, 10], [100, 10], [100, 0]]]}}]})";
+  run("thin.geojson", "hull.obj", "sim.json", {"thin.geojson", "thickness_m"});
+  // A negative strength, an unknown key (with the file name).
+  std::ofstream(dir / "strength.json") << R"({"duration_s": 1.0, "steady_start_s": 0.5,
+                                              "ice": {"crushing_strength_pa": -2e6}})";
+  run("floes.geojson", "hull.obj", "strength.json", {"strength.json", "ice.crushing_strength_pa", "> 0"});
+  std::ofstream(dir / "unknown.json") << R"({"duration_s": 1.0, "steady_start_s": 0.5, "water": {"curent_speed_mps": 1}})";
+  run("floes.geojson", "hull.obj", "unknown.json", {"unknown.json", "water.curent_speed_mps"});
+  // A thrust series with a gap (an empty line, a missing value) or with time going back.
+  auto thrust_case = [&](const std::string& csv, std::initializer_list<const char*> pieces) {
+    std::ofstream(dir / "thrust.csv") << csv;
+    std::ofstream(dir / "thrust.json")
+        << R"({"duration_s": 1.0, "steady_start_s": 0.5, "vessel": {"propulsion": {"mode": "thrust_series",
+              "thrust_file": "thrust.csv"}}})";
+    run("floes.geojson", "hull.obj", "thrust.json", pieces);
+  };
+  thrust_case("time_s,thrust_N\n0,1e5\n\n2,1e5\n", {"thrust.csv:3", "empty line"});
+  thrust_case("time_s,thrust_N\n0,1e5\n1,\n2,1e5\n", {"thrust.csv:3", "thrust_N"});
+  thrust_case("time_s,thrust_N\n0,1e5\n2,1e5\n1,1e5\n", {"thrust.csv:4", "increase strictly"});
+  std::filesystem::remove_all(dir);
+}
+
+// A simulation that goes unstable stops with a diagnosis naming the step and the body: a non-finite state (NaN) of
+// a free body, or of a body in contact (which the contact solver spreads to its partner), stops the step that
+// produced it. (Blow-ups that stay finite are stopped by the health limits: SimVessel.HealthStopWritesNothing.)
+TEST(SimInput, NumericalFailureIsDiagnosed) {
+  SimulateOptions o = testing::floe_options();
+  FloeField field;
+  field.floes = {rect_floe(1, 0, 0, 10, 10, 1.0), rect_floe(2, 30, 0, 5, 5, 1.0)};
+  const Model m = build_model(field, nullptr, o);
+  {
+    World w(m);
+    w.mutable_state().velocity[1] = Vec3(std::nan(""), 0, 0);
+    expect_error([&] { w.step(); }, {"numerical failure at step 1", "floe id 2", "not finite"});
+  }
+  {
+    // Two floes pressed together, one with a NaN velocity: the contact solver's residual is NaN.
+    FloeField touching;
+    touching.floes = {rect_floe(1, 0, 0, 10, 10, 1.0), rect_floe(2, 10, 0, 5, 5, 1.0)};
+    const Model mt = build_model(touching, nullptr, o);
+    World w(mt);
+    w.mutable_state().velocity[0] = Vec3(0.1, 0, 0);
+    w.step();
+    ASSERT_GT(w.contacts().size(), 0u);
+    w.mutable_state().velocity[1] = Vec3(std::nan(""), 0, 0);
+    expect_error([&] { w.step(); }, {"numerical failure at step 2", "floe id", "not finite"});
+  }
 }
 
 }  // namespace
