@@ -34,6 +34,152 @@ struct PartWorld {
   Vec3 lo, hi;                // exact box
 };
 
+// Places part cp at (x, R): world vertices, face normals and plane offsets, exact box.
+void transform_part(const ConvexPart& cp, const Vec3& x, const Mat3& R, PartWorld& w) {
+  w.v.resize(cp.vertices.size());
+  w.n.resize(cp.faces.size());
+  w.d.resize(cp.faces.size());
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  for (size_t i = 0; i < cp.vertices.size(); ++i) {
+    w.v[i] = x + R * cp.vertices[i];
+    lo = lo.cwiseMin(w.v[i]);
+    hi = hi.cwiseMax(w.v[i]);
+  }
+  for (size_t f = 0; f < cp.faces.size(); ++f) {
+    w.n[f] = R * cp.face_normal[f];
+    w.d[f] = w.n[f].dot(w.v[cp.faces[f][0]]);
+  }
+  w.lo = lo;
+  w.hi = hi;
+}
+
+// Sums over the faces of one part clipped by the other part (one side of the overlap's boundary), in coordinates
+// relative to a local origin near the overlap (so that the volume does not cancel large world offsets).
+struct SideSums {
+  Vec3 vec_area = Vec3::Zero();  // sum of area x outward normal over contact-surface faces
+  Vec3 moment = Vec3::Zero();    // sum of area x centroid over contact-surface faces
+  double area = 0;               // sum of the areas of contact-surface faces
+  double volume = 0;             // divergence theorem over all faces: (1/3) sum of area x (n . centroid)
+};
+
+// Points up to this far outside a plane count as inside (1 nm): a face lying in the other part's face plane (the
+// tops of two floes of equal thickness) is then reliably on the boundary of the overlap, not flickering in and out.
+constexpr double kClipTolerance = 1e-9;
+
+// The faces of P (translated by tp) clipped by the half-spaces n.x <= d of Q (translated by tq): Sutherland-Hodgman
+// per face, a face leaving nothing as soon as one plane has it all outside. second_side: P's faces lying in the
+// plane of a face of Q with the same orientation are skipped, because Q's side (clipped first) already holds that
+// piece of the overlap's boundary; counting both would double it (e.g. the volume of two floes' common top).
+void clip_faces(const ConvexPart& P, const PartWorld& pw, const Vec3& tp, const ConvexPart& Q, const PartWorld& qw,
+                const Vec3& tq, const Vec3& origin, bool second_side, std::vector<Vec3>& poly, std::vector<Vec3>& tmp,
+                SideSums& out) {
+  const size_t nq = Q.faces.size();
+  const Vec3 shift_p = tp - origin, shift_q = tq - origin;
+  for (size_t f = 0; f < P.faces.size(); ++f) {
+    if (second_side) {
+      const double df = pw.d[f] + pw.n[f].dot(shift_p);
+      bool coplanar = false;
+      for (size_t g = 0; g < nq && !coplanar; ++g)
+        coplanar = pw.n[f].dot(qw.n[g]) > 1 - 1e-12 &&
+                   std::abs(df - (qw.d[g] + qw.n[g].dot(shift_q))) <= kClipTolerance;
+      if (coplanar) continue;
+    }
+    poly.clear();
+    for (int i : P.faces[f]) poly.push_back(pw.v[i] + shift_p);
+    for (size_t g = 0; g < nq && poly.size() >= 3; ++g) {
+      const Vec3& qn = qw.n[g];
+      const double qd = qw.d[g] + qn.dot(shift_q) + kClipTolerance;
+      tmp.swap(poly);
+      poly.clear();
+      const size_t k = tmp.size();
+      double sp = qn.dot(tmp[k - 1]) - qd;  // previous vertex (edge tmp[k-1] -> tmp[0] first)
+      for (size_t i = 0; i < k; ++i) {
+        const Vec3& p = tmp[i == 0 ? k - 1 : i - 1];
+        const Vec3& q = tmp[i];
+        const double sq = qn.dot(q) - qd;
+        if ((sp <= 0) != (sq <= 0)) poly.push_back(p + (sp / (sp - sq)) * (q - p));
+        if (sq <= 0) poly.push_back(q);
+        sp = sq;
+      }
+    }
+    if (poly.size() < 3) continue;
+    // Area (signed about the face normal: clipping keeps the winding) and centroid of the clipped face.
+    const Vec3& nf = pw.n[f];
+    double a2 = 0;
+    Vec3 c = Vec3::Zero();
+    for (size_t i = 1; i + 1 < poly.size(); ++i) {
+      const double w = (poly[i] - poly[0]).cross(poly[i + 1] - poly[0]).dot(nf);
+      a2 += w;
+      c += w * (poly[0] + poly[i] + poly[i + 1]);
+    }
+    if (!(a2 > 0)) continue;
+    const double area = 0.5 * a2;
+    const Vec3 centroid = c / (3 * a2);
+    out.volume += area * nf.dot(centroid) / 3;
+    if (P.face_internal[f]) continue;  // bounds the overlap, but is no surface of the body
+    out.vec_area += area * nf;
+    out.moment += area * centroid;
+    out.area += area;
+  }
+}
+
+// Areas below this (1 mm^2; 2 N at 2 MPa) are no contact: the parts merely graze.
+constexpr double kMinPatchArea = 1e-6;
+
+// step_of(point, normal) gives the penetration step of the area's secant (see ContactPatch::area_step_m).
+template <class StepFn>
+ContactPatch overlap_patch(const ConvexPart& A, const PartWorld& wa, const ConvexPart& B, const PartWorld& wb,
+                           PatchSide side, StepFn step_of, std::vector<Vec3>& poly, std::vector<Vec3>& tmp) {
+  ContactPatch r;
+  // Local origin: the centre of the intersection of the two boxes.
+  const Vec3 origin = 0.5 * (wa.lo.cwiseMax(wb.lo) + wa.hi.cwiseMin(wb.hi));
+  const Vec3 zero = Vec3::Zero();
+  SideSums sa, sb;
+  clip_faces(A, wa, zero, B, wb, zero, origin, false, poly, tmp, sa);
+  clip_faces(B, wb, zero, A, wa, zero, origin, true, poly, tmp, sb);
+  // The boundary of the overlap is closed, so sa.vec_area = -sb.vec_area up to the internal faces left out: the
+  // vector area of one side is the overlap projected on the plane normal to it, which is the nominal contact area
+  // (a wedge of half-angle phi pushed delta into a wall: 2 h delta tan(phi); a flat edge: h w).
+  Vec3 S;
+  bool from_b = false;  // structure side empty (only possible when b reaches through a's internal faces)
+  if (side == PatchSide::a_is_structure) {
+    S = sa.vec_area;
+    if (S.norm() < kMinPatchArea) {
+      S = -sb.vec_area;
+      from_b = true;
+    }
+  } else {
+    S = 0.5 * (sa.vec_area - sb.vec_area);
+  }
+  const double area = S.norm();
+  if (!(area >= kMinPatchArea)) return r;
+  r.valid = true;
+  r.area_m2 = area;
+  r.normal = S / area;
+  r.volume_m3 = std::max(0.0, sa.volume + sb.volume);
+  if (side == PatchSide::symmetric) {
+    r.point = (sa.moment + sb.moment) / (sa.area + sb.area);
+  } else {
+    r.point = from_b ? Vec3(sb.moment / sb.area) : Vec3(sa.moment / sa.area);
+  }
+  r.point += origin;
+  // dA/d(delta): b moved by the step towards a along the normal, the same sides re-clipped, projected on this normal.
+  const double eps = step_of(r.point, r.normal);
+  const Vec3 t = -eps * r.normal;
+  SideSums fa, fb;
+  if (side == PatchSide::symmetric || !from_b) clip_faces(A, wa, zero, B, wb, t, origin, false, poly, tmp, fa);
+  if (side == PatchSide::symmetric || from_b) clip_faces(B, wb, t, A, wa, zero, origin, true, poly, tmp, fb);
+  double area_eps;
+  if (side == PatchSide::symmetric) area_eps = 0.5 * (fa.vec_area - fb.vec_area).dot(r.normal);
+  else area_eps = from_b ? -fb.vec_area.dot(r.normal) : fa.vec_area.dot(r.normal);
+  // A shrinking area (a corner passing through a thin part) would soften the implicit row and could make it
+  // unstable; the hardening is kept >= 0 (constant-force crushing in that case).
+  r.area_step_m = eps;
+  r.area_end_m2 = std::max(area, area_eps);
+  r.area_slope_m = (r.area_end_m2 - area) / eps;
+  return r;
+}
+
 struct PairCandidate {
   int body_a, part_a, body_b, part_b;
   bool operator<(const PairCandidate& o) const {
@@ -48,7 +194,7 @@ struct PairCandidate {
 struct Scratch {
   std::vector<Vec3> poly, tmp;
   std::vector<Contact> contacts;      // contacts of this worker's pairs, in pair order
-  long hits = 0, edges = 0;
+  long hits = 0, edges = 0, crushing = 0;
 };
 
 }  // namespace
@@ -69,27 +215,72 @@ struct CollisionWorld::Impl {
   ThreadPool& pool;
   std::vector<Scratch> scratch;
 
-  Impl(const Model& m, ThreadPool& p) : model(m), pool(p), scratch(p.threads()) {}
+  bool compliant_structure, compliant_ice;  // options.contact, per pair of body classes
+
+  Impl(const Model& m, ThreadPool& p)
+      : model(m),
+        pool(p),
+        scratch(p.threads()),
+        compliant_structure(m.options.contact.ice_structure == "compliant"),
+        compliant_ice(m.options.contact.ice_ice == "compliant") {}
+
+  bool is_structure_pair(const PairCandidate& pc) const {
+    return pc.body_a == model.vessel || pc.body_b == model.vessel;
+  }
+  bool is_compliant(const PairCandidate& pc) const {
+    // Domain walls are boundaries, not ice or a structure under test: always rigid.
+    if (model.bodies[pc.body_a].kind == BodyKind::wall || model.bodies[pc.body_b].kind == BodyKind::wall)
+      return false;
+    return is_structure_pair(pc) ? compliant_structure : compliant_ice;
+  }
+
+  // The crushing contact of a compliant pair: one row at the patch centroid. Returns false if the parts do not
+  // overlap. The vessel is body 0, so in a vessel-floe pair it is always a (the structure side of the patch).
+  bool crushing_contact(const PairCandidate& pc, Scratch& sc, std::vector<Contact>& out) {
+    const bool structure = is_structure_pair(pc);
+    // The area's secant spans the penetration this step is about to add at the current approach speed (at least
+    // the finite-difference step): the implicit force F_0 + K_t dt (-v) then follows the clipped geometry up to
+    // the end-of-step penetration instead of extrapolating a tangent taken over a few millimetres (a hull face
+    // meeting a floe edge almost flat gets all its area within millimetres: the tangent would overshoot it many
+    // times over), and the crushing force is capped at p_c A at the end of that step.
+    const double dt = model.options.time_step_s, eps = model.options.contact.area_gradient_step_m;
+    const State& s = *state;
+    auto step_of = [&](const Vec3& p, const Vec3& n) {
+      const int a = pc.body_a, b = pc.body_b;
+      const Vec3 va = s.velocity[a] + s.angular_velocity[a].cross(p - s.position[a]);
+      const Vec3 vb = s.velocity[b] + s.angular_velocity[b].cross(p - s.position[b]);
+      return std::max(eps, dt * std::max(0.0, -n.dot(vb - va)));
+    };
+    const ContactPatch patch =
+        overlap_patch(model.parts[pc.part_a], world[pc.part_a], model.parts[pc.part_b], world[pc.part_b],
+                      structure ? PatchSide::a_is_structure : PatchSide::symmetric, step_of, sc.poly, sc.tmp);
+    if (!patch.valid) return false;
+    Contact c;
+    c.body_a = pc.body_a;
+    c.part_a = pc.part_a;
+    c.body_b = pc.body_b;
+    c.part_b = pc.part_b;
+    c.point = patch.point;
+    c.normal = patch.normal;
+    c.gap = -patch.volume_m3 / patch.area_m2;  // mean depth of the crushed overlap (diagnostics only: no bias)
+    c.type = ContactType::crushing;
+    c.mu = structure ? model.options.ice.mu_ice_structure : model.options.ice.mu_ice_ice;
+    c.area_m2 = patch.area_m2;
+    c.area_slope_m = patch.area_slope_m;
+    c.area_end_m2 = patch.area_end_m2;
+    c.area_step_m = patch.area_step_m;
+    out.push_back(c);
+    return true;
+  }
 
   // Moves part p to the pose (x, q). Returns true when its box in the tree must change: the tree holds a box
   // enlarged by kTreeMargin (Box2D's fat boxes), so that small motions do not re-insert the leaf every step.
   static constexpr double kTreeMargin = 0.1;  // m
   bool place_part(int p, const Vec3& x, const Quat& q) {
-    const ConvexPart& cp = model.parts[p];
     PartWorld& w = world[p];
     const Mat3 R = q.toRotationMatrix();
-    Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-    for (size_t i = 0; i < cp.vertices.size(); ++i) {
-      w.v[i] = x + R * cp.vertices[i];
-      lo = lo.cwiseMin(w.v[i]);
-      hi = hi.cwiseMax(w.v[i]);
-    }
-    for (size_t f = 0; f < cp.faces.size(); ++f) {
-      w.n[f] = R * cp.face_normal[f];
-      w.d[f] = w.n[f].dot(w.v[cp.faces[f][0]]);
-    }
-    w.lo = lo;
-    w.hi = hi;
+    transform_part(model.parts[p], x, R, w);
+    const Vec3 lo = w.lo, hi = w.hi;
     objects[p]->setTransform(R, x);
     const fcl::AABBd& fat = objects[p]->getAABB();
     if ((lo.array() >= fat.min_.array()).all() && (hi.array() <= fat.max_.array()).all()) return false;
@@ -379,7 +570,7 @@ void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out
   const int npairs = static_cast<int>(m.pairs.size());
   for (auto& sc : m.scratch) {
     sc.contacts.clear();
-    sc.hits = sc.edges = 0;
+    sc.hits = sc.edges = sc.crushing = 0;
   }
   m.pool.parallel_for(npairs, [&](int begin, int end, int w) {
     Scratch& sc = m.scratch[w];
@@ -390,6 +581,10 @@ void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out
       // A separating face axis proves the parts apart: most box-overlapping neighbours end here, before GJK.
       const Impl::FaceAxes axes = m.face_axes(pc);
       if (axes.sa > 0 || axes.sb > 0) continue;
+      if (m.is_compliant(pc)) {
+        if (m.crushing_contact(pc, sc, sc.contacts)) ++sc.hits, ++sc.crushing;
+        continue;
+      }
       fcl::CollisionResultd res;
       fcl::collide(m.objects[pc.part_a].get(), m.objects[pc.part_b].get(), req, res);
       if (!res.isCollision() || res.numContacts() == 0) continue;
@@ -403,8 +598,18 @@ void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out
     out.insert(out.end(), sc.contacts.begin(), sc.contacts.end());
     stats_.narrowphase_hits += sc.hits;
     stats_.edge_contacts += sc.edges;
+    stats_.crushing_contacts += sc.crushing;
   }
   m.state = nullptr;
+}
+
+ContactPatch convex_overlap(const ConvexPart& pa, const Vec3& xa, const Quat& qa, const ConvexPart& pb,
+                            const Vec3& xb, const Quat& qb, PatchSide side, double eps) {
+  PartWorld wa, wb;
+  transform_part(pa, xa, qa.toRotationMatrix(), wa);
+  transform_part(pb, xb, qb.toRotationMatrix(), wb);
+  std::vector<Vec3> poly, tmp;
+  return overlap_patch(pa, wa, pb, wb, side, [eps](const Vec3&, const Vec3&) { return eps; }, poly, tmp);
 }
 
 }  // namespace floesim::sim

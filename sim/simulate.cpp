@@ -28,6 +28,19 @@ void push_body_wrench(std::vector<double>& col, const Mat3& R, const Wrench& w) 
   col.insert(col.end(), {f.x(), f.y(), f.z(), m.x(), m.y(), m.z()});
 }
 
+// The contact law behind the vessel's ice load, which decides the filter window of its plots (PHYSICS.md §5):
+// "rigid" or "compliant" when every recorded vessel contact load is of that kind, "mixed" when both occur. A run
+// without vessel contacts reports the law its ice-structure pairs would have had.
+std::string vessel_contact_model(const Model& model, const Results& r) {
+  bool rigid = false, compliant = false;
+  for (double x : r.get("ice_load_rigid")) rigid = rigid || x != 0;
+  for (double x : r.get("ice_load_compliant")) compliant = compliant || x != 0;
+  if (rigid && compliant) return "mixed";
+  if (rigid) return "rigid";
+  if (compliant) return "compliant";
+  return model.options.contact.ice_structure;
+}
+
 }  // namespace
 
 std::vector<double> moving_average(const std::vector<double>& x, size_t n) {
@@ -86,6 +99,7 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
 
   const auto t0 = std::chrono::steady_clock::now();
   double record_s = 0, awake_sum = 0, contact_sum = 0, iter_sum = 0, pair_sum = 0, hit_sum = 0, edge_sum = 0;
+  double crush_sum = 0;
   const int v = model.vessel;
   for (long k = 1; k <= steps; ++k) {
     world.step();
@@ -117,6 +131,7 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
     pair_sum += world.collision_stats().broadphase_pairs;
     hit_sum += world.collision_stats().narrowphase_hits;
     edge_sum += world.collision_stats().edge_contacts;
+    crush_sum += world.collision_stats().crushing_contacts;
     // Frames at t = k * output_interval (k >= 1): all bodies, vessel first (body id 0).
     if (k % every == 0) {
       r.frame_time_s.push_back(s.time_s);
@@ -149,6 +164,7 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
   stats.mean_pairs = pair_sum / steps;
   stats.mean_touching = hit_sum / steps;
   stats.mean_edge_pairs = edge_sum / steps;
+  stats.mean_crushing_pairs = crush_sum / steps;
 
   // Geometry: floe outlines in the body frame with their thickness; the hull surface in the vessel body frame.
   r.floe_vertex_offset.push_back(0);
@@ -167,7 +183,9 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
   r.attributes["duration_s"] = o.duration_s;
   r.attributes["output_interval_s"] = o.output_interval_s;
   r.attributes["steady_start_s"] = o.steady_start_s;
-  r.attributes["contact_model"] = "rigid";
+  r.attributes["contact_model"] = vessel_contact_model(model, r);
+  r.attributes["contact_ice_structure"] = o.contact.ice_structure;
+  r.attributes["contact_ice_ice"] = o.contact.ice_ice;
   r.attributes["frames_at"] = "t = k * output_interval_s, k = 1 .. duration_s / output_interval_s";
   return r;
 }
@@ -176,6 +194,8 @@ nlohmann::json summarize(const Model& model, const Results& r) {
   const SimulateOptions& o = model.options;
   const auto& t = r.get("time_s");
   const auto& ice = r.get("ice_load");
+  const auto& ice_rigid = r.get("ice_load_rigid");
+  const auto& ice_compliant = r.get("ice_load_compliant");
   const auto& vel = r.get("vessel_velocity_mps");
   const auto& prop = r.get("propulsion_load");
   const auto& awake = r.get("awake_floes");
@@ -187,9 +207,11 @@ nlohmann::json summarize(const Model& model, const Results& r) {
   size_t first = 0;
   while (first < t.size() && t[first] < o.steady_start_s - 0.5 * o.time_step_s) ++first;
   std::vector<double> fx;
-  double speed = 0, thrust = 0, aw = 0, co = 0, it = 0, vc = 0, rmax = 0;
+  double speed = 0, thrust = 0, aw = 0, co = 0, it = 0, vc = 0, rmax = 0, fx_rigid = 0, fx_compliant = 0;
   for (size_t i = first; i < t.size(); ++i) {
     fx.push_back(ice[6 * i]);
+    fx_rigid += ice_rigid[6 * i];
+    fx_compliant += ice_compliant[6 * i];
     speed += vel[3 * i];
     thrust += prop[6 * i];
     aw += awake[i];
@@ -211,27 +233,41 @@ nlohmann::json summarize(const Model& model, const Results& r) {
   s["mean_surge_ice_load_N"] = mean;
   s["mean_surge_ice_resistance_N"] = -mean;
   s["std_surge_ice_load_N"] = sd;
+  // The same mean split by contact law (they add up to the mean above).
+  s["mean_surge_ice_load_rigid_N"] = fx_rigid / n;
+  s["mean_surge_ice_load_compliant_N"] = fx_compliant / n;
+  const std::string model_kind = r.attributes.value("contact_model", o.contact.ice_structure);
   s["steady_part"] = {{"from_s", o.steady_start_s}, {"to_s", o.duration_s}, {"samples", fx.size()}};
   nlohmann::json windows = nlohmann::json::array();
   for (double w : {kCompliantWindowS, kRigidWindowS}) {
     const size_t nw = static_cast<size_t>(std::lround(w / o.time_step_s));
     const std::vector<double> ma = moving_average(fx, nw);
-    nlohmann::json j = {{"window_s", w}, {"samples", nw}, {"kind", w == kRigidWindowS ? "rigid" : "compliant"}};
+    const std::string kind = w == kRigidWindowS ? "rigid" : "compliant";
+    nlohmann::json j = {{"window_s", w}, {"samples", nw}, {"kind", kind},
+                        // the window the seed uses for this run's vessel contacts (rigid: 20 s, else 0.5 s)
+                        {"applies", (model_kind == "rigid") == (kind == "rigid")}};
     if (ma.empty()) {
       j["note"] = "the steady part is shorter than the window";
       j["max_N"] = nullptr;
       j["min_N"] = nullptr;
       j["max_resistance_N"] = nullptr;
+      j["std_N"] = nullptr;
     } else {
       const auto [lo, hi] = std::minmax_element(ma.begin(), ma.end());
       j["max_N"] = *hi;
       j["min_N"] = *lo;
       j["max_resistance_N"] = -*lo;  // the largest filtered resistance (most negative surge load)
+      double m = 0, v2 = 0;
+      for (double x : ma) m += x;
+      m /= static_cast<double>(ma.size());
+      for (double x : ma) v2 += (x - m) * (x - m);
+      j["std_N"] = std::sqrt(v2 / static_cast<double>(ma.size()));  // spread of the filtered signal
     }
     windows.push_back(j);
   }
   s["moving_average_surge_ice_load"] = windows;
-  s["contact_model"] = "rigid";
+  s["contact_model"] = model_kind;
+  s["contact_laws"] = {{"ice_structure", o.contact.ice_structure}, {"ice_ice", o.contact.ice_ice}};
   s["mean_vessel_speed_mps"] = speed / n;
   s["mean_thrust_N"] = thrust / n;
   s["mean_awake_floes"] = aw / n;
@@ -310,7 +346,8 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   rep << "mean awake floes " << stats.mean_awake_floes << ", mean contacts " << stats.mean_contacts
       << ", mean solver sweeps " << stats.mean_iterations << "\n";
   rep << "mean part pairs per step: " << stats.mean_pairs << " from the broad phase, " << stats.mean_touching
-      << " touching (" << stats.mean_edge_pairs << " edge-on-edge, single point)\n";
+      << " touching (" << stats.mean_edge_pairs << " edge-on-edge, single point; " << stats.mean_crushing_pairs
+      << " crushing, one point)\n";
   rep << "stage times (ms/step):";
   for (int i = 0; i <= kStageCount; ++i)
     rep << " " << (i < kStageCount ? stage_name(i) : "record") << " " << std::setprecision(3)

@@ -17,7 +17,7 @@ struct IceOptions {
   double density_kg_m3 = 900.0;        // rho_i; the thickness comes from the floes file
   double mu_ice_ice = 0.15;            // friction coefficient between floes
   double mu_ice_structure = 0.15;      // friction coefficient between floe and hull
-  double crushing_strength_pa = 2e6;   // sigma_c (recorded; used by the compliant contacts of a later issue)
+  double crushing_strength_pa = 2e6;   // sigma_c: crushing pressure of compliant contacts (p_0 of the p-A law)
   double air_drag_ca = 0.0012;         // air-ice skin drag coefficient on the exposed top face (wind on floes)
   double max_overlap_fraction = 0.02;  // floes overlapping more than this fraction of the smaller floe are an error
   template <class V>
@@ -26,7 +26,8 @@ struct IceOptions {
     v.field("mu_ice_ice", mu_ice_ice, "-", "ice-ice friction coefficient", in_range(0, 2));
     v.field("mu_ice_structure", mu_ice_structure, "-", "ice-hull friction coefficient", in_range(0, 2));
     v.field("crushing_strength_pa", crushing_strength_pa, "Pa",
-            "ice crushing strength (recorded now; the compliant contact law of a later issue uses it)", positive());
+            "ice crushing strength sigma_c: the pressure that caps the normal force of compliant contacts",
+            positive());
     v.field("air_drag_ca", air_drag_ca, "-", "air-ice skin drag coefficient (wind on the floes' top faces)",
             non_negative());
     v.field("max_overlap_fraction", max_overlap_fraction, "-",
@@ -242,6 +243,38 @@ struct SolverOptions {
   }
 };
 
+// Contact laws per pair of body classes (PHYSICS.md §1.7-1.8). Rigid: non-penetration with ERP push-out and a
+// manifold of up to 4 points. Compliant: crushing (§1.8(c)), one row per pair of convex parts at the centroid of the
+// overlap's contact surface, normal force capped by p_c(A) A of the overlap's nominal contact area A, hardening with
+// K_t = dF/d(delta) inside the implicit step, no push-out and no spring-back. Defaults as SAMS: the vessel crushes ice,
+// floes meet rigidly.
+struct ContactOptions {
+  std::string ice_structure = "compliant";  // contacts between a floe and the vessel
+  std::string ice_ice = "rigid";            // contacts between two floes
+  double pressure_area_exponent = 0.0;      // e_x of p_c(A) = sigma_c (A / 1 m^2)^e_x; 0: constant pressure sigma_c
+  double area_gradient_step_m = 0.005;      // smallest step of the secant dA/d(delta) = (A(delta + step) - A) / step
+  double crushing_damping_ratio = 0.0;      // zeta of c_n = 2 zeta sqrt(m_eff K_t) added to the crushing force
+  template <class V>
+  void visit(V& v) {
+    v.field("ice_structure", ice_structure, "-",
+            "contact law between floes and the vessel: compliant (crushing, force <= p_c(A) x contact area) or rigid "
+            "(non-penetration)",
+            one_of({"compliant", "rigid"}));
+    v.field("ice_ice", ice_ice, "-", "contact law between floes: rigid or compliant", one_of({"compliant", "rigid"}));
+    v.field("pressure_area_exponent", pressure_area_exponent, "-",
+            "pressure-area exponent e_x of the crushing pressure p_c = ice.crushing_strength_pa x (A / 1 m^2)^e_x "
+            "(0: constant pressure)",
+            in_range(-0.9, 0));
+    v.field("area_gradient_step_m", area_gradient_step_m, "m",
+            "smallest penetration step of the secant dA/d(delta) of the contact area (force-penetration gradient); "
+            "the step is the penetration the approach speed adds in one time step when that is larger",
+            in_range(1e-5, 0.1));
+    v.field("crushing_damping_ratio", crushing_damping_ratio, "-",
+            "damping c_n = 2 zeta sqrt(m_eff K_t) of crushing contacts, fraction of critical (0: pure crushing)",
+            in_range(0, 2));
+  }
+};
+
 // The simulation domain: optional fixed walls along the sides of a rectangle (a coast, fast ice or a basin), so
 // that floes driven by a current or wind pack against them instead of drifting away. Walls are static bodies with
 // rigid contacts (ice.mu_ice_ice); they are not written to the results.
@@ -313,6 +346,7 @@ struct SimulateOptions {
   VesselOptions vessel;
   WindOptions wind;
   SolverOptions solver;
+  ContactOptions contact;
   DomainOptions domain;
   SleepOptions sleep;
   HealthOptions health;
@@ -333,6 +367,7 @@ struct SimulateOptions {
     v.section("vessel", vessel, "vessel start, mass, resistance, propulsion, steering");
     v.section("wind", wind, "wind");
     v.section("solver", solver, "contact solver");
+    v.section("contact", contact, "contact laws (rigid or compliant crushing) per pair of body classes");
     v.section("domain", domain, "fixed walls around the floe field (floes pack against them)");
     v.section("sleep", sleep, "sleeping of resting floes");
     v.section("health", health, "numerical health limits");

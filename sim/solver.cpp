@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace floesim::sim {
 
@@ -40,6 +41,29 @@ inline double rel_velocity(const State& s, const Contact& c, const Vec3& d) {
   return d.dot(vb - va);
 }
 
+// The normal impulse of a crushing row given its current normal velocity vn (PHYSICS.md §1.8(c)), the local
+// three-branch update of a Gauss-Seidel sweep. With W = 1/m_eff and v0 = vn - W p the velocity without this row's
+// impulse, the end-of-step velocity is v = v0 + W p and
+//   v0 >= 0                        -> p = 0                  separating: no tension, no spring-back
+//   -v0 <= W dt F_0                -> p = -v0 / W            below the crushing force: rigid (v = 0), no push-out
+//   otherwise                      -> p = dt (F_0 - k v) with k = dt K_t + c_n, i.e.
+//                                     p = dt (F_0 - k v0) / (1 + dt k W)   crushing, the force hardening with the
+//                                     area at the end-of-step penetration delta + dt (-v) (implicit in v),
+// the hardening capped at F_end (+ damping), the force of the area the collision stage measured at the end of the
+// step's expected penetration: the secant K_t is exact up to there, and beyond it the area is unknown, so the force
+// stays at p_c A of a penetration that is certainly reached (A grows with the penetration): never above p_c A.
+// Written without dividing by W, so that two kinematic bodies (W = 0) crush at exactly F_0 + K_t dt (-v0).
+double crushing_impulse(const Contact& c, double vn, double dt) {
+  const double W = c.inv_mass_n;
+  const double v0 = vn - W * c.pn;
+  if (v0 >= 0) return 0.0;
+  if (-v0 <= W * dt * c.crush_force_n) return -v0 / W;
+  const double k = dt * c.crush_stiffness_npm + c.crush_damping_nspm;
+  const double hardening = dt * (c.crush_force_n - k * v0) / (1 + dt * k * W);
+  const double capped = dt * (c.crush_force_end_n - c.crush_damping_nspm * v0) / (1 + dt * c.crush_damping_nspm * W);
+  return std::min(hardening, capped);
+}
+
 }  // namespace
 
 void prepare_contacts(const Model& model, const SolverBodies& sb, State& state, std::vector<Contact>& contacts,
@@ -62,12 +86,30 @@ void prepare_contacts(const Model& model, const SolverBodies& sb, State& state, 
       return w > 0 ? 1.0 / w : 0.0;
     };
     c.mass_n = row(c.normal, c.ia_n, c.ib_n);
+    c.inv_mass_n = c.mass_n > 0 ? 1.0 / c.mass_n : 0.0;
     c.mass_t1 = row(c.t1, c.ia_t1, c.ib_t1);
     c.mass_t2 = row(c.t2, c.ia_t2, c.ib_t2);
     // Bias = smallest allowed normal velocity. Rigid: push out the overlap beyond the slop at ERP per step (capped);
     // a speculative gap allows approaching by gap/dt. Crushing rows never push out (PHYSICS.md §1.8(c)).
-    if (c.type == ContactType::crushing) c.bias = 0;
-    else if (c.gap > 0) c.bias = -c.gap / dt;
+    if (c.type == ContactType::crushing) {
+      c.bias = 0;
+      // Crushing law (PHYSICS.md §1.8(a)): F(A) = p_c(A) A with p_c = sigma_c (A / 1 m^2)^e_x. F_0 at the current
+      // overlap, F_end at the overlap deepened by the step the collision stage measured, and the gradient
+      // K_t = dF/d(delta) as the secant between them (for e_x = 0 and a wedge: exactly 2 sigma_c h tan(phi)).
+      const ContactOptions& co = model.options.contact;
+      const double sigma = model.options.ice.crushing_strength_pa;
+      auto force = [&](double area) {
+        return co.pressure_area_exponent == 0 ? sigma * area
+                                              : sigma * std::pow(area, 1 + co.pressure_area_exponent);
+      };
+      c.crush_force_n = force(c.area_m2);
+      c.crush_force_end_n = std::max(c.crush_force_n, force(c.area_end_m2));
+      c.crush_stiffness_npm = c.area_step_m > 0 ? (c.crush_force_end_n - c.crush_force_n) / c.area_step_m : 0.0;
+      // Optional damping c_n = 2 zeta sqrt(m_eff K_t) (none between two kinematic bodies: m_eff infinite).
+      c.crush_damping_nspm = c.mass_n > 0 ? 2 * co.crushing_damping_ratio * std::sqrt(c.mass_n * c.crush_stiffness_npm)
+                                          : 0.0;
+      c.max_normal_impulse = dt * c.crush_force_n;  // the cap at the start-of-step penetration (warm start clamp)
+    } else if (c.gap > 0) c.bias = -c.gap / dt;
     else c.bias = std::min(o.erp * std::max(0.0, -c.gap - o.slop_m) / dt, o.max_push_mps);
     c.local_a = state.orientation[c.body_a].conjugate() * c.ra;
     c.pn = c.pt1 = c.pt2 = 0;
@@ -76,7 +118,8 @@ void prepare_contacts(const Model& model, const SolverBodies& sb, State& state, 
     if (!o.warm_start) continue;
     auto it = std::lower_bound(state.contact_cache.begin(), state.contact_cache.end(), c, key_less);
     const CachedContact* best = nullptr;
-    double bd = match_tol2;
+    // A crushing pair has one row (at the patch centroid, which may slide): its cached impulse is the pair's.
+    double bd = c.type == ContactType::crushing ? std::numeric_limits<double>::infinity() : match_tol2;
     for (; it != state.contact_cache.end() && same_key(*it, c); ++it) {
       const double d = (it->local_a - c.local_a).squaredNorm();
       if (d < bd) bd = d, best = &*it;
@@ -106,14 +149,19 @@ SolverReport solve_contacts(const Model& model, const SolverBodies& sb, State& s
   for (int it = 0; it < iterations; ++it) {
     double change = 0;
     for (Contact& c : contacts) {
-      const double target = use_bias ? c.bias : (c.gap > 0 && c.type == ContactType::rigid ? -c.gap / dt : 0.0);
       const double vn = rel_velocity(state, c, c.normal);
-      const double pn = std::clamp(c.pn + c.mass_n * (target - vn), 0.0, c.max_normal_impulse);
+      double pn;
+      if (c.type == ContactType::crushing) {
+        pn = crushing_impulse(c, vn, dt);
+      } else {
+        const double target = use_bias ? c.bias : (c.gap > 0 ? -c.gap / dt : 0.0);
+        pn = std::clamp(c.pn + c.mass_n * (target - vn), 0.0, c.max_normal_impulse);
+      }
       const double dpn = pn - c.pn;
       if (dpn != 0) {
         apply(state, sb, c, c.normal, c.ia_n, c.ib_n, dpn);
         c.pn = pn;
-        change = std::max(change, std::abs(dpn) / std::max(c.mass_n, 1e-300));
+        change = std::max(change, std::abs(dpn) * c.inv_mass_n);
       }
       const double lim = c.mu * c.pn;
       const double v1 = rel_velocity(state, c, c.t1), v2 = rel_velocity(state, c, c.t2);

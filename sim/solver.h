@@ -1,7 +1,9 @@
 // Velocity-level contact solver: matrix-free projected Gauss-Seidel on the cone complementarity problem
-// (PHYSICS.md §1.4-1.6), one normal row and two friction rows per contact, with warm starting, the ERP push-out
-// bias for rigid rows and an upper bound on the normal impulse (infinite for rigid rows; the crushing cap of
-// §1.8(c) for the compliant rows of a later issue). Laid out like Chrono's ChSolverPSOR in numbered steps.
+// (PHYSICS.md §1.4-1.6), one normal row and two friction rows per contact, with warm starting. Rigid rows: the ERP
+// push-out bias, normal impulse >= 0. Crushing rows (compliant contacts, §1.8(c)): the three-branch local law
+// (separating -> 0; rigid below the crushing force dt F_0; crushing above it, hardening with K_t implicitly in the
+// end-of-step velocity), zero bias, so crushed overlap is never pushed out and nothing springs back. Friction on
+// the same row for both. Laid out like Chrono's ChSolverPSOR in numbered steps.
 #pragma once
 #include <vector>
 
@@ -27,7 +29,8 @@ void prepare_contacts(const Model& model, const SolverBodies& bodies, State& sta
                       double dt);
 
 // 3. Gauss-Seidel sweeps until the largest velocity change of a sweep is below `tolerance` or `iterations` sweeps.
-// use_bias = false is the relax pass: rigid rows only keep non-penetration (and speculative gaps), no push-out.
+// use_bias = false is the relax pass: rigid rows only keep non-penetration (and speculative gaps), no push-out;
+// crushing rows have no bias in either pass (the same local law).
 SolverReport solve_contacts(const Model& model, const SolverBodies& bodies, State& state,
                             std::vector<Contact>& contacts, double dt, bool use_bias, int iterations,
                             double tolerance);

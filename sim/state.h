@@ -14,8 +14,9 @@ namespace floesim::sim {
 
 using Quat = Eigen::Quaterniond;
 
-// Rigid: non-penetration with ERP push-out (this issue). Crushing: compliant ice crushing, normal impulse capped by
-// the crushing force (PHYSICS.md §1.8(c), a later issue): the row structure below already carries its bound.
+// Rigid: non-penetration with ERP push-out. Crushing: compliant ice crushing (PHYSICS.md §1.8(c)): rigid while the
+// normal force is below the crushing force p_c(A) A of the overlap, crushing (hardening with K_t) above it, never
+// pushed out and never pulling. Which law a pair gets is chosen per pair of body classes (options.contact).
 enum class ContactType : uint8_t { rigid, crushing };
 
 // One contact point between body a and body b (a < b). Written by collide, completed and solved by solve.
@@ -27,7 +28,17 @@ struct Contact {
   double gap = 0;              // signed distance along the normal: < 0 overlap, > 0 speculative
   ContactType type = ContactType::rigid;
   double mu = 0;               // friction coefficient
-  double max_normal_impulse = std::numeric_limits<double>::infinity();  // N s; finite for crushing contacts
+  double max_normal_impulse = std::numeric_limits<double>::infinity();  // N s; dt F_0 for crushing contacts
+  // Crushing contacts (collide): nominal contact area of the overlap projected on the contact plane, and the area
+  // after a further penetration step along the normal (the clipped geometry re-measured): the step is what this
+  // time step adds at the current approach speed (at least contact.area_gradient_step_m).
+  double area_m2 = 0;
+  double area_end_m2 = 0;      // A(delta + step) >= A
+  double area_step_m = 0;      // the step, m
+  double area_slope_m = 0;     // (area_end - area) / step, m^2/m
+  // Crushing law (solve): F_0 = p_c(A) A, its secant gradient K_t = dF/d(delta) over the step, the cap
+  // F_end = p_c(A_end) A_end, damping c_n, and W = 1/m_eff of the normal row.
+  double crush_force_n = 0, crush_force_end_n = 0, crush_stiffness_npm = 0, crush_damping_nspm = 0, inv_mass_n = 0;
   // Solver data (solve): lever arms, tangents, effective masses, bias and the accumulated impulses.
   Vec3 ra = Vec3::Zero(), rb = Vec3::Zero();
   Vec3 t1 = Vec3::Zero(), t2 = Vec3::Zero();
