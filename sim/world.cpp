@@ -227,7 +227,8 @@ void World::stage_relax() {
     report_.relax = solve_contacts(model_, solver_bodies_, state_, contacts_, dt, false, o.relax_iterations,
                                    o.tolerance_mps);
   store_impulses(model_, state_, contacts_);
-  // Contact loads on the vessel: impulse / dt, about its centre of mass (lever arms of the solve).
+  // Contact loads on the vessel: impulse / dt, about its centre of mass (lever arms of the solve), split by contact
+  // law (the seed filters compliant loads over 0.5 s and rigid ones over 20 s, PHYSICS.md §5).
   report_.contacts = static_cast<int>(contacts_.size());
   const int vessel = model_.vessel;
   for (const Contact& c : contacts_) {

@@ -1,11 +1,14 @@
 // The time step (Box2D-style list of named, timed stages) over an immutable Model and a mutable State:
 //
-//   collide    broad phase for the bodies that moved, narrow phase + manifolds; awake bodies wake sleepers they touch
+//   collide    broad phase for the bodies that moved, narrow phase + manifolds (rigid pairs) or clipped overlap
+//              patches (compliant pairs); awake bodies wake sleepers they touch
 //   forces     external forces on awake bodies (gravity, buoyancy, damping, drag, resistance, propulsion, steering,
 //              wind) -> predicted velocities v* = v + dt M^-1 f
-//   solve      contact rows, warm start, PGS with the ERP bias
+//   solve      contact rows, warm start, PGS: rigid rows with the ERP bias, crushing rows with the compliant law
+//              (PHYSICS.md §1.8(c): rigid below p_c(A) A, crushing above it, never pushed out)
 //   integrate  semi-implicit Euler: x += dt v, q += dt/2 [0, w] q (normalised)
-//   relax      PGS without push-out bias, so that resolving overlap leaves no velocity; impulses stored for warm start
+//   relax      PGS without push-out bias, so that resolving overlap leaves no velocity (crushing rows keep their
+//              law, which has no bias anyway); impulses stored for warm start; the vessel's loads by contact law
 //   sleep      floes at rest without contacts fall asleep; numerical health checks (NaN, blow-up)
 //
 // Loads on the vessel are recorded per step in StepReport (world frame; the recorder turns them to body axes).

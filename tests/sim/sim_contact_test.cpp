@@ -1,5 +1,6 @@
-// Contact mechanics as physical invariants: a floe resting on another carries its weight through the contact;
-// colliding floes in vacuum conserve linear momentum and do not gain energy.
+// Contact mechanics as physical invariants, for rigid and compliant (crushing) floe-floe contacts: a floe resting
+// on another carries its weight through the contact; colliding floes in vacuum conserve linear momentum and do not
+// gain energy.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -27,10 +28,16 @@ Vec3 contact_force_on(const World& w, int b) {
 
 // A small floe put on top of a big floating one sits above the water (no buoyancy): the contact carries exactly
 // its weight m g. The pair settles to a common heave equilibrium with the big floe deeper by m_small/(rho_w A_big).
-TEST(SimContact, FloeOnFloeCarriesItsWeight) {
+// Both contact laws: a compliant (crushing) contact below its crushing force behaves as a rigid one, with one row
+// at the centroid of the overlap instead of a 4-point manifold (its centroid moves under a tilting floe and
+// rights it).
+class SimContactLaw : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(SimContactLaw, FloeOnFloeCarriesItsWeight) {
   FloeField field;
   field.floes = {rect_floe(1, 0, 0, 20, 20, 1.0), rect_floe(2, 30, 0, 4, 4, 0.5)};
   SimulateOptions o = floe_options();
+  o.contact.ice_ice = GetParam();
   const Model m = build_model(field, nullptr, o);
   World w(m);
   State& s = w.mutable_state();
@@ -48,8 +55,8 @@ TEST(SimContact, FloeOnFloeCarriesItsWeight) {
   }
   mean /= n;
   const double weight = m.bodies[1].mass_kg * 9.81;
-  std::printf("[measured] contact force on the top floe %.2f N (weight %.2f N, %+.4f %%), horizontal %.3g N\n",
-              mean.z(), weight, 100 * (mean.z() / weight - 1), std::hypot(mean.x(), mean.y()));
+  std::printf("[measured] %s: contact force on the top floe %.2f N (weight %.2f N, %+.4f %%), horizontal %.3g N\n",
+              GetParam(), mean.z(), weight, 100 * (mean.z() / weight - 1), std::hypot(mean.x(), mean.y()));
   EXPECT_NEAR(mean.z() / weight, 1.0, 1e-3);
   EXPECT_LT(std::hypot(mean.x(), mean.y()), 1e-3 * weight);
   // The top floe stays level on top (a single contact point would let it tip over).
@@ -64,10 +71,11 @@ TEST(SimContact, FloeOnFloeCarriesItsWeight) {
 
 // No water, no gravity: two spinning floes collide obliquely. Linear momentum is conserved to round-off and the
 // kinetic energy does not grow (contacts are inelastic; the relax pass removes push-out energy).
-TEST(SimContact, CollisionConservesMomentumInVacuum) {
+TEST_P(SimContactLaw, CollisionConservesMomentumInVacuum) {
   FloeField field;
   field.floes = {rect_floe(1, 0, 0, 6, 5, 1.0), rect_floe(2, 8, 1.5, 4, 4, 0.8)};
   SimulateOptions o = floe_options();
+  o.contact.ice_ice = GetParam();
   o.water.enabled = false;
   o.water.gravity_mps2 = 0;
   const Model m = build_model(field, nullptr, o);
@@ -88,13 +96,15 @@ TEST(SimContact, CollisionConservesMomentumInVacuum) {
   }
   const Vec3 p1 = w.linear_momentum();
   const double e1 = w.kinetic_energy();
-  std::printf("[measured] %d steps in contact; |dp|/|p| = %.3g; kinetic energy %.1f -> %.1f J\n", contact_steps,
-              (p1 - p0).norm() / p0.norm(), e0, e1);
+  std::printf("[measured] %s: %d steps in contact; |dp|/|p| = %.3g; kinetic energy %.1f -> %.1f J\n", GetParam(),
+              contact_steps, (p1 - p0).norm() / p0.norm(), e0, e1);
   EXPECT_GT(contact_steps, 0);
   EXPECT_LT((p1 - p0).norm(), 1e-9 * p0.norm());
   EXPECT_LE(e1, e0 * (1 + 1e-9));
   EXPECT_GT(w.state().velocity[1].x(), -0.8 + 0.1);  // the collision did change the motion
 }
+
+INSTANTIATE_TEST_SUITE_P(Laws, SimContactLaw, ::testing::Values("rigid", "compliant"));
 
 }  // namespace
 }  // namespace floesim::sim
