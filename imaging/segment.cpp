@@ -64,6 +64,62 @@ cv::Mat masked_smooth(const cv::Mat& gray, const cv::Mat& mask, double sigma_px,
   return out;
 }
 
+// Local water and ice brightness from Otsu's split of each block of block_px x block_px pixels: the two class
+// means of a block, weighted by how clearly it holds both classes (contrast above min_contrast, and the share of
+// the smaller class), are smoothed over the neighbouring blocks (normalised convolution, sigma one block) and
+// interpolated between block centres. Unlike one global split, this follows a darker far field or a field of
+// grey floes; a block of one class only (inside a large floe, open water) takes its neighbours' levels. Where no
+// block has both classes, the global class means (fallback_water, fallback_ice) are used.
+void local_otsu_levels(const cv::Mat& img, const cv::Mat& valid, int block_px, double min_contrast,
+                       double fallback_water, double fallback_ice, cv::Mat& water, cv::Mat& ice) {
+  const int bx = (img.cols + block_px - 1) / block_px, by = (img.rows + block_px - 1) / block_px;
+  cv::Mat L(by, bx, CV_32F, cv::Scalar(0)), H(by, bx, CV_32F, cv::Scalar(0)), W(by, bx, CV_32F, cv::Scalar(0));
+  double sum_l = 0, sum_h = 0, sum_w = 0;
+  std::array<double, 256> hist;
+  for (int j = 0; j < by; ++j)
+    for (int i = 0; i < bx; ++i) {
+      hist.fill(0);
+      double n = 0;
+      for (int r = j * block_px; r < std::min(img.rows, (j + 1) * block_px); ++r) {
+        const float* p = img.ptr<float>(r);
+        const uint8_t* v = valid.ptr<uint8_t>(r);
+        for (int c = i * block_px; c < std::min(img.cols, (i + 1) * block_px); ++c)
+          if (v[c]) {
+            hist[std::clamp(static_cast<int>(p[c] + 0.5f), 0, 255)] += 1;
+            n += 1;
+          }
+      }
+      if (n < 0.2 * block_px * block_px) continue;  // mostly no data: too few pixels to judge
+      const int t = otsu(hist);
+      double n0 = 0, s0 = 0, s1 = 0;
+      for (int k = 0; k < 256; ++k) (k <= t ? s0 : s1) += k * hist[k], n0 += k <= t ? hist[k] : 0;
+      if (n0 <= 0 || n0 >= n) continue;
+      const double m0 = s0 / n0, m1 = s1 / (n - n0);
+      if (m1 - m0 <= min_contrast) continue;
+      const double w = std::min(n0, n - n0);  // both classes present: the smaller class's pixel count
+      L.at<float>(j, i) = static_cast<float>(m0 * w);
+      H.at<float>(j, i) = static_cast<float>(m1 * w);
+      W.at<float>(j, i) = static_cast<float>(w);
+      sum_l += m0 * w;
+      sum_h += m1 * w;
+      sum_w += w;
+    }
+  const double gl = sum_w > 0 ? sum_l / sum_w : fallback_water, gh = sum_w > 0 ? sum_h / sum_w : fallback_ice;
+  cv::GaussianBlur(W, W, cv::Size(0, 0), 1.0, 1.0, cv::BORDER_REFLECT);
+  cv::GaussianBlur(L, L, cv::Size(0, 0), 1.0, 1.0, cv::BORDER_REFLECT);
+  cv::GaussianBlur(H, H, cv::Size(0, 0), 1.0, 1.0, cv::BORDER_REFLECT);
+  // A small prior weight pulls blocks without support to the image-wide levels.
+  const float eps = static_cast<float>(1e-3 * (sum_w > 0 ? sum_w / (bx * by) : 1.0));
+  L = (L + eps * static_cast<float>(gl)) / (W + eps);
+  H = (H + eps * static_cast<float>(gh)) / (W + eps);
+  // Bilinear between block centres (cv::resize maps block centres onto the pixel grid), then cropped.
+  cv::Mat wl, il;
+  cv::resize(L, wl, cv::Size(bx * block_px, by * block_px), 0, 0, cv::INTER_LINEAR);
+  cv::resize(H, il, cv::Size(bx * block_px, by * block_px), 0, 0, cv::INTER_LINEAR);
+  water = wl(cv::Rect(0, 0, img.cols, img.rows)).clone();
+  ice = il(cv::Rect(0, 0, img.cols, img.rows)).clone();
+}
+
 // Fills the 8-connected non-ice components that touch neither the image border nor a no-data pixel and have
 // at most max_px pixels (melt ponds and other water enclosed by ice).
 void fill_small_holes(cv::Mat& ice, const cv::Mat& valid, double max_px) {
@@ -204,50 +260,69 @@ struct UnionFind {
 }  // namespace
 
 void reconstruct_by_dilation(cv::Mat& marker, const cv::Mat& mask, const cv::Mat& domain) {
-  const int R = marker.rows, C = marker.cols;
-  auto in = [&](int r, int c) { return r >= 0 && c >= 0 && r < R && c < C && domain.at<uint8_t>(r, c); };
-  // Forward raster scan with the causal half of the 8-neighbourhood, then the backward scan.
-  for (int r = 0; r < R; ++r)
+  const int R = marker.rows, C = marker.cols, W = C + 2;
+  // Flat copies with a one-pixel frame outside the domain, so the neighbours need no bounds checks.
+  const size_t N = static_cast<size_t>(R + 2) * W;
+  std::vector<float> f(N, 0.0f), g(N, 0.0f);
+  std::vector<uint8_t> in(N, 0);
+  for (int r = 0; r < R; ++r) {
+    const float* pm = marker.ptr<float>(r);
+    const float* pg = mask.ptr<float>(r);
+    const uint8_t* pd = domain.ptr<uint8_t>(r);
+    const size_t o = static_cast<size_t>(r + 1) * W + 1;
     for (int c = 0; c < C; ++c) {
-      if (!domain.at<uint8_t>(r, c)) continue;
-      float v = marker.at<float>(r, c);
-      for (int k = 0; k < 4; ++k)
-        if (in(r + kDr[k], c + kDc[k])) v = std::max(v, marker.at<float>(r + kDr[k], c + kDc[k]));
-      marker.at<float>(r, c) = std::min(v, mask.at<float>(r, c));
+      f[o + c] = pm[c];
+      g[o + c] = pg[c];
+      in[o + c] = pd[c] ? 1 : 0;
     }
-  std::deque<int> fifo;
+  }
+  // Causal (forward) and anti-causal halves of the 8-neighbourhood.
+  const long fw[4] = {-W - 1, -W, -W + 1, -1}, bw[4] = {W + 1, W, W - 1, 1};
+  for (int r = 0; r < R; ++r)
+    for (size_t p = static_cast<size_t>(r + 1) * W + 1, e = p + C; p < e; ++p) {
+      if (!in[p]) continue;
+      float v = f[p];
+      for (long d : fw)
+        if (in[p + d]) v = std::max(v, f[p + d]);
+      f[p] = std::min(v, g[p]);
+    }
+  std::deque<size_t> fifo;
   for (int r = R - 1; r >= 0; --r)
-    for (int c = C - 1; c >= 0; --c) {
-      if (!domain.at<uint8_t>(r, c)) continue;
-      float v = marker.at<float>(r, c);
-      for (int k = 4; k < 8; ++k)
-        if (in(r + kDr[k], c + kDc[k])) v = std::max(v, marker.at<float>(r + kDr[k], c + kDc[k]));
-      v = std::min(v, mask.at<float>(r, c));
-      marker.at<float>(r, c) = v;
-      for (int k = 4; k < 8; ++k) {
-        const int rr = r + kDr[k], cc = c + kDc[k];
-        if (in(rr, cc) && marker.at<float>(rr, cc) < v && marker.at<float>(rr, cc) < mask.at<float>(rr, cc)) {
-          fifo.push_back(r * C + c);
+    for (size_t e = static_cast<size_t>(r + 1) * W + 1, p = e + C; p-- > e;) {
+      if (!in[p]) continue;
+      float v = f[p];
+      for (long d : bw)
+        if (in[p + d]) v = std::max(v, f[p + d]);
+      v = std::min(v, g[p]);
+      f[p] = v;
+      for (long d : bw) {
+        const size_t q = p + d;
+        if (in[q] && f[q] < v && f[q] < g[q]) {
+          fifo.push_back(p);
           break;
         }
       }
     }
   // Propagate what the two scans could not reach.
+  const long all[8] = {-W - 1, -W, -W + 1, -1, 1, W - 1, W, W + 1};
   while (!fifo.empty()) {
-    const int p = fifo.front();
+    const size_t p = fifo.front();
     fifo.pop_front();
-    const int r = p / C, c = p % C;
-    const float v = marker.at<float>(r, c);
-    for (int k = 0; k < 8; ++k) {
-      const int rr = r + kDr[k], cc = c + kDc[k];
-      if (!in(rr, cc)) continue;
-      float& q = marker.at<float>(rr, cc);
-      const float g = mask.at<float>(rr, cc);
-      if (q < v && q != g) {
-        q = std::min(v, g);
-        fifo.push_back(rr * C + cc);
+    const float v = f[p];
+    for (long d : all) {
+      const size_t q = p + d;
+      if (!in[q]) continue;
+      if (f[q] < v && f[q] != g[q]) {
+        f[q] = std::min(v, g[q]);
+        fifo.push_back(q);
       }
     }
+  }
+  for (int r = 0; r < R; ++r) {
+    float* pm = marker.ptr<float>(r);
+    const float* pd = &f[static_cast<size_t>(r + 1) * W + 1];
+    for (int c = 0; c < C; ++c)
+      if (domain.ptr<uint8_t>(r)[c]) pm[c] = pd[c];
   }
 }
 
@@ -328,11 +403,27 @@ Segmentation segment_floes(const cv::Mat& gray, double s, const DigitiseOptions&
                   ": every pixel is 0, which digitise reads as \"no data\" (outside the camera footprint); "
                   "is this the right image?");
 
+  // Pre-smoothing against sensor noise and surface texture, normalised inside the footprint so no-data does
+  // not darken the pixels next to it.
+  cv::Mat g32;
+  gray.convertTo(g32, CV_32F);
+  const double smooth_px = o.smoothing_m / s;
+  if (smooth_px >= 0.3) {
+    cv::Mat v32, num, den;
+    seg.valid.convertTo(v32, CV_32F, 1.0 / 255);
+    cv::GaussianBlur(g32, num, cv::Size(0, 0), smooth_px, smooth_px, cv::BORDER_REFLECT);
+    cv::GaussianBlur(v32, den, cv::Size(0, 0), smooth_px, smooth_px, cv::BORDER_REFLECT);
+    g32 = num / cv::max(den, 1e-3f);
+    g32.setTo(0, ~seg.valid);
+  }
+
   // 2. Ice / water.
   std::array<double, 256> hist{};
   for (int r = 0; r < R; ++r) {
-    const uint8_t* p = gray.ptr<uint8_t>(r);
-    for (int c = 0; c < C; ++c) hist[p[c]] += 1;
+    const float* p = g32.ptr<float>(r);
+    const uint8_t* v = seg.valid.ptr<uint8_t>(r);
+    for (int c = 0; c < C; ++c)
+      if (v[c]) hist[std::clamp(static_cast<int>(p[c] + 0.5f), 0, 255)] += 1;
   }
   hist[0] = 0;
   const int t = otsu(hist);
@@ -374,18 +465,39 @@ Segmentation segment_floes(const cv::Mat& gray, double s, const DigitiseOptions&
     ice = seg.valid.clone();
   } else {
     seg.classes = "mixed";
-    ice = seg.valid & (gray > t);
-    const double sigma_px = o.illumination_scale_m / s;
-    cv::Mat g32;
-    gray.convertTo(g32, CV_32F);
-    for (int pass = 0; pass < 2; ++pass) {
-      const cv::Mat water = seg.valid & ~ice;
-      const cv::Mat wl = masked_smooth(gray, water, sigma_px, seg.water_grey);
-      const cv::Mat il = masked_smooth(gray, ice, sigma_px, seg.ice_grey);
-      // Local contrast floored at half the least contrast, so a patch with one class does not blow up.
-      cv::Mat den = cv::max(il - wl, 0.5 * o.min_contrast);
+    ice = seg.valid & (g32 > t);
+    cv::Mat wl, den;
+    if (o.illumination == "local_otsu") {
+      cv::Mat il;
+      const int block_px = std::max(8, static_cast<int>(std::lround(o.local_block_m / s)));
+      local_otsu_levels(g32, seg.valid, block_px, o.min_contrast, seg.water_grey, seg.ice_grey, wl, il);
+      den = cv::max(il - wl, 0.5 * o.min_contrast);
       norm = (g32 - wl) / den;
       ice = seg.valid & (norm > o.threshold_fraction);
+    } else {
+      const double sigma_px = o.illumination_scale_m / s;
+      for (int pass = 0; pass < 2; ++pass) {
+        const cv::Mat water = seg.valid & ~ice;
+        wl = masked_smooth(g32, water, sigma_px, seg.water_grey);
+        const cv::Mat il = masked_smooth(g32, ice, sigma_px, seg.ice_grey);
+        // Local contrast floored at half the least contrast, so a patch with one class does not blow up.
+        den = cv::max(il - wl, 0.5 * o.min_contrast);
+        norm = (g32 - wl) / den;
+        ice = seg.valid & (norm > o.threshold_fraction);
+      }
+    }
+
+    // Cracks: a dark line narrower than crack_width_m (the black top-hat: closing minus image) that is deeper
+    // than crack_depth of the local contrast separates two floes even where the threshold bridged it. No-data
+    // is set to the water level first, so the footprint's edge is not a crack.
+    const int crack_r = static_cast<int>(std::lround(o.crack_width_m / (2 * s)));
+    if (o.crack_width_m > 0 && crack_r >= 1) {
+      cv::Mat img = g32.clone(), closed;
+      wl.copyTo(img, ~seg.valid);
+      const cv::Mat k = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * crack_r + 1, 2 * crack_r + 1));
+      cv::morphologyEx(img, closed, cv::MORPH_CLOSE, k, cv::Point(-1, -1), 1, cv::BORDER_REPLICATE);
+      const cv::Mat depth = (closed - img) / den;
+      ice.setTo(0, depth > o.crack_depth);
     }
 
     // 3. Cleanup: melt ponds, opening, brash.
@@ -421,7 +533,7 @@ Segmentation segment_floes(const cv::Mat& gray, double s, const DigitiseOptions&
     cv::Mat piece;
     const int n_pieces = cv::connectedComponents(ice, piece, 4, CV_32S);
     std::vector<float> bright(n_pieces, 1.0f);
-    {
+    if (o.core_fraction > 0) {
       std::vector<std::vector<float>> values(n_pieces);
       for (int r = 0; r < R; ++r)
         for (int c = 0; c < C; ++c)
@@ -434,11 +546,15 @@ Segmentation segment_floes(const cv::Mat& gray, double s, const DigitiseOptions&
       }
     }
     cv::Mat core(R, C, CV_8U, cv::Scalar(0));
-    for (int r = 0; r < R; ++r)
-      for (int c = 0; c < C; ++c)
-        if (const int k = piece.at<int>(r, c))
-          core.at<uint8_t>(r, c) = norm_s.at<float>(r, c) > o.core_fraction * bright[k] ? 255 : 0;
-    fill_small_holes(core, seg.valid, o.max_hole_area_m2 / px_area);
+    if (o.core_fraction > 0) {
+      for (int r = 0; r < R; ++r)
+        for (int c = 0; c < C; ++c)
+          if (const int k = piece.at<int>(r, c))
+            core.at<uint8_t>(r, c) = norm_s.at<float>(r, c) > o.core_fraction * bright[k] ? 255 : 0;
+      fill_small_holes(core, seg.valid, o.max_hole_area_m2 / px_area);
+    } else {
+      core = ice.clone();  // the shape alone splits (its holes are filled already)
+    }
     cv::Mat dist;
     cv::distanceTransform(core, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
     const float h = static_cast<float>(o.marker_dynamic_m / s);
@@ -453,7 +569,10 @@ Segmentation segment_floes(const cv::Mat& gray, double s, const DigitiseOptions&
     // An ice piece without core (a small floe) is seeded at its deepest pixel.
     {
       cv::Mat ice_dist;
-      cv::distanceTransform(ice, ice_dist, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+      if (o.core_fraction > 0)
+        cv::distanceTransform(ice, ice_dist, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+      else
+        ice_dist = dist;
       std::vector<char> has_seed(n_pieces, 0);
       std::vector<float> best(n_pieces, -1);
       std::vector<cv::Point> where(n_pieces);
@@ -503,7 +622,7 @@ Segmentation segment_floes(const cv::Mat& gray, double s, const DigitiseOptions&
     // (its highest core distance, the saddle, reaches neck_ratio of the smaller piece's deepest point) are one
     // floe with a dent, not two floes. A boundary through the dark band between cores has saddle 0 and stays.
     const double min_px = o.min_floe_area_m2 / px_area;
-    for (int iter = 0; iter < 8; ++iter) {
+    {
       cv::Mat markers(R, C, CV_32S, cv::Scalar(0));
       for (int r = 0; r < R; ++r)
         for (int c = 0; c < C; ++c) {
@@ -511,6 +630,33 @@ Segmentation segment_floes(const cv::Mat& gray, double s, const DigitiseOptions&
           if (l > 0) markers.at<int>(r, c) = uf.find(l);
         }
       lab = watershed_distance(markers, relief, ice);
+    }
+    for (int iter = 0; iter < 8; ++iter) {
+      if (iter > 0) {
+        // The merged pieces take their root's label, and the lines between pieces of one floe become floe:
+        // nearly what flooding again from the merged seeds gives (a boundary may differ by a pixel where three
+        // floods met), at a fraction of the cost.
+        for (int r = 0; r < R; ++r) {
+          int* p = lab.ptr<int>(r);
+          for (int c = 0; c < C; ++c)
+            if (p[c] > 0) p[c] = uf.find(p[c]);
+        }
+        for (int r = 0; r < R; ++r)
+          for (int c = 0; c < C; ++c) {
+            if (lab.at<int>(r, c) != -1) continue;
+            int u = 0;
+            bool one = true;
+            for (int k = 0; k < 8 && one; ++k) {
+              const int rr = r + kDr[k], cc = c + kDc[k];
+              if (rr < 0 || cc < 0 || rr >= R || cc >= C) continue;
+              const int m = lab.at<int>(rr, cc);
+              if (m <= 0) continue;
+              if (u == 0) u = m;
+              else if (m != u) one = false;
+            }
+            if (one && u > 0) lab.at<int>(r, c) = u;
+          }
+      }
       std::vector<long long> area(n_seeds + 1, 0);
       std::vector<float> depth(n_seeds + 1, 0.0f);
       struct Shared {
@@ -567,6 +713,20 @@ Segmentation segment_floes(const cv::Mat& gray, double s, const DigitiseOptions&
   for (int r = 0; r < R; ++r)
     for (int c = 0; c < C; ++c)
       if (lab.at<int>(r, c) > 0) ++area[lab.at<int>(r, c)];
+  std::vector<char> slush(max_label + 1, 0);
+  if (o.min_floe_brightness > 0 && !norm.empty()) {
+    // Slush and grey brash pass the ice threshold in patches; a floe is bright over most of its area.
+    std::vector<std::vector<float>> values(max_label + 1);
+    for (int r = 0; r < R; ++r)
+      for (int c = 0; c < C; ++c)
+        if (const int l = lab.at<int>(r, c); l > 0) values[l].push_back(norm.at<float>(r, c));
+    for (int l = 1; l <= max_label; ++l) {
+      auto& v = values[l];
+      if (v.empty()) continue;
+      std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+      slush[l] = v[v.size() / 2] < o.min_floe_brightness;
+    }
+  }
   const double min_px = o.min_floe_area_m2 / px_area;
   std::vector<int> renum(max_label + 1, 0);
   int next = 0;
@@ -575,7 +735,7 @@ Segmentation segment_floes(const cv::Mat& gray, double s, const DigitiseOptions&
     for (int c = 0; c < C; ++c) {
       const int l = p[c];
       if (l <= 0) continue;
-      if (area[l] < min_px) {
+      if (area[l] < min_px || slush[l]) {
         p[c] = 0;
         continue;
       }
