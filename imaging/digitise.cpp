@@ -9,6 +9,7 @@
 #include "imaging/stats.h"
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
+#include "pipeline/geometry2d.h"
 #include "pipeline/provenance.h"
 
 namespace floesim::imaging {
@@ -51,6 +52,29 @@ DigitiseResult digitise(const cv::Mat& gray, double s, const DigitiseOptions& o,
                                {"overlaps_remaining", res.polygons.overlaps_remaining}};
   res.warnings = res.seg.warnings;
   return res;
+}
+
+nlohmann::json convex_parts_geojson(const FloeField& field) {
+  nlohmann::json fc = floes_to_geojson(FloeField{{}, field.width_m, field.height_m, field.provenance});
+  fc["floesim"]["format"] = "floesim-convex-parts/1";
+  nlohmann::json feats = nlohmann::json::array();
+  for (const Floe& f : field.floes) {
+    nlohmann::json polys = nlohmann::json::array();
+    const std::vector<Polygon> parts = convex_decompose(f.outline);
+    for (const Polygon& p : parts) {
+      nlohmann::json ring = nlohmann::json::array();
+      for (const Vec2& v : p) ring.push_back({v.x(), v.y()});
+      ring.push_back({p[0].x(), p[0].y()});  // GeoJSON rings are closed
+      polys.push_back({ring});
+    }
+    feats.push_back({{"type", "Feature"},
+                     {"id", f.id},
+                     {"properties",
+                      {{"id", f.id}, {"area_m2", f.area_m2}, {"thickness_m", f.thickness_m}, {"parts", parts.size()}}},
+                     {"geometry", {{"type", "MultiPolygon"}, {"coordinates", polys}}}});
+  }
+  fc["features"] = feats;
+  return fc;
 }
 
 cv::Mat render_overlay(const cv::Mat& gray, const FloeField& floes, double s) {
@@ -150,21 +174,36 @@ DigitiseResult run_digitise(const DigitiseRequest& req) {
 
   ensure_directory(req.out_dir);
   AtomicFile geo(req.out_dir / "floes.geojson"), labels(req.out_dir / "labels.png"),
-      overlay(req.out_dir / "overlay.png"), stats_f(req.out_dir / "stats.json"), score_f(req.out_dir / "score.json");
+      overlay(req.out_dir / "overlay.png"), stats_f(req.out_dir / "stats.json"), fsd_png(req.out_dir / "fsd.png"),
+      fsd_csv(req.out_dir / "fsd.csv"), score_f(req.out_dir / "score.json"),
+      parts_f(req.out_dir / "convex_parts.geojson");
   write_json_tmp(geo, floes_to_geojson(res.floes));
   write_labels_png(labels.tmp(), res.seg.labels, labels.path().string());
   write_png_tmp(overlay, render_overlay(gray, res.floes, req.metres_per_pixel));
   write_json_tmp(stats_f, stats);
+  write_png_tmp(fsd_png, plot_size_distribution(res.stats, "floe size distribution of " +
+                                                               req.image.filename().string() + ": " +
+                                                               std::to_string(res.floes.floes.size()) + " floes"));
+  {
+    std::ofstream out(fsd_csv.tmp(), std::ios::binary);
+    out << size_distribution_csv(res.stats);
+    out.flush();
+    FLOESIM_REQUIRE(static_cast<bool>(out), fsd_csv.path().string(), ": write failed (is the directory writable?)");
+  }
   if (res.score) {
     nlohmann::json sj = res.score->to_json();
     sj["provenance"] = prov;
     write_json_tmp(score_f, sj);
   }
+  if (o.convex_parts) write_json_tmp(parts_f, convex_parts_geojson(res.floes));
   geo.commit();
   labels.commit();
   overlay.commit();
   stats_f.commit();
+  fsd_png.commit();
+  fsd_csv.commit();
   if (res.score) score_f.commit();
+  if (o.convex_parts) parts_f.commit();
   return res;
 }
 

@@ -7,6 +7,11 @@
 //   overlay.png    the photograph in colour with each floe's outline and id
 //   stats.json     count, concentration, size distribution table, power-law fits, diagnostics, warnings,
 //                  provenance
+//   fsd.png        the size distribution (number density against equivalent diameter, log-log) with the
+//                  truncated power-law fit and its exponent; fsd.csv the same table
+//   convex_parts.geojson  only with the option convex_parts: per floe (same id) a MultiPolygon of convex CCW
+//                  pieces that tile its outline exactly (pipeline/geometry2d.h convex_decompose), for simulators
+//                  that take convex bodies
 //   score.json     only with a truth file (GeoJSON polygons, or a labelled mask): precision, recall, F1, mean
 //                  IoU, pixel IoU, concentration error, KS distance of the log-area distributions (score.h)
 //
@@ -56,6 +61,10 @@ struct DigitiseRequest {
 
 // Reads and checks everything, digitises, writes the artefacts (see above).
 DigitiseResult run_digitise(const DigitiseRequest& req);
+
+// convex_parts.geojson's content: each floe as a MultiPolygon of its convex pieces (properties id, area_m2,
+// thickness_m, parts), the field extent and provenance as in floes.geojson.
+nlohmann::json convex_parts_geojson(const FloeField& floes);
 
 // The photograph in colour with each floe's outline (a colour per id) and, where it fits, its id.
 cv::Mat render_overlay(const cv::Mat& gray, const FloeField& floes, double metres_per_pixel);

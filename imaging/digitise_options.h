@@ -43,8 +43,10 @@ struct DigitiseOptions {
                                          // this is slush or brash, not a floe, and is dropped; 0 = off
   double simplify_tolerance_m = 0.5;     // Douglas-Peucker tolerance of the outlines
   double thickness_m = 1.0;              // written to every floe (SAMS table: h = 1 m)
+  bool convex_parts = false;             // also write convex_parts.geojson: each floe split into convex pieces
   int size_bins_per_decade = 5;          // floe size distribution table: log-spaced bins of equivalent diameter
-  double fit_min_diameter_m = 0.0;       // power-law fit uses floes with D >= this (0: the smallest floe)
+  double fit_min_diameter_m = 0.0;       // power-law fit uses floes with D >= this (0: chosen from the data by
+                                         // the Kolmogorov-Smirnov criterion of Clauset et al. 2009)
 
   template <class V>
   void visit(V& v) {
@@ -86,9 +88,11 @@ struct DigitiseOptions {
             "floes with a median normalised brightness below this are slush and dropped (0 = off)", in_range(0, 2));
     v.field("simplify_tolerance_m", simplify_tolerance_m, "m", "outline simplification tolerance", non_negative());
     v.field("thickness_m", thickness_m, "m", "ice thickness written to every floe", positive());
+    v.field("convex_parts", convex_parts, "-",
+            "also write convex_parts.geojson (each floe as a MultiPolygon of convex pieces that tile it)");
     v.field("size_bins_per_decade", size_bins_per_decade, "-", "size distribution bins per decade of diameter",
             int_in_range(1, 50));
-    v.field("fit_min_diameter_m", fit_min_diameter_m, "m", "lower bound of the power-law fit (0: smallest floe)",
+    v.field("fit_min_diameter_m", fit_min_diameter_m, "m", "lower bound of the power-law fit (0: KS-minimising choice, Clauset et al. 2009)",
             non_negative());
   }
 };

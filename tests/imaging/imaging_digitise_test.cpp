@@ -90,6 +90,40 @@ TEST(PowerLaw, RecoversTheExponentOfAKnownSample) {
   EXPECT_GT(fit_power_law(d, lo).alpha, a + 0.01);
 }
 
+TEST(PowerLaw, ChoosesTheLowerBoundWhereTheImageStopsResolvingFloes) {
+  // D ~ D^-2.5 on [5, 300], plus floes in [1, 5] at a tenth of the power law's density (an image that
+  // under-resolves small floes): the KS criterion puts d_min near 5 m and the fit above it recovers alpha.
+  std::vector<double> d;
+  const double a = 2.5, e = 1 - a;
+  auto sample = [&](double lo, double hi, int n) {
+    for (int i = 0; i < n; ++i) {
+      const double u = (i + 0.5) / n;
+      d.push_back(std::pow(std::pow(lo, e) + u * (std::pow(hi, e) - std::pow(lo, e)), 1 / e));
+    }
+  };
+  sample(5, 300, 3000);
+  // The power law would put (1^e - 5^e) / (5^e - 300^e) * 3000 = 31,000 floes in [1, 5]; a tenth of that:
+  sample(1, 5, 3100);
+  std::sort(d.begin(), d.end());
+  double ks = 0;
+  const double dmin = choose_fit_min_diameter(d, 30, &ks);
+  EXPECT_NEAR(dmin, 5.0, 0.5);
+  EXPECT_LT(ks, 0.02);
+  EXPECT_NEAR(fit_power_law(d, dmin, d.back()).alpha, a, 0.05);
+  // From the smallest floe the exponent is far too low.
+  EXPECT_LT(fit_power_law(d, d.front(), d.back()).alpha, 2.0);
+}
+
+TEST(PowerLaw, PlotIsDeterministicAndHandlesNoFloes) {
+  const Json st = floe_statistics({1, 2, 3, 5, 8, 13, 21, 34, 55, 89}, 231, 1000, 5, 0.5);
+  const cv::Mat a = plot_size_distribution(st, "test"), b = plot_size_distribution(st, "test");
+  ASSERT_EQ(a.type(), CV_8UC3);
+  EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0);
+  const cv::Mat none = plot_size_distribution(floe_statistics({}, 0, 1000, 5, 0), "empty");
+  EXPECT_EQ(none.size(), a.size());
+  EXPECT_EQ(size_distribution_csv(floe_statistics({}, 0, 1000, 5, 0)), "d_min_m,d_max_m,count,number_density_per_m3\n");
+}
+
 // ---- on the synthetic image ----
 
 struct SyntheticRun {
@@ -136,7 +170,8 @@ TEST(DigitiseSynthetic, ArtefactsAgreeWithEachOther) {
   const std::filesystem::path out = d.path / "floes";
   std::set<std::string> files;
   for (const auto& n : test::list_dir(out)) files.insert(n);
-  EXPECT_EQ(files, (std::set<std::string>{"floes.geojson", "labels.png", "overlay.png", "stats.json", "score.json"}));
+  EXPECT_EQ(files, (std::set<std::string>{"floes.geojson", "labels.png", "overlay.png", "stats.json", "fsd.png",
+                                          "fsd.csv", "score.json"}));
 
   // floes.geojson reads back through the strict reader (simple, CCW, unique ids >= 1).
   const FloeField floes = read_floes(out / "floes.geojson");
@@ -209,10 +244,59 @@ TEST(DigitiseSynthetic, ArtefactsAgreeWithEachOther) {
   const PowerLawFit ft = fit_power_law(d_truth, dmin, dmax), fp = fit_power_law(d_pred, dmin, dmax);
   EXPECT_NEAR(fp.alpha, ft.alpha, 3 * ft.alpha_stderr) << "truth " << ft.alpha << " +- " << ft.alpha_stderr;
 
+  // fsd.csv: the same bins as stats.json; fsd.png a colour plot.
+  std::ifstream csv(out / "fsd.csv");
+  std::string line;
+  int rows = -1;  // header
+  while (std::getline(csv, line)) ++rows;
+  EXPECT_EQ(rows, static_cast<int>(st["size_distribution"]["bins"].size()));
+  EXPECT_EQ(cv::imread((out / "fsd.png").string(), cv::IMREAD_UNCHANGED).type(), CV_8UC3);
+
   // overlay.png: colour, the input's size.
   const cv::Mat overlay = cv::imread((out / "overlay.png").string(), cv::IMREAD_UNCHANGED);
   EXPECT_EQ(overlay.type(), CV_8UC3);
   EXPECT_EQ(overlay.size(), cv::Size(1114, 627));
+}
+
+TEST(DigitiseSynthetic, ConvexPartsTileEachFloe) {
+  SynthOptions so;
+  const SynthResult syn = synthesize(so);
+  test::ScratchDir d;
+  cv::imwrite((d.path / "image.png").string(), syn.image);
+  DigitiseRequest req;
+  req.image = d.path / "image.png";
+  req.metres_per_pixel = so.metres_per_pixel;
+  req.out_dir = d.path / "out";
+  req.config = {{"convex_parts", true}};
+  const DigitiseResult res = run_digitise(req);
+  const Json parts = load_json_file(d.path / "out" / "convex_parts.geojson");
+  ASSERT_EQ(parts["features"].size(), res.floes.floes.size());
+  int non_convex_floes = 0;
+  for (size_t i = 0; i < res.floes.floes.size(); ++i) {
+    const Floe& f = res.floes.floes[i];
+    const Json& feat = parts["features"][i];
+    ASSERT_EQ(feat["properties"]["id"].get<int>(), f.id);
+    ASSERT_EQ(feat["geometry"]["type"], "MultiPolygon");
+    double sum = 0;
+    for (const Json& poly : feat["geometry"]["coordinates"]) {
+      Polygon p;
+      for (const Json& v : poly[0]) p.emplace_back(v[0].get<double>(), v[1].get<double>());
+      ASSERT_EQ(p.front(), p.back()) << "GeoJSON rings are closed";
+      p.pop_back();
+      EXPECT_GT(signed_area(p), 0) << "floe " << f.id;
+      EXPECT_TRUE(is_convex(p, 1e-9)) << "floe " << f.id;
+      sum += signed_area(p);
+    }
+    EXPECT_NEAR(sum, f.area_m2, 1e-9 * f.area_m2) << "floe " << f.id;
+    EXPECT_EQ(feat["properties"]["parts"].get<size_t>(), feat["geometry"]["coordinates"].size());
+    non_convex_floes += feat["geometry"]["coordinates"].size() > 1;
+  }
+  EXPECT_GT(non_convex_floes, 10) << "the digitised outlines include non-convex floes";
+  // Without the option the file is not written.
+  req.config = Json::object();
+  req.out_dir = d.path / "out2";
+  run_digitise(req);
+  EXPECT_FALSE(std::filesystem::exists(d.path / "out2" / "convex_parts.geojson"));
 }
 
 TEST(DigitiseSynthetic, SameInputSameBytes) {
@@ -227,7 +311,7 @@ TEST(DigitiseSynthetic, SameInputSameBytes) {
     req.out_dir = d.path / out;
     run_digitise(req);
   }
-  for (const char* f : {"floes.geojson", "labels.png", "overlay.png", "stats.json"})
+  for (const char* f : {"floes.geojson", "labels.png", "overlay.png", "stats.json", "fsd.png", "fsd.csv"})
     EXPECT_EQ(sha256_file(d.path / "a" / f), sha256_file(d.path / "b" / f)) << f;
 }
 

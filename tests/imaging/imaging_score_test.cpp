@@ -9,6 +9,7 @@
 
 #include "imaging/digitise.h"
 #include "imaging/score.h"
+#include "imaging/shapes.h"
 #include "pipeline/options.h"
 #include "test_util.h"
 
@@ -241,6 +242,20 @@ TEST(Score, CloseRangeSettingsOnOneLabelledImage) {
   EXPECT_LT(std::abs(res.score->concentration_error), 0.08);
   EXPECT_LT(res.score->ks_log_area, 0.25);
   EXPECT_EQ(res.polygons.overlaps_remaining, 0);
+  // The written outlines read back (simple, CCW: the strict reader checks) and no two of them overlap or touch.
+  const FloeField floes = read_floes(d.path / "floes.geojson");
+  ASSERT_GT(floes.floes.size(), 100u);
+  std::vector<BBox> boxes;
+  for (const Floe& f : floes.floes) {
+    EXPECT_GT(signed_area(f.outline), 0);
+    boxes.push_back(bounding_box(f.outline));
+  }
+  int overlapping = 0;
+  for (size_t i = 0; i < boxes.size(); ++i)
+    for (size_t j = i + 1; j < boxes.size(); ++j)
+      if (boxes[i].overlaps(boxes[j]) && polygons_within(floes.floes[i].outline, floes.floes[j].outline, 0))
+        ++overlapping;
+  EXPECT_EQ(overlapping, 0);
 }
 
 }  // namespace
