@@ -11,7 +11,8 @@
 namespace floesim::imaging {
 
 struct DigitiseOptions {
-  double max_pixels = 100e6;             // larger images are refused before decoding (memory)
+  double max_pixels = 50e6;              // larger images are refused before decoding: digitise needs about
+                                         // 80 bytes per pixel (measured peak 230 MB for 2.8 megapixels), ~4 GB
   double smoothing_m = 0.0;              // Gaussian sigma of the pre-smoothing (sensor noise, surface texture);
                                          // 0 = none (the helicopter scale: a pixel is already ~1 m)
   std::string illumination = "two_class";  // how the local water and ice brightness are estimated:

@@ -1,6 +1,7 @@
 #include "imaging/image_io.h"
 
 #include <array>
+#include <cmath>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
@@ -64,7 +65,9 @@ cv::Mat load_grayscale_image(const std::filesystem::path& file, double max_pixel
   if (read_image_size(file, w, h))
     FLOESIM_REQUIRE(double(w) * double(h) <= max_pixels, f, ": the image has ", w, " x ", h, " = ",
                     double(w) * double(h) / 1e6, " megapixels, more than max_pixels = ", max_pixels / 1e6,
-                    " megapixels; digitise it in tiles or raise max_pixels in the config if memory allows");
+                    " megapixels (digitise needs about 80 bytes per pixel: ",
+                    std::lround(double(w) * double(h) * 80 / 1e9 * 10) / 10.0,
+                    " GB for this image); digitise it in tiles or raise max_pixels in the config if memory allows");
 
   cv::Mat img;
   try {

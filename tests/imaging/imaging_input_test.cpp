@@ -126,6 +126,16 @@ TEST_F(DigitiseBadInput, LargerThanMaxPixels) {
   EXPECT_EQ(h, 120);
 }
 
+TEST_F(DigitiseBadInput, HugeImageRefusedFromItsHeaderWithDefaults) {
+  // A PNG whose header announces 60000 x 60000 pixels (3.6 gigapixels, ~290 GB of working memory) and holds no
+  // pixel data: refused from the header with the default max_pixels, before any decoding or allocation.
+  const unsigned char header[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R',
+                                  0, 0, 0xEA, 0x60, 0, 0, 0xEA, 0x60, 8, 0, 0, 0, 0, 0, 0, 0, 0};
+  const auto f = dir_.path / "huge.png";
+  std::ofstream(f, std::ios::binary).write(reinterpret_cast<const char*>(header), sizeof header);
+  expect_refused(request(f), {"huge.png", "60000 x 60000", "3600 megapixels", "max_pixels", "GB", "tiles"});
+}
+
 TEST_F(DigitiseBadInput, UnknownAndInvalidConfigKeys) {
   DigitiseRequest r = request(good_);
   r.config_file = dir_.path / "digitise.json";
