@@ -90,10 +90,66 @@ inline Wrench face_drag(const Model& m, const BodyKinematics& k, const Vec3& n, 
 }
 }  // namespace
 
+namespace {
+// The usual case of a floe afloat and nearly level: the water plane cuts only its side walls, so the bottom is wet,
+// the top dry and each side wall wet over a trapezoid between the bottom and the waterline, whose heights l_i, l_j
+// at the wall's ends follow from the plane in the body frame (l = l0 - a x - b y from the bottom, as in
+// prism_submerged). Everything is done in the body frame with the relative velocity turned once: ~60 flops per
+// wall instead of transforming and clipping the slab's vertices. Returns false when the plane may cut the top or
+// bottom face (then the general path clips).
+bool floe_drag_afloat(const Model& m, const Body& b, const BodyKinematics& k, double cd, double cf, double half_rho,
+                      Wrench& out) {
+  if (b.section_area <= 0 || b.top_face < 0) return false;
+  const Vec3 mv = k.R.row(2).transpose();  // world z in the body frame
+  if (mv.z() < 0.5) return false;
+  const double h = b.thickness_m;
+  const double a = mv.x() / mv.z(), bb = mv.y() / mv.z();
+  const double l0 = -k.x.z() / mv.z() + h / 2;
+  const double spread = b.section_radius * std::sqrt(a * a + bb * bb);
+  if (l0 - spread < 0 || l0 + spread > h) return false;
+  const Vec3 vb = k.R.transpose() * (k.v - m.current), wb = k.R.transpose() * k.w;
+  Vec3 F = Vec3::Zero(), T = Vec3::Zero();
+  auto face = [&](const Vec3& n, double area, const Vec3& c) {
+    const Vec3 vrel = vb + wb.cross(c);
+    const double vn = vrel.dot(n);
+    Vec3 f = Vec3::Zero();
+    if (vn > 0) f -= half_rho * cd * area * vn * vn * n;
+    const Vec3 vt = vrel - vn * n;
+    f -= half_rho * cf * area * vt.norm() * vt;
+    F += f;
+    T += c.cross(f);
+  };
+  // Bottom: whole and wet (faces 0 = bottom, top_face = top, then the side walls).
+  const DragFace& bottom = b.drag_faces[0];
+  face(bottom.normal, bottom.area, bottom.centroid);
+  const int n = static_cast<int>(b.outline.size());
+  for (const DragFace& f : b.drag_faces) {
+    if (f.side < 0) continue;
+    const int i = f.side, j = i + 1 == n ? 0 : i + 1;
+    const Vec2& pi = b.outline[i];
+    const Vec2& pj = b.outline[j];
+    const double li = l0 - a * pi.x() - bb * pi.y(), lj = l0 - a * pj.x() - bb * pj.y();
+    const double sum = li + lj;
+    if (sum <= 0) continue;
+    const double len = f.area / h;  // the wall is len x h
+    // Trapezoid with parallel vertical sides li (at vertex i) and lj: area, centroid along the edge and height.
+    const double area = 0.5 * len * sum;
+    const double t = (li + 2 * lj) / (3 * sum);
+    const double zc = -h / 2 + (li * li + li * lj + lj * lj) / (3 * sum);
+    const Vec2 cxy = pi + t * (pj - pi);
+    face(f.normal, area, Vec3(cxy.x(), cxy.y(), zc));
+  }
+  out.force = k.R * F;
+  out.torque = k.R * T;
+  return true;
+}
+}  // namespace
+
 Wrench floe_water_drag(const Model& m, const Body& b, const BodyKinematics& k, ForceScratch& s) {
   Wrench w;
   const double cd = m.options.water.form_drag_cd, cf = m.options.water.skin_friction_cf;
   const double half_rho = 0.5 * m.options.water.density_kg_m3;
+  if (floe_drag_afloat(m, b, k, cd, cf, half_rho, w)) return w;
   s.vertices.resize(b.drag_vertices.size());
   for (size_t i = 0; i < b.drag_vertices.size(); ++i) s.vertices[i] = k.x + k.R * b.drag_vertices[i];
   // Waterline points of the vertical edges (bottom ring vertex i, top ring vertex n + i) that cross the water

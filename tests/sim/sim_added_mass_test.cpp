@@ -107,6 +107,7 @@ TEST(SimAddedMass, CollisionConservesMomentumWithAddedMass) {
   o.water.form_drag_cd = 0;
   o.water.skin_friction_cf = 0;
   o.sleep.enabled = false;
+  o.contact.ice_structure = "rigid";
   FloeField field;
   // Beside the parallel body's port side (half beam 12.5 m), 15 m aft of midship, 2 m clear of the hull.
   field.floes = {rect_floe(1, -20, 14.5, 10, 8, 1.0)};
