@@ -40,8 +40,9 @@ struct DigitiseOptions {
   double neck_ratio = 0.85;              // two pieces whose neck half-width reaches this fraction of the smaller
                                          // one's inscribed radius are one floe with a dent (see segment.h)
   double min_floe_area_m2 = 10.0;        // split pieces smaller than this rejoin their neighbour; lone ones dropped
-  double min_floe_brightness = 0.0;      // a floe whose median normalised brightness (0 water, 1 ice) is below
-                                         // this is slush or brash, not a floe, and is dropped; 0 = off
+  double edge_band_m = 0.1;              // outline refinement: within this of its outline a floe keeps ...
+  double edge_fraction = 0.0;            // ... only pixels brighter than this fraction of its median
+                                         // normalised brightness (its edge at its own half level); 0 = off
   double simplify_tolerance_m = 0.5;     // Douglas-Peucker tolerance of the outlines
   double thickness_m = 1.0;              // written to every floe (SAMS table: h = 1 m)
   bool convex_parts = false;             // also write convex_parts.geojson: each floe split into convex pieces
@@ -85,8 +86,11 @@ struct DigitiseOptions {
             "inscribed radius",
             in_range(0, 10));
     v.field("min_floe_area_m2", min_floe_area_m2, "m^2", "smallest floe kept after splitting", non_negative());
-    v.field("min_floe_brightness", min_floe_brightness, "-",
-            "floes with a median normalised brightness below this are slush and dropped (0 = off)", in_range(0, 2));
+    v.field("edge_band_m", edge_band_m, "m", "width of the outline band refined at the floe's own level",
+            non_negative());
+    v.field("edge_fraction", edge_fraction, "-",
+            "outline pixels darker than this fraction of their floe's median brightness are water (0 = off)",
+            in_range(0, 1));
     v.field("simplify_tolerance_m", simplify_tolerance_m, "m", "outline simplification tolerance", non_negative());
     v.field("thickness_m", thickness_m, "m", "ice thickness written to every floe", positive());
     v.field("convex_parts", convex_parts, "-",

@@ -702,6 +702,40 @@ Segmentation segment_floes(const cv::Mat& gray, double s, const DigitiseOptions&
     lab.setTo(0, lab < 0);
     max_label = n_seeds;
     for (int l = 1; l <= n_seeds; ++l) seg.seeds += uf.find(l) == l;
+
+    // Outline refinement: the ice threshold sits below the half-contrast level (to keep dark floes), so the
+    // outlines of bright floes run a pixel or so outside their edge. Within edge_band_m of its outline, a floe
+    // keeps only the pixels brighter than edge_fraction of its own median brightness: each floe's edge at its
+    // own half level, dark floes included.
+    if (o.edge_fraction > 0 && o.edge_band_m > 0) {
+      std::vector<std::vector<float>> values(max_label + 1);
+      for (int r = 0; r < R; ++r)
+        for (int c = 0; c < C; ++c)
+          if (const int l = lab.at<int>(r, c); l > 0) values[l].push_back(norm.at<float>(r, c));
+      std::vector<float> median(max_label + 1, 0.0f);
+      for (int l = 1; l <= max_label; ++l)
+        if (auto& v = values[l]; !v.empty()) {
+          std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+          median[l] = v[v.size() / 2];
+        }
+      cv::Mat not_edge(R, C, CV_8U, cv::Scalar(255));  // 0 on pixels with a 4-neighbour of another label
+      for (int r = 0; r < R; ++r)
+        for (int c = 0; c < C; ++c) {
+          const int l = lab.at<int>(r, c);
+          if (l <= 0) continue;
+          if ((r > 0 && lab.at<int>(r - 1, c) != l) || (r + 1 < R && lab.at<int>(r + 1, c) != l) ||
+              (c > 0 && lab.at<int>(r, c - 1) != l) || (c + 1 < C && lab.at<int>(r, c + 1) != l))
+            not_edge.at<uint8_t>(r, c) = 0;
+        }
+      cv::Mat to_edge;
+      cv::distanceTransform(not_edge, to_edge, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+      const float band = static_cast<float>(o.edge_band_m / s);
+      for (int r = 0; r < R; ++r)
+        for (int c = 0; c < C; ++c) {
+          int& l = lab.at<int>(r, c);
+          if (l > 0 && to_edge.at<float>(r, c) < band && norm.at<float>(r, c) < o.edge_fraction * median[l]) l = 0;
+        }
+    }
   }
 
   // 5. Regions.
@@ -713,20 +747,6 @@ Segmentation segment_floes(const cv::Mat& gray, double s, const DigitiseOptions&
   for (int r = 0; r < R; ++r)
     for (int c = 0; c < C; ++c)
       if (lab.at<int>(r, c) > 0) ++area[lab.at<int>(r, c)];
-  std::vector<char> slush(max_label + 1, 0);
-  if (o.min_floe_brightness > 0 && !norm.empty()) {
-    // Slush and grey brash pass the ice threshold in patches; a floe is bright over most of its area.
-    std::vector<std::vector<float>> values(max_label + 1);
-    for (int r = 0; r < R; ++r)
-      for (int c = 0; c < C; ++c)
-        if (const int l = lab.at<int>(r, c); l > 0) values[l].push_back(norm.at<float>(r, c));
-    for (int l = 1; l <= max_label; ++l) {
-      auto& v = values[l];
-      if (v.empty()) continue;
-      std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-      slush[l] = v[v.size() / 2] < o.min_floe_brightness;
-    }
-  }
   const double min_px = o.min_floe_area_m2 / px_area;
   std::vector<int> renum(max_label + 1, 0);
   int next = 0;
@@ -735,7 +755,7 @@ Segmentation segment_floes(const cv::Mat& gray, double s, const DigitiseOptions&
     for (int c = 0; c < C; ++c) {
       const int l = p[c];
       if (l <= 0) continue;
-      if (area[l] < min_px || slush[l]) {
+      if (area[l] < min_px) {
         p[c] = 0;
         continue;
       }
@@ -744,6 +764,7 @@ Segmentation segment_floes(const cv::Mat& gray, double s, const DigitiseOptions&
     }
   }
   seg.labels = lab;
+  seg.norm = norm;
   seg.floes = next;
   if (seg.classes == "mixed" && next == 0)
     seg.warnings.push_back(name + ": no floe larger than min_floe_area_m2 = " + std::to_string(o.min_floe_area_m2) +

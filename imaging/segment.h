@@ -33,6 +33,7 @@ struct Segmentation {
   cv::Mat labels;  // CV_32S: 0 = no floe, k = floe k (see step 5 for the guarantees)
   int floes = 0;
   cv::Mat valid;  // CV_8U, 255 where the pixel is data (non-zero)
+  cv::Mat norm;   // CV_32F normalised brightness (0 = local water level, 1 = local ice level); empty if one class
   long long valid_pixels = 0;
   std::string classes;                  // "mixed", "no_ice" or "all_ice"
   double otsu_threshold = 0;            // first global split (grey level)
