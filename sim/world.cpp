@@ -66,7 +66,8 @@ World::World(const Model& model) : model_(model), pool_(model.options.threads) {
     solver_bodies_.inv_mass[b] = R * model.bodies[b].inv_mass_added.asDiagonal() * R.transpose();
   }
   external_.resize(n);
-  in_contact_.assign(n, 0);
+  island_.assign(n, 0);
+  island_ok_.assign(n, 0);
   scratch_.resize(pool_.threads());
   collision_ = std::make_unique<CollisionWorld>(model_, state_, pool_);
 }
@@ -121,8 +122,6 @@ void World::stage_collide() {
     if (!state_.awake[c.body_a]) wake(c.body_a);
     if (!state_.awake[c.body_b]) wake(c.body_b);
   }
-  std::fill(in_contact_.begin(), in_contact_.end(), 0);
-  for (const Contact& c : contacts_) in_contact_[c.body_a] = in_contact_[c.body_b] = 1;
   awake_list_.clear();
   for (size_t b = 0; b < model_.bodies.size(); ++b)
     if (state_.awake[b]) awake_list_.push_back(static_cast<int>(b));
@@ -260,16 +259,32 @@ void World::stage_sleep() {
     if (w.norm() > h.max_angular_radps)
       fail(b, "angular speed " + std::to_string(w.norm()) + " rad/s exceeds health.max_angular_radps (blow-up)");
     if (b == model_.vessel) continue;
-    if (sleep_allowed_ && !in_contact_[b] && v.norm() < s.linear_mps && w.norm() < s.angular_radps) {
-      state_.still_time_s[b] += dt;
-      if (state_.still_time_s[b] >= s.time_s) {
-        state_.awake[b] = 0;
-        state_.velocity[b].setZero();
-        state_.angular_velocity[b].setZero();
-      }
-    } else {
-      state_.still_time_s[b] = 0;
-    }
+    const bool slow = v.norm() < s.linear_mps && w.norm() < s.angular_radps;
+    state_.still_time_s[b] = slow ? state_.still_time_s[b] + dt : 0.0;
+  }
+  if (!sleep_allowed_) return;
+  // Islands (Box2D's rule): the awake bodies joined by this step's contacts (a fixed wall joins nothing). An island
+  // falls asleep as a whole once every floe in it has been slow for sleep.time_s, and never while the vessel is in
+  // it; so floes resting against each other sleep too, and a sleeper touched by an awake body wakes (collide). A
+  // partition does not depend on the order of the unions: deterministic.
+  auto find = [&](int b) {
+    while (island_[b] != b) b = island_[b] = island_[island_[b]];
+    return b;
+  };
+  for (int b : awake_list_) island_[b] = b;
+  for (const Contact& c : contacts_) {
+    if (model_.bodies[c.body_a].kind == BodyKind::wall || model_.bodies[c.body_b].kind == BodyKind::wall) continue;
+    const int ra = find(c.body_a), rb = find(c.body_b);
+    if (ra != rb) island_[std::max(ra, rb)] = std::min(ra, rb);
+  }
+  for (int b : awake_list_) island_ok_[b] = 1;
+  for (int b : awake_list_)
+    if (b == model_.vessel || state_.still_time_s[b] < s.time_s) island_ok_[find(b)] = 0;
+  for (int b : awake_list_) {
+    if (b == model_.vessel || !island_ok_[find(b)]) continue;
+    state_.awake[b] = 0;
+    state_.velocity[b].setZero();
+    state_.angular_velocity[b].setZero();
   }
 }
 

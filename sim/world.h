@@ -9,7 +9,7 @@
 //   integrate  semi-implicit Euler: x += dt v, q += dt/2 [0, w] q (normalised)
 //   relax      PGS without push-out bias, so that resolving overlap leaves no velocity (crushing rows keep their
 //              law, which has no bias anyway); impulses stored for warm start; the vessel's loads by contact law
-//   sleep      floes at rest without contacts fall asleep; numerical health checks (NaN, blow-up)
+//   sleep      islands of floes joined by contacts fall asleep together at rest; health checks (NaN, blow-up)
 //
 // Loads on the vessel are recorded per step in StepReport (world frame; the recorder turns them to body axes).
 #pragma once
@@ -82,7 +82,8 @@ class World {
   std::vector<Contact> contacts_;
   std::vector<int> awake_list_;     // bodies integrated this step (ascending)
   std::vector<int> moved_;          // bodies integrated in the previous step (broad phase refresh)
-  std::vector<uint8_t> in_contact_;
+  std::vector<int> island_;         // sleep stage: union-find parent of each awake body (contact islands)
+  std::vector<uint8_t> island_ok_;  // sleep stage: per island root, every member has been still long enough
   std::vector<Wrench> external_;    // per body, this step
   std::vector<ForceScratch> scratch_;
   SolverBodies solver_bodies_;
