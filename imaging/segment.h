@@ -1,22 +1,31 @@
 // Digitise's image processing: from an 8-bit grayscale photograph to a label image of floes.
 //
 //   1. no data: pure black (0) pixels are outside the camera footprint - never ice, not part of the valid area.
-//   2. ice/water: Otsu on the valid pixels gives a first split; the smooth local water and ice brightness
-//      (masked Gaussian averages at illumination_scale_m) then normalise the image, which removes illumination
-//      gradients, and ice is where the normalised brightness exceeds threshold_fraction (twice, refining the
-//      split). An image whose classes differ by less than min_contrast is one class: all ice or no ice.
+//      Optional pre-smoothing (smoothing_m, normalised inside the footprint) against noise and surface texture.
+//   2. ice/water: Otsu on the valid pixels gives a first split; an image whose classes differ by less than
+//      min_contrast is one class (all ice or no ice). Otherwise the local water and ice brightness normalise the
+//      image (0 = water, 1 = ice), and ice is where the normalised brightness exceeds threshold_fraction. The
+//      local levels are either "two_class" (masked Gaussian averages of the two classes at illumination_scale_m,
+//      twice, refining the split: smooth illumination, one kind of ice) or "local_otsu" (Otsu's class means in
+//      blocks of local_block_m, weighted by how clearly a block holds both classes and smoothed over the
+//      neighbouring blocks: also a darker far field, grey floes, a field of dense floes).
+//      Cracks (crack_width_m > 0): dark lines narrower than crack_width_m (black top-hat) deeper than
+//      crack_depth of the local contrast are cut from the ice, so touching floes part along them.
 //   3. cleanup: enclosed water up to max_hole_area_m2 is filled (melt ponds), a morphological opening of
 //      opening_radius_m removes thin bridges and specks, connected pieces below brash_cutoff_m2 are dropped.
 //   4. splitting of touching floes, with two cues. Intensity: the core of each floe (smoothed normalised
-//      brightness above core_fraction of its ice piece's bright level) loses the dark line between floes even
-//      where blur bridged the gap. Shape: seeds are the h-maxima of the core's distance map with
-//      h = marker_dynamic_m (a bump must rise that much to be a floe of its own); seeds closer than
-//      min_marker_separation_m within one piece merge; a piece without core is seeded at its deepest pixel.
-//      Marker-based watershed (hierarchical queue) floods the ice from the seeds over the relief "core distance
-//      inside the core, brightness below it", so boundaries follow necks and the darkest pixels between cores.
-//      Then pieces rejoin and the flooding is repeated: two pieces whose shared boundary is not a neck (its
-//      highest core distance reaches neck_ratio of the smaller piece's inscribed radius) are one floe with a
-//      dent; a piece below min_floe_area_m2 joins the neighbour it shares the longest boundary with.
+//      brightness above core_fraction of its ice piece's bright level; core_fraction 0: the whole ice piece)
+//      loses the dark line between floes even where blur bridged the gap. Shape: seeds are the h-maxima of the
+//      core's distance map with h = marker_dynamic_m (a bump must rise that much to be a floe of its own);
+//      seeds closer than min_marker_separation_m within one piece merge; a piece without core is seeded at its
+//      deepest pixel. Marker-based watershed (hierarchical queue) floods the ice from the seeds over the relief
+//      "core distance inside the core, brightness below it", so boundaries follow necks and the darkest pixels
+//      between cores. Then pieces rejoin (relabelled, without flooding again): two pieces whose shared boundary
+//      is not a neck (its highest core distance reaches neck_ratio of the smaller piece's inscribed radius) are
+//      one floe with a dent; a piece below min_floe_area_m2 joins the neighbour it shares the longest boundary
+//      with. Outline refinement (edge_fraction > 0): within edge_band_m of its outline a floe keeps only pixels
+//      brighter than edge_fraction of its own median brightness, which puts each floe's edge at its own half
+//      level (the threshold sits low so that dark floes are kept).
 //   5. regions: holes of each region filled (a region enclosed by another joins it), each region reduced to its
 //      largest 4-connected part, regions never 8-adjacent, lone regions below min_floe_area_m2 dropped,
 //      numbered 1..N in raster order of their first pixel.
