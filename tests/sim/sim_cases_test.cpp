@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include "pipeline/floes_io.h"
 #include "sim/hull.h"
@@ -137,6 +138,44 @@ TEST(SimCases, SingleFloeStruckOffCentreTurnsAndIsPushedToPort) {
   EXPECT_GT(d.y(), 5);            // and to port
   EXPECT_GT(yaw, 10);             // turned counter-clockwise
   EXPECT_LT(peak, 2e7);           // compliant contact: bounded (sigma_c x the contact area of a 1 m thick edge)
+}
+
+
+// The benchmark runs (briefly here; it is not a timed test): the generated Oden-size field has about a thousand
+// floes at 60 % concentration, the 4x field four times the floes, and the last line is the realtime factor.
+TEST(SimBench, GeneratedFieldsAndLastLine) {
+  const fs::path root = temp_root();
+  const fs::path log = root / "bench.log";
+  const std::string cmd = "'" + (kBin / "floesim-bench").string() + "' --duration 2 --scales 1,4 > '" +
+                          log.string() + "' 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << read_text(log);
+  const std::string out = read_text(log);
+  std::istringstream in(out);
+  std::string line, last;
+  std::vector<int> floes;
+  std::vector<double> conc;
+  while (std::getline(in, line)) {
+    if (!line.empty()) last = line;
+    int n = 0;
+    double c = 0;
+    const size_t f = line.find(" floes ("), k = line.find("concentration ");
+    if (line.rfind("field ", 0) == 0 && f != std::string::npos && k != std::string::npos) {
+      n = std::stoi(line.substr(line.rfind(' ', f - 1) + 1));
+      c = std::stod(line.substr(k + 14));
+      floes.push_back(n);
+      conc.push_back(c);
+    }
+  }
+  std::printf("[measured] fields: %d floes (c = %.3f), %d floes (c = %.3f); last line '%s'\n", floes.at(0), conc.at(0),
+              floes.at(1), conc.at(1), last.c_str());
+  ASSERT_EQ(floes.size(), 2u) << out;
+  EXPECT_GT(floes[0], 700);
+  EXPECT_LT(floes[0], 1300);
+  EXPECT_NEAR(floes[1] / double(floes[0]), 4.0, 0.5);
+  for (double c : conc) EXPECT_NEAR(c, 0.60, 0.01);
+  EXPECT_EQ(last.rfind("realtime_factor ", 0), 0u) << last;
+  EXPECT_GT(std::stod(last.substr(16)), 0.0);
+  fs::remove_all(root);
 }
 
 }  // namespace
