@@ -162,7 +162,8 @@ std::vector<Artefact> prepare_run(const RunOptions& o) {
       FLOESIM_REQUIRE(d.is_object(), cf, ": digitise must be an object");
       const fs::path dir = run / "floes";
       Stage st{"digitise", "floe segmentation and polygons", {image_png, stage_config("digitise", d)},
-               {dir / "floes.geojson", dir / "labels.png", dir / "overlay.png", dir / "stats.json"},
+               {dir / "floes.geojson", dir / "labels.png", dir / "overlay.png", dir / "stats.json",
+                dir / "fsd.png", dir / "fsd.csv"},
                bin / "floesim-digitise", ""};
       std::ostringstream mp;
       mp.precision(17);
@@ -173,6 +174,7 @@ std::vector<Artefact> prepare_run(const RunOptions& o) {
       arts.push_back({"digitise", "floes/labels.png", "16-bit label image, k = floe id"});
       arts.push_back({"digitise", "floes/overlay.png", "outlines on the photo"});
       arts.push_back({"digitise", "floes/stats.json", "count, concentration, size distribution"});
+      arts.push_back({"digitise", "floes/fsd.png", "floe size distribution and power-law fit"});
       floes_file = dir / "floes.geojson";
     }
   }
