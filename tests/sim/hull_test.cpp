@@ -11,6 +11,7 @@
 
 #include "pipeline/error.h"
 #include "sim/hull.h"
+#include "tests/sim/obj_faces.h"
 
 #ifndef FLOESIM_SHARED_DATA_DIR
 #error "FLOESIM_SHARED_DATA_DIR must be defined by the build"
@@ -270,25 +271,7 @@ TEST(LoadHull, NodeTransformsPlaceTheMeshes) {
 // ---- the real benchmark hulls (model scale, waterline at z = 0, not convex) ----
 
 // The file's own faces (fan-triangulated), for a reference independent of assimp and of the loader.
-TriMesh read_obj_faces(const fs::path& f) {
-  TriMesh m;
-  std::ifstream in(f);
-  for (std::string line; std::getline(in, line);) {
-    std::istringstream s(line);
-    std::string tag;
-    s >> tag;
-    if (tag == "v") {
-      double x, y, z;
-      s >> x >> y >> z;
-      m.vertices.emplace_back(x, y, z);
-    } else if (tag == "f") {
-      std::vector<int> f;
-      for (std::string w; s >> w;) f.push_back(std::stoi(w) - 1);  // "i", "i/t" or "i/t/n": stoi stops at '/'
-      for (size_t k = 1; k + 1 < f.size(); ++k) m.triangles.push_back({f[0], f[k], f[k + 1]});
-    }
-  }
-  return m;
-}
+using floesim::sim::testing::read_obj_faces;
 
 struct RealHull {
   const char* file;

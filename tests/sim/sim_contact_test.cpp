@@ -13,18 +13,8 @@ namespace {
 
 using testing::floe_options;
 using testing::rect_floe;
+using testing::contact_force_on;
 
-// Net contact force on body b this step (impulse / dt), world frame.
-Vec3 contact_force_on(const World& w, int b) {
-  Vec3 f = Vec3::Zero();
-  const double dt = w.model().options.time_step_s;
-  for (const Contact& c : w.contacts()) {
-    const Vec3 p = c.pn * c.normal + c.pt1 * c.t1 + c.pt2 * c.t2;
-    if (c.body_b == b) f += p / dt;
-    if (c.body_a == b) f -= p / dt;
-  }
-  return f;
-}
 
 // A small floe put on top of a big floating one sits above the water (no buoyancy): the contact carries exactly
 // its weight m g. The pair settles to a common heave equilibrium with the big floe deeper by m_small/(rho_w A_big).

@@ -16,6 +16,8 @@
 namespace floesim::sim {
 namespace {
 
+using testing::contact_force_on;
+
 constexpr double kPi = 3.14159265358979323846;
 
 // A vertical wall (box lx x ly x hz, centred on the origin in x and y, z from z0) as a single-part hull.
@@ -212,17 +214,6 @@ WallRig wall_rig(const Floe& floe, double ice_density, double wall_speed, double
   return WallRig{build_model(field, &hull, o), floe.thickness_m};
 }
 
-// Net contact force on body b this step (impulse / dt), world frame.
-Vec3 contact_force_on(const World& w, int b) {
-  Vec3 f = Vec3::Zero();
-  const double dt = w.model().options.time_step_s;
-  for (const Contact& c : w.contacts()) {
-    const Vec3 p = c.pn * c.normal + c.pt1 * c.t1 + c.pt2 * c.t2;
-    if (c.body_b == b) f += p / dt;
-    if (c.body_a == b) f -= p / dt;
-  }
-  return f;
-}
 
 // A floe corner driven into the wall at constant relative speed (the floe ~1e9 kg, so that its speed stays
 // constant to 0.2 %): the force is the crushing force of the geometry, F = sigma_c 2 h delta tan(phi), at the

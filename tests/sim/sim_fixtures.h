@@ -8,6 +8,7 @@
 #include "sim/hull.h"
 #include "sim/model.h"
 #include "sim/simulate_options.h"
+#include "sim/world.h"
 
 namespace floesim::sim::testing {
 
@@ -49,6 +50,18 @@ inline std::filesystem::path temp_dir(const std::string& name) {
   std::filesystem::remove_all(d);
   std::filesystem::create_directories(d);
   return d;
+}
+
+// Net contact force on body b this step (impulse / dt), world frame.
+inline Vec3 contact_force_on(const World& w, int b) {
+  Vec3 f = Vec3::Zero();
+  const double dt = w.model().options.time_step_s;
+  for (const Contact& c : w.contacts()) {
+    const Vec3 p = c.pn * c.normal + c.pt1 * c.t1 + c.pt2 * c.t2;
+    if (c.body_b == b) f += p / dt;
+    if (c.body_a == b) f -= p / dt;
+  }
+  return f;
 }
 
 }  // namespace floesim::sim::testing

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "sim/world.h"
+#include "tests/sim/obj_faces.h"
 
 namespace floesim::sim {
 namespace {
@@ -26,24 +27,8 @@ fs::path hull_file(const std::string& name) {
 
 // The raw mesh (all faces of the OBJ, no welding or slicing): its volume below z = 0 is what the ship displaces.
 double raw_displaced_volume(const fs::path& f) {
-  std::ifstream in(f);
-  std::vector<Vec3> v;
-  std::vector<std::array<int, 3>> t;
-  for (std::string line; std::getline(in, line);) {
-    std::istringstream s(line);
-    std::string tag;
-    s >> tag;
-    if (tag == "v") {
-      double x, y, z;
-      s >> x >> y >> z;
-      v.emplace_back(x, y, z);
-    } else if (tag == "f") {
-      std::vector<int> idx;
-      for (std::string w; s >> w;) idx.push_back(std::stoi(w) - 1);
-      for (size_t k = 1; k + 1 < idx.size(); ++k) t.push_back({idx[0], idx[k], idx[k + 1]});
-    }
-  }
-  return submerged_part(v, t, 0.0).volume;
+  const TriMesh raw = testing::read_obj_faces(f);
+  return submerged_part(raw.vertices, raw.triangles, 0.0).volume;
 }
 
 struct Attitude {
