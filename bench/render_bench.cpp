@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -105,6 +106,12 @@ int main(int argc, char** argv) {
     r.floe_vertex_offset.push_back(static_cast<int64_t>(r.floe_vertices_m.size() / 2));
     r.floe_id.push_back(k + 1);
     r.floe_thickness_m.push_back(0.6 + 1.2 * u(rng));
+    // Floes of the input field that never break (the layout wants a lineage for every floe).
+    r.floe_parent_id.push_back(-1);
+    r.floe_generation.push_back(0);
+    r.floe_origin_mode.push_back(kFractureNone);
+    r.floe_created_s.push_back(0);
+    r.floe_ended_s.push_back(std::numeric_limits<double>::infinity());
     fl.push_back({-150 + cell * i + 8 * (u(rng) - 0.5), (j - rows / 2.0) * cell + 8 * (u(rng) - 0.5),
                   2 * kPi * u(rng), 0.2 * (u(rng) - 0.5), 0.2 * (u(rng) - 0.5), 0.02 * (u(rng) - 0.5)});
   }

@@ -4,9 +4,12 @@
 // field it prints the floes, the awake floes and contacts per step (mean), wall time, ms per step, simulated
 // seconds per wall second, the stage times, the time to record and write the results, and the peak memory. The
 // vessel covers the same ~400 m in every field, so the cost must stay with the floes it sets in motion, not grow
-// with the field. The last line is `realtime_factor <simulated s per wall s on the Oden-size field>`.
+// with the field. Fracture (PHYSICS.md §2) is on as in the cases; the Oden-size field runs first without it, in the
+// same process, so that its cost is a ratio of one run: events per simulated second, floe bodies at the start and
+// the end, the fracture stage's time, and `fracture_speed_ratio <with / without>`. The last line is
+// `realtime_factor <simulated s per wall s on the Oden-size field, fracture on>`.
 //
-//   floesim-bench [--duration 200] [--threads 2] [--scales 1,4,9] [--seed 1] [--keep DIR]
+//   floesim-bench [--duration 200] [--threads 2] [--scales 1,4,9] [--seed 1] [--keep DIR] [--no-compare]
 //
 // The field is generated here (star-shaped floes placed by rejection sampling, largest first), not by imaging/:
 // sim and imaging never link each other. Everything is seeded: two runs simulate the same thing.
@@ -195,10 +198,11 @@ struct BenchOptions {
   std::vector<int> scales = {1, 4, 9};
   uint64_t seed = 1;
   std::string keep_dir;  // if set, the results of each field are kept there
+  bool compare = true;   // the Oden-size field without fracture first
 };
 
 // One field: generate, build, simulate (with the recorder), write the results; returns simulated s per wall s.
-double run_field(int scale, const BenchOptions& bo, const HullModel& hull) {
+double run_field(int scale, const BenchOptions& bo, const HullModel& hull, bool fracture) {
   FieldSpec spec;
   const double s = std::sqrt(static_cast<double>(scale));
   spec.width_m *= s;
@@ -220,15 +224,16 @@ double run_field(int scale, const BenchOptions& bo, const HullModel& hull) {
   o.vessel.initial_speed_mps = 2.0;
   o.vessel.propulsion.mode = "speed";
   o.vessel.propulsion.speed_mps = 2.0;
+  o.fracture.enabled = fracture;
   const Model model = build_model(field, &hull, o);
   const double build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - g0).count();
   size_t floe_parts = 0;
   for (const Body& b : model.bodies)
     if (b.kind == BodyKind::floe) floe_parts += b.part_count;
 
-  std::printf("field %dx: %.0f m x %.0f m, %d floes (%zu convex parts), concentration %.3f, h = %.1f m "
-              "(generated and built in %.2f s)\n",
-              scale, spec.width_m, spec.height_m, model.floe_count(), floe_parts,
+  std::printf("field %dx, fracture %s: %.0f m x %.0f m, %d floes (%zu convex parts), concentration %.3f, "
+              "h = %.1f m (generated and built in %.2f s)\n",
+              scale, fracture ? "on" : "off", spec.width_m, spec.height_m, model.floe_count(), floe_parts,
               floe_area / (spec.width_m * spec.height_m), spec.thickness_m, build_s);
   std::fflush(stdout);
 
@@ -257,6 +262,15 @@ double run_field(int scale, const BenchOptions& bo, const HullModel& hull) {
   for (int i = 0; i < kStageCount; ++i) std::printf(" %s %.3f", stage_name(i), 1e3 * st.stage_s[i] / st.steps);
   std::printf("\n  results: record %.2f s (in the wall time, %.1f %%), write %.2f s (%.1f MB, %zu frames)\n",
               record_s, 100 * record_s / st.wall_s, write_s, mb, r.frames());
+  if (fracture) {
+    int mode[4] = {0, 0, 0, 0};
+    for (int32_t m : r.fracture_mode) ++mode[std::clamp(m, 0, 3)];
+    const auto& bodies = r.get("floe_bodies");
+    std::printf("  fracture: %zu events (bending %d, radial %d, splitting %d), %.2f per simulated s; floe bodies "
+                "%d at the start, %.0f at the end; fracture stage %.3f ms/step\n",
+                r.fracture_mode.size(), mode[1], mode[2], mode[3], r.fracture_mode.size() / bo.duration_s,
+                model.floe_count(), bodies.empty() ? 0.0 : bodies.back(), 1e3 * st.stage_s[kFracture] / st.steps);
+  }
   std::printf("  peak memory (ru_maxrss, whole process so far) %.0f MB\n", peak_memory_mb());
   std::fflush(stdout);
   return rtf;
@@ -277,6 +291,8 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   app.add_option("--seed", bo.seed, "field generator seed");
   app.add_option("--keep", bo.keep_dir, "keep each field's results.h5 in this folder");
+  bool no_compare = false;
+  app.add_flag("--no-compare", no_compare, "skip the Oden-size field without fracture");
   return run_stage(app, argc, argv, [&] {
     FLOESIM_REQUIRE(!bo.scales.empty() && bo.scales.front() == 1,
                     "--scales must start with 1 (realtime_factor is measured on the Oden-size field)");
@@ -289,11 +305,14 @@ int main(int argc, char** argv) {
     ensure_directory(tmp);
     write_obj(tmp / "hull.obj", generate_hull(HullGeneratorOptions{}), "floesim-bench hull");
     const HullModel hull = load_hull(tmp / "hull.obj");
+    bo.compare = !no_compare;
+    const double rtf_off = bo.compare ? run_field(1, bo, hull, false) : 0.0;
     double rtf1 = 0;
     for (size_t i = 0; i < bo.scales.size(); ++i) {
-      const double rtf = run_field(bo.scales[i], bo, hull);
+      const double rtf = run_field(bo.scales[i], bo, hull, true);
       if (i == 0) rtf1 = rtf;
     }
+    if (bo.compare) std::printf("fracture_speed_ratio %.3f\n", rtf1 / rtf_off);
     std::printf("realtime_factor %.2f\n", rtf1);
   });
 }

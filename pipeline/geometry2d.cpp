@@ -1,7 +1,22 @@
 #include "pipeline/geometry2d.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
+#include <map>
+#include <string>
+#include <tuple>
+
+// Boost 1.74's geometry includes a header Boost itself deprecated (a #pragma message on every build); not ours.
+#define BOOST_ALLOW_DEPRECATED_HEADERS
+// No rescaling: by default Boost 1.74 snaps overlay computations to an integer grid of ~1e-7 of the extent, which
+// moves cut vertices by that much (a square cut along its diagonal gained a 8e-7 m sliver vertex). Without it the
+// cut vertices are the floating-point intersections of the two segments, and vertices of the inputs stay exact.
+#define BOOST_GEOMETRY_NO_ROBUSTNESS
+#include <boost/geometry.hpp>
+
+#include "pipeline/error.h"
 
 namespace floesim {
 
@@ -103,13 +118,6 @@ Polygon clean_polygon(const Polygon& in, double tol) {
 }  // namespace floesim
 
 // ---- convex_decompose: ear clipping, then Hertel-Mehlhorn merging ----------------------------------------------
-// (Includes kept with the appended code so the file above stays untouched.)
-#include <array>
-#include <limits>
-#include <map>
-
-#include "pipeline/error.h"
-
 
 namespace floesim {
 namespace {
@@ -266,6 +274,406 @@ std::vector<Polygon> convex_decompose(const Polygon& in) {
     pieces.push_back(std::move(piece));
   }
   return pieces;
+}
+
+}  // namespace floesim
+
+// ---- Cutting floes: boolean operations (Boost.Geometry), line split, chords, sectors -----------------------------
+namespace floesim {
+namespace {
+
+namespace bg = boost::geometry;
+// Closed CCW rings: Boost's overlay is exercised most with closed rings, and CCW is our orientation.
+using BgPoint = bg::model::d2::point_xy<double>;
+using BgPolygon = bg::model::polygon<BgPoint, /*ClockWise=*/false, /*Closed=*/true>;
+using BgMulti = bg::model::multi_polygon<BgPolygon>;
+
+// An operand of an overlay: its ring with repeated vertices dropped (what results are snapped back onto), and the
+// same ring as Boost's polygon, oriented and closed.
+struct Operand {
+  Polygon ring;
+  BgPolygon bg;
+};
+
+Operand prepare(const Polygon& in, const char* what) {
+  Operand o;
+  for (const Vec2& v : in) {
+    FLOESIM_REQUIRE(v.allFinite(), what, ": polygon has a non-finite vertex");
+    if (o.ring.empty() || v != o.ring.back()) o.ring.push_back(v);
+  }
+  while (o.ring.size() > 1 && o.ring.front() == o.ring.back()) o.ring.pop_back();
+  FLOESIM_REQUIRE(o.ring.size() >= 3, what, ": a polygon needs at least 3 distinct vertices, got ", o.ring.size());
+  for (const Vec2& v : o.ring) bg::append(o.bg.outer(), BgPoint(v.x(), v.y()));
+  bg::append(o.bg.outer(), BgPoint(o.ring[0].x(), o.ring[0].y()));
+  bg::correct(o.bg);  // orientation (either is accepted) and closure
+  // A self-intersecting ring makes the overlay meaningless; say so instead of returning garbage.
+  std::string why;
+  FLOESIM_REQUIRE(bg::is_valid(o.bg, why), what, ": input polygon is not simple (", why, ")");
+  return o;
+}
+
+bool lex_less(const Vec2& u, const Vec2& v) { return u.x() < v.x() || (u.x() == v.x() && u.y() < v.y()); }
+
+double segment_distance(const Vec2& v, const Vec2& p, const Vec2& q) {
+  const Vec2 e = q - p;
+  const double l2 = e.squaredNorm();
+  const double t = l2 > 0 ? std::clamp((v - p).dot(e) / l2, 0.0, 1.0) : 0.0;
+  return (v - (p + t * e)).norm();
+}
+
+// Puts each vertex of an overlay's result where it belongs. Boost computes the crossing of an edge of a with an edge
+// of b afresh in every operation, from the segments in the order and orientation that operation sees them
+// (difference reverses b), so a n b and a \ b may place the same cut vertex a few ulps apart, and an input vertex
+// on the other polygon's edge may come back as a computed crossing near it. The pieces would then not tile a
+// exactly, nor touch exactly (and a later overlay of two such pieces is misjudged). So a vertex within round-off of
+// an input vertex becomes that vertex, and any other becomes the crossing of the nearest edge of a with the nearest
+// edge of b, computed by one formula from the two segments in a canonical order: the same bits in every operation.
+class Snapper {
+ public:
+  Snapper(const Polygon& a, const Polygon& b) : a_(a), b_(b) {
+    vertices_ = a;
+    vertices_.insert(vertices_.end(), b.begin(), b.end());
+    std::sort(vertices_.begin(), vertices_.end(), lex_less);
+    Vec2 lo = vertices_[0], hi = vertices_[0];
+    for (const Vec2& v : vertices_) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+    // Round-off of a crossing computed from coordinates of this magnitude is a few ulps of the largest of them.
+    const double scale = std::max({lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff(), (hi - lo).maxCoeff()});
+    vertex_tol_ = 1e-12 * scale;
+    crossing_tol_ = 1e-9 * scale;
+  }
+
+  Vec2 operator()(const Vec2& v) const {
+    // An input vertex (exactly, or within round-off).
+    auto it = std::lower_bound(vertices_.begin(), vertices_.end(), Vec2(v.x() - vertex_tol_, -HUGE_VAL), lex_less);
+    const Vec2* best = nullptr;
+    double best_d = vertex_tol_;
+    for (; it != vertices_.end() && it->x() <= v.x() + vertex_tol_; ++it) {
+      const double d = (*it - v).cwiseAbs().maxCoeff();
+      if (d <= best_d) best = &*it, best_d = d;
+    }
+    if (best) return *best;
+    // A crossing of an edge of a with an edge of b.
+    const auto [pa, qa] = nearest_edge(a_, v);
+    const auto [pb, qb] = nearest_edge(b_, v);
+    std::array<Vec2, 2> s{pa, qa}, r{pb, qb};
+    if (lex_less(s[1], s[0])) std::swap(s[0], s[1]);
+    if (lex_less(r[1], r[0])) std::swap(r[0], r[1]);
+    if (lex_less(r[0], s[0]) || (r[0] == s[0] && lex_less(r[1], s[1]))) std::swap(s, r);
+    const Vec2 es = s[1] - s[0], er = r[1] - r[0];
+    const double den = cross(es, er);
+    if (den == 0) return v;  // parallel: Boost's own point is all there is
+    const Vec2 x = s[0] + (cross(r[0] - s[0], er) / den) * es;
+    // Only if it is the crossing Boost found (not a far one of nearly parallel edges).
+    return (x - v).norm() <= crossing_tol_ ? x : v;
+  }
+
+ private:
+  static std::pair<Vec2, Vec2> nearest_edge(const Polygon& p, const Vec2& v) {
+    size_t best = 0;
+    double best_d = HUGE_VAL;
+    for (size_t i = 0; i < p.size(); ++i) {
+      const double d = segment_distance(v, p[i], p[(i + 1) % p.size()]);
+      if (d < best_d) best = i, best_d = d;
+    }
+    return {p[best], p[(best + 1) % p.size()]};
+  }
+
+  const Polygon& a_;
+  const Polygon& b_;
+  std::vector<Vec2> vertices_;  // of a and b, sorted by lex_less
+  double vertex_tol_ = 0, crossing_tol_ = 0;
+};
+
+double ring_area(const BgPolygon::ring_type& r) { return std::abs(bg::area(r)); }
+
+// Removes the tips of zero-width spikes (the path runs out and straight back, within tol metres) and repeated
+// vertices. Splitting along a line that runs through a vertex or along an edge leaves such spikes.
+Polygon remove_spikes(Polygon p, double tol) {
+  bool changed = true;
+  while (changed && p.size() >= 3) {
+    changed = false;
+    for (size_t i = 0; i < p.size() && p.size() >= 3; ++i) {
+      const Vec2& a = p[(i + p.size() - 1) % p.size()];
+      const Vec2& b = p[i];
+      const Vec2& c = p[(i + 1) % p.size()];
+      const double len = (c - a).norm();
+      const bool repeat = (b - a).norm() <= tol;
+      const bool spike = (b - a).dot(c - b) < 0 && (len == 0 || std::abs(cross(c - a, b - a)) / len <= tol);
+      if (repeat || spike) {
+        p.erase(p.begin() + static_cast<long>(i));
+        changed = true;
+      }
+    }
+  }
+  return p;
+}
+
+// Splits a ring at each vertex it passes twice: two pieces that touch at a point (a line through a reflex vertex,
+// say) can come back as one ring pinched there, which is not a simple polygon but two simple ones.
+void split_pinches(const Polygon& p, std::vector<Polygon>& out) {
+  std::vector<size_t> order(p.size());
+  for (size_t k = 0; k < p.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(),
+            [&](size_t u, size_t v) { return lex_less(p[u], p[v]) || (p[u] == p[v] && u < v); });
+  for (size_t k = 0; k + 1 < order.size(); ++k) {
+    if (p[order[k]] != p[order[k + 1]]) continue;
+    const size_t i = order[k], j = order[k + 1];  // i < j
+    Polygon loop(p.begin() + static_cast<long>(i), p.begin() + static_cast<long>(j));
+    Polygon rest(p.begin() + static_cast<long>(j), p.end());
+    rest.insert(rest.end(), p.begin(), p.begin() + static_cast<long>(i));
+    split_pinches(loop, out);
+    split_pinches(rest, out);
+    return;
+  }
+  out.push_back(p);
+}
+
+// Candidate rings (CCW where they are pieces) as the results we promise: spikes and pinches resolved, cleaned,
+// slivers below min_area_m2 dropped (their area added to `dropped`), simple, each starting at its smallest vertex,
+// sorted. A clockwise loop of at least min_area_m2 is a hole touching the boundary: an error.
+std::vector<Polygon> finish(const std::vector<Polygon>& candidates, double min_area_m2, const char* what,
+                            double& dropped) {
+  std::vector<Polygon> out, rings;
+  for (const Polygon& c : candidates) {
+    rings.clear();
+    split_pinches(remove_spikes(c, 1e-9), rings);
+    for (Polygon& q : rings) {
+      q = clean_polygon(q);
+      const double area = q.size() < 3 ? 0.0 : signed_area(q);
+      FLOESIM_REQUIRE(area > -min_area_m2, what, ": the result has a hole of ", -area, " m^2");
+      if (area < min_area_m2 || area <= 0) {
+        dropped += std::abs(area);
+        continue;
+      }
+      // Boost 1.74's floating-point overlay can, in nearly degenerate configurations, return a self-intersecting
+      // ring; a caller gets an error (no cut) rather than such a floe.
+      BgPolygon check;
+      for (const Vec2& v : q) bg::append(check.outer(), BgPoint(v.x(), v.y()));
+      bg::append(check.outer(), BgPoint(q[0].x(), q[0].y()));
+      std::string why;
+      FLOESIM_REQUIRE(bg::is_valid(check, why), what, ": the result is not a simple polygon (", why, ")");
+      std::rotate(q.begin(), std::min_element(q.begin(), q.end(), lex_less), q.end());
+      out.push_back(std::move(q));
+    }
+  }
+  // Pieces have disjoint interiors, so their smallest vertices differ unless two pieces touch there; the vertex
+  // count and then the second vertex break such ties.
+  std::sort(out.begin(), out.end(), [](const Polygon& u, const Polygon& v) {
+    auto key = [](const Polygon& q) { return std::make_tuple(q[0].x(), q[0].y(), q.size(), q[1].x(), q[1].y()); };
+    return key(u) < key(v);
+  });
+  return out;
+}
+
+// Boost's result as our polygons: holes refused, closing vertex dropped, vertices snapped, then finish().
+std::vector<Polygon> from_boost(const BgMulti& m, const Snapper& snap, double min_area_m2, const char* what,
+                                double& dropped) {
+  std::vector<Polygon> candidates;
+  for (const BgPolygon& g : m) {
+    for (const auto& hole : g.inners()) {
+      FLOESIM_REQUIRE(ring_area(hole) < min_area_m2, what, ": the result has a hole of ", ring_area(hole), " m^2");
+      dropped -= ring_area(hole);  // the outer ring's area counts it
+    }
+    Polygon p;
+    const auto& r = g.outer();
+    for (size_t i = 0; i + 1 < r.size(); ++i) p.push_back(snap(Vec2(bg::get<0>(r[i]), bg::get<1>(r[i]))));
+    candidates.push_back(std::move(p));
+  }
+  return finish(candidates, min_area_m2, what, dropped);
+}
+
+double total_area(const std::vector<Polygon>& pieces) {
+  double a = 0;
+  for (const Polygon& q : pieces) a += signed_area(q);
+  return a;
+}
+
+// The pieces of one cut must tile the polygon: a floating-point overlay that went wrong in a nearly degenerate
+// configuration shows up here, and the caller gets an error (no cut) instead of ice created or lost.
+void require_tiling(double whole, double pieces, double dropped, const char* what) {
+  FLOESIM_REQUIRE(std::abs(pieces + dropped - whole) <= 1e-9 * std::abs(whole), what,
+                  ": the pieces do not add up to the polygon (", pieces, " + ", dropped, " dropped vs ", whole,
+                  " m^2)");
+}
+
+}  // namespace
+
+std::vector<Polygon> polygon_intersection(const Polygon& a, const Polygon& b, double min_area_m2) {
+  const Operand oa = prepare(a, "polygon_intersection"), ob = prepare(b, "polygon_intersection");
+  BgMulti out;
+  bg::intersection(oa.bg, ob.bg, out);
+  double dropped = 0;
+  return from_boost(out, Snapper(oa.ring, ob.ring), min_area_m2, "polygon_intersection", dropped);
+}
+
+std::vector<Polygon> polygon_difference(const Polygon& a, const Polygon& b, double min_area_m2) {
+  const Operand oa = prepare(a, "polygon_difference"), ob = prepare(b, "polygon_difference");
+  BgMulti out;
+  bg::difference(oa.bg, ob.bg, out);
+  double dropped = 0;
+  return from_boost(out, Snapper(oa.ring, ob.ring), min_area_m2, "polygon_difference", dropped);
+}
+
+PolygonCut cut_polygon(const Polygon& a, const Polygon& b, double min_area_m2) {
+  const Operand oa = prepare(a, "cut_polygon"), ob = prepare(b, "cut_polygon");
+  const Snapper snap(oa.ring, ob.ring);
+  BgMulti in, out;
+  bg::intersection(oa.bg, ob.bg, in);
+  bg::difference(oa.bg, ob.bg, out);
+  double dropped = 0;
+  PolygonCut cut{from_boost(in, snap, min_area_m2, "cut_polygon", dropped),
+                 from_boost(out, snap, min_area_m2, "cut_polygon", dropped)};
+  require_tiling(std::abs(signed_area(oa.ring)), total_area(cut.inside) + total_area(cut.outside), dropped,
+                 "cut_polygon");
+  return cut;
+}
+
+LineSplit split_by_line(const Polygon& in, const Vec2& point, const Vec2& dir, double min_area_m2) {
+  FLOESIM_REQUIRE(point.allFinite() && dir.allFinite() && dir.norm() > 0,
+                  "split_by_line: the line needs a finite point and a non-zero direction");
+  // Our own walk rather than an overlay with a half-plane: Boost 1.74's floating-point overlay misjudges a line
+  // through a vertex (the half-plane's edge then misses the vertex by an ulp), which is exactly where cracks from
+  // contacts at vertices run. Here every decision is the sign of one number per vertex, computed once.
+  Polygon p = prepare(in, "split_by_line").ring;  // validates: finite, >= 3 distinct vertices, simple
+  make_ccw(p);
+  const size_t n = p.size();
+  const Vec2 d = dir.normalized();
+  std::vector<double> s(n), t(n);  // signed distance to the line (> 0 left) and position along it
+  for (size_t i = 0; i < n; ++i) s[i] = cross(d, p[i] - point), t[i] = d.dot(p[i] - point);
+  // Simulation of simplicity: a vertex on the line (s = 0) counts as left, as if the line were moved right by an
+  // infinitesimal amount. No vertex is then on the line, every crossing is a proper one, and along the line the
+  // crossings alternate between leaving and entering the polygon (Jordan). Zero-width spikes and sliver pieces
+  // that the infinitesimal move creates are removed by finish().
+  auto is_left = [&](size_t i) { return s[i] >= 0; };
+
+  // The ring with each crossing inserted in its edge. A crossing is computed from its edge's left end point a, so
+  // one on a vertex (s_a = 0) is that vertex exactly.
+  struct Node {
+    Vec2 x;
+    size_t vertex;  // index into p, or n for a crossing
+    double t = 0, slope = 0;
+    size_t partner = 0;
+  };
+  std::vector<Node> ring;
+  std::vector<size_t> crossings;
+  for (size_t i = 0; i < n; ++i) {
+    ring.push_back({p[i], i});
+    const size_t j = (i + 1) % n;
+    if (is_left(i) == is_left(j)) continue;
+    const size_t a = is_left(i) ? i : j, b = is_left(i) ? j : i;
+    const double lambda = s[a] / (s[a] - s[b]);
+    Node c{p[a] + lambda * (p[b] - p[a]), n};
+    c.t = t[a] + lambda * (t[b] - t[a]);
+    // How the crossing moves along the line as the line moves right by eps: orders crossings at the same t (two
+    // edges through one vertex on the line) the way the displaced line meets them.
+    c.slope = (t[b] - t[a]) / (s[a] - s[b]);
+    crossings.push_back(ring.size());
+    ring.push_back(c);
+  }
+  // Along the line, crossings pair up as the ends of the chords inside the polygon.
+  std::sort(crossings.begin(), crossings.end(), [&](size_t u, size_t v) {
+    return ring[u].t < ring[v].t || (ring[u].t == ring[v].t && ring[u].slope < ring[v].slope);
+  });
+  for (size_t k = 0; k + 1 < crossings.size(); k += 2) {
+    ring[crossings[k]].partner = crossings[k + 1];
+    ring[crossings[k + 1]].partner = crossings[k];
+  }
+  // Vertices on the line, by position: one inside a chord is a point where a piece's chord edge touches the piece
+  // again (or the other side's piece); putting it on the chord edge lets finish() split the pinch there.
+  std::vector<size_t> on_line;
+  for (size_t i = 0; i < n; ++i)
+    if (s[i] == 0) on_line.push_back(i);
+  std::sort(on_line.begin(), on_line.end(), [&](size_t u, size_t v) { return t[u] < t[v]; });
+
+  // Walk each side: along the ring while on the side; at a crossing (always a way out, since the walk only comes
+  // from the side's vertices) along the chord to its partner (a way back in), and on along the ring.
+  std::vector<Polygon> left, right;
+  std::vector<bool> visited(ring.size(), false);
+  const size_t m = ring.size();
+  for (size_t start = 0; start < m; ++start) {
+    if (ring[start].vertex == n || visited[start]) continue;
+    const bool side = is_left(ring[start].vertex);
+    Polygon piece;
+    size_t cur = start;
+    for (size_t steps = 0;; ++steps) {
+      FLOESIM_REQUIRE(steps <= 2 * m, "split_by_line: internal error, a piece does not close");
+      visited[cur] = true;
+      piece.push_back(ring[cur].x);
+      if (ring[cur].vertex == n) {
+        const size_t y = ring[cur].partner;
+        const double t0 = ring[cur].t, t1 = ring[y].t;
+        auto inside = [&](size_t i) { return std::min(t0, t1) < t[i] && t[i] < std::max(t0, t1); };
+        if (t0 < t1) {
+          for (size_t i : on_line)
+            if (inside(i)) piece.push_back(p[i]);
+        } else {
+          for (auto it = on_line.rbegin(); it != on_line.rend(); ++it)
+            if (inside(*it)) piece.push_back(p[*it]);
+        }
+        visited[y] = true;
+        piece.push_back(ring[y].x);
+        cur = (y + 1) % m;
+      } else {
+        cur = (cur + 1) % m;
+      }
+      if (cur == start) break;
+    }
+    (side ? left : right).push_back(std::move(piece));
+  }
+  double dropped = 0;
+  LineSplit out{finish(left, min_area_m2, "split_by_line", dropped),
+                finish(right, min_area_m2, "split_by_line", dropped)};
+  require_tiling(signed_area(p), total_area(out.left) + total_area(out.right), dropped, "split_by_line");
+  return out;
+}
+
+double chord_length(const Polygon& p, const Vec2& point, const Vec2& dir) {
+  FLOESIM_REQUIRE(point.allFinite() && dir.allFinite() && dir.norm() > 0,
+                  "chord_length: the line needs a finite point and a non-zero direction");
+  FLOESIM_REQUIRE(p.size() >= 3, "chord_length: a polygon needs at least 3 vertices, got ", p.size());
+  constexpr double kOnTol = 1e-9;  // m: a point this close to a crossing counts as on the boundary
+  const Vec2 d = dir.normalized();
+  const size_t n = p.size();
+  double best = 0;
+  std::vector<double> t;
+  // The line is displaced infinitesimally to one side, then to the other: a vertex on the line counts as lying
+  // on the far side, so every crossing is proper and, sorted along the line, crossings alternate entry and exit
+  // (Jordan). A line grazing a vertex or running along an edge is inside for one displacement and outside (or
+  // of zero length) for the other; the longer chord is the one the closed polygon contains.
+  for (const bool zero_is_left : {true, false}) {
+    t.clear();
+    for (size_t i = 0; i < n; ++i) {
+      const Vec2 u = p[i] - point, v = p[(i + 1) % n] - point;
+      const double su = cross(d, u), sv = cross(d, v);
+      const bool lu = zero_is_left ? su >= 0 : su > 0, lv = zero_is_left ? sv >= 0 : sv > 0;
+      if (lu == lv) continue;
+      const double tu = d.dot(u), tv = d.dot(v);
+      t.push_back(tu + (tv - tu) * (su / (su - sv)));
+    }
+    std::sort(t.begin(), t.end());
+    for (size_t k = 0; k + 1 < t.size(); k += 2)
+      if (t[k] <= kOnTol && t[k + 1] >= -kOnTol) best = std::max(best, t[k + 1] - t[k]);
+  }
+  return best;
+}
+
+Polygon circular_sector(const Vec2& apex, const Vec2& axis, double half_angle_rad, double radius_m, int segments) {
+  FLOESIM_REQUIRE(apex.allFinite() && axis.allFinite() && axis.norm() > 0,
+                  "circular_sector: needs a finite apex and a non-zero axis");
+  FLOESIM_REQUIRE(half_angle_rad > 0 && half_angle_rad <= 1.57079632679489661923,
+                  "circular_sector: half-angle must be in (0, pi/2], got ", half_angle_rad);
+  FLOESIM_REQUIRE(radius_m > 0 && std::isfinite(radius_m), "circular_sector: radius must be > 0, got ", radius_m);
+  FLOESIM_REQUIRE(segments >= 1, "circular_sector: needs at least one arc segment, got ", segments);
+  const Vec2 x = axis.normalized(), y(-x.y(), x.x());
+  Polygon s;
+  s.reserve(static_cast<size_t>(segments) + 2);
+  s.push_back(apex);
+  for (int k = 0; k <= segments; ++k) {
+    // (2k - segments) is exact, so the arc is symmetric about the axis bit for bit.
+    const double phi = half_angle_rad * (2 * k - segments) / segments;
+    s.push_back(apex + radius_m * (std::cos(phi) * x + std::sin(phi) * y));
+  }
+  return s;
 }
 
 }  // namespace floesim

@@ -21,4 +21,38 @@ Polygon clean_polygon(const Polygon& p, double tol = 1e-9);
 // Hertel-Mehlhorn merging of diagonals: at most 4x the optimal number of pieces). A convex input comes back whole.
 std::vector<Polygon> convex_decompose(const Polygon& ccw_simple_polygon);
 
+// ---- Cutting floes (Boost.Geometry inside; no Boost type appears here) ----
+// Boolean operations on simple polygons (either orientation; a self-intersecting input throws floesim::Error).
+// Results: simple CCW polygons, cleaned (clean_polygon), pieces below min_area_m2 dropped, each ring starting at
+// its lexicographically smallest (x, y) vertex and the pieces sorted by that vertex, so the same input gives the
+// same output bits. A result with a hole of at least min_area_m2 throws floesim::Error (callers treat it as
+// "no cut"). The intersection and the difference of the same pair share their cut vertices bit for bit, so
+// area(a) = area(a n b) + area(a \ b) to round-off.
+std::vector<Polygon> polygon_intersection(const Polygon& a, const Polygon& b, double min_area_m2 = 1e-9);
+std::vector<Polygon> polygon_difference(const Polygon& a, const Polygon& b, double min_area_m2 = 1e-9);
+// a n b and a \ b together, checked against each other: their areas (with any dropped slivers) must add up to a's
+// to 1e-9 relative, else floesim::Error. Boost 1.74's floating-point overlay can go wrong in nearly degenerate
+// configurations; this is what a caller that cuts a floe in two should use, so that a bad cut is no cut.
+struct PolygonCut {
+  std::vector<Polygon> inside, outside;  // a n b, a \ b
+};
+PolygonCut cut_polygon(const Polygon& a, const Polygon& b, double min_area_m2 = 1e-9);
+// Splits a simple polygon by the infinite line through `point` with direction `dir`: pieces left of the line
+// (cross(dir, x - point) > 0) and right of it, cleaned and ordered as above. Not an overlay but a walk along the
+// ring with one side test per vertex, robust for lines through vertices and along edges. The areas add up to the
+// polygon's to round-off (with any dropped slivers; checked, else floesim::Error).
+struct LineSplit {
+  std::vector<Polygon> left, right;
+};
+LineSplit split_by_line(const Polygon& p, const Vec2& point, const Vec2& dir, double min_area_m2 = 1e-9);
+// Length of the part of the line through `point` along `dir` that lies inside p and contains `point` (the chord a
+// crack from `point` along dir would cut); 0 if point is outside. If `point` is on the boundary, the chord that
+// starts there and goes into the polygon. "On" means within 1e-9 m (clean_polygon's default tolerance); a line
+// running along a boundary edge counts that edge as inside.
+double chord_length(const Polygon& p, const Vec2& point, const Vec2& dir);
+// A circular sector as a convex CCW polygon: apex, direction of its axis (normalised here), half-angle (0, pi/2],
+// radius, and the arc as `segments` chords (vertices: the apex, then the arc from -half_angle to +half_angle). The
+// arc's vertices lie on the circle, so the polygon is inside the true sector.
+Polygon circular_sector(const Vec2& apex, const Vec2& axis, double half_angle_rad, double radius_m, int segments);
+
 }  // namespace floesim

@@ -3,7 +3,9 @@
 #include <hdf5.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
@@ -28,6 +30,8 @@ const std::vector<FieldSpec>& series_fields() {
       {"solver_iterations", 1, "-", "contact solver sweeps in the step"},
       {"solver_residual", 1, "m/s", "largest velocity change of the last sweep"},
       {"awake_floes", 1, "-", "floes integrated this step (others sleep)"},
+      {"fracture_events", 1, "-", "fracture events in the step (floes broken, /fracture holds each event)"},
+      {"floe_bodies", 1, "-", "floe bodies in the world at the end of the step (pieces included)"},
   };
   return k;
 }
@@ -36,6 +40,17 @@ const FieldSpec& series_field(const std::string& name) {
   for (const auto& f : series_fields())
     if (name == f.name) return f;
   throw Error("unknown results series '" + name + "'");
+}
+
+const char* fracture_mode_name(int32_t mode) {
+  switch (mode) {
+    case kFractureNone: return "input";
+    case kFractureBending: return "bending";
+    case kFractureRadial: return "radial";
+    case kFractureSplitting: return "splitting";
+  }
+  throw Error("unknown fracture mode " + std::to_string(mode) +
+              " (expected 0 input, 1 bending, 2 radial, 3 splitting)");
 }
 
 size_t Results::steps() const {
@@ -121,6 +136,101 @@ std::vector<T> read_ds(hid_t file_id, const std::string& name, size_t cols, cons
   return v;
 }
 
+// The layout this version writes, and the one before fracture (no /fracture, no lineage, fewer series), which it
+// still reads so that old artefacts still plot and render.
+constexpr const char* kLayout = "floesim-results/2";
+constexpr const char* kLayoutBeforeFracture = "floesim-results/1";
+// Series that floesim-results/1 did not have, and what reading such a file fills in (see read_results).
+bool series_added_in_layout_2(const std::string& name) { return name == "fracture_events" || name == "floe_bodies"; }
+
+// The lineage and the fracture events, checked alike on write (then a bug in simulate) and on read (a damaged or
+// foreign file): returns the first problem found, naming the dataset, or "" if there is none.
+std::string fracture_problem(const Results& r) {
+  std::string e;  // the first length problem
+  const size_t n = r.floe_id.size();
+  auto rows = [&](const char* name, size_t size, size_t cols, size_t expected, const char* what) {
+    if (!e.empty() || size == expected * cols) return;
+    e = std::string(name) + " has " + std::to_string(size) + (cols == 1 ? " rows" : " values") + ", expected " +
+        std::to_string(expected) + (cols == 1 ? "" : " x " + std::to_string(cols)) + " (" + what + ")";
+  };
+  rows("/geometry/floe_parent_id", r.floe_parent_id.size(), 1, n, "one per /geometry/floe_id");
+  rows("/geometry/floe_generation", r.floe_generation.size(), 1, n, "one per /geometry/floe_id");
+  rows("/geometry/floe_origin_mode", r.floe_origin_mode.size(), 1, n, "one per /geometry/floe_id");
+  rows("/geometry/floe_created_s", r.floe_created_s.size(), 1, n, "one per /geometry/floe_id");
+  rows("/geometry/floe_ended_s", r.floe_ended_s.size(), 1, n, "one per /geometry/floe_id");
+  const size_t E = r.fracture_time_s.size();
+  const char* per_event = "one per event of /fracture/time_s";
+  rows("/fracture/parent_id", r.fracture_parent_id.size(), 1, E, per_event);
+  rows("/fracture/mode", r.fracture_mode.size(), 1, E, per_event);
+  rows("/fracture/at_structure", r.fracture_at_structure.size(), 1, E, per_event);
+  rows("/fracture/force_n", r.fracture_force_n.size(), 3, E, per_event);
+  rows("/fracture/threshold_n", r.fracture_threshold_n.size(), 1, E, per_event);
+  rows("/fracture/point_m", r.fracture_point_m.size(), 3, E, per_event);
+  rows("/fracture/width_m", r.fracture_width_m.size(), 1, E, per_event);
+  rows("/fracture/theta_rad", r.fracture_theta_rad.size(), 1, E, per_event);
+  rows("/fracture/brash_mass_kg", r.fracture_brash_mass_kg.size(), 1, E, per_event);
+  rows("/fracture/child_offset", r.fracture_child_offset.size(), 1, E + 1, "events + 1");
+  if (!e.empty()) return e;
+
+  // Offsets into child_id: 0, non-decreasing, ending at its size.
+  const auto& off = r.fracture_child_offset;
+  if (off.front() != 0) return "/fracture/child_offset starts at " + std::to_string(off.front()) + ", expected 0";
+  for (size_t k = 0; k < E; ++k)
+    if (off[k + 1] < off[k])
+      return "/fracture/child_offset decreases at event " + std::to_string(k) + " (" + std::to_string(off[k]) +
+             " -> " + std::to_string(off[k + 1]) + ")";
+  if (static_cast<uint64_t>(off.back()) != r.fracture_child_id.size())
+    return "/fracture/child_offset ends at " + std::to_string(off.back()) + ", but /fracture/child_id has " +
+           std::to_string(r.fracture_child_id.size()) + " rows";
+
+  // Events: modes, flags, time order.
+  for (size_t k = 0; k < E; ++k) {
+    const std::string at = " at event " + std::to_string(k);
+    if (r.fracture_mode[k] < kFractureBending || r.fracture_mode[k] > kFractureSplitting)
+      return "/fracture/mode is " + std::to_string(r.fracture_mode[k]) + at +
+             "; expected 1 (bending), 2 (radial) or 3 (splitting)";
+    if (r.fracture_at_structure[k] != 0 && r.fracture_at_structure[k] != 1)
+      return "/fracture/at_structure is " + std::to_string(r.fracture_at_structure[k]) + at + "; expected 0 or 1";
+    if (!std::isfinite(r.fracture_time_s[k])) return "/fracture/time_s is not finite" + at;
+    if (k > 0 && r.fracture_time_s[k] < r.fracture_time_s[k - 1])
+      return "/fracture/time_s decreases" + at + " (events must be in time order)";
+  }
+
+  // Every floe an event or a lineage names has geometry: pieces are recorded like input floes.
+  std::vector<int32_t> ids(r.floe_id);
+  std::sort(ids.begin(), ids.end());
+  auto known = [&](int32_t id) { return std::binary_search(ids.begin(), ids.end(), id); };
+  for (size_t k = 0; k < E; ++k)
+    if (!known(r.fracture_parent_id[k]))
+      return "/fracture/parent_id " + std::to_string(r.fracture_parent_id[k]) + " at event " + std::to_string(k) +
+             " is not in /geometry/floe_id";
+  for (size_t c = 0; c < r.fracture_child_id.size(); ++c)
+    if (!known(r.fracture_child_id[c]))
+      return "/fracture/child_id " + std::to_string(r.fracture_child_id[c]) + " (row " + std::to_string(c) +
+             ") is not in /geometry/floe_id";
+
+  // Lineage: an input floe has parent -1, mode 0 and generation 0; a piece names a known parent and its mode.
+  for (size_t g = 0; g < n; ++g) {
+    const std::string floe = " for floe " + std::to_string(r.floe_id[g]);
+    const int32_t parent = r.floe_parent_id[g], mode = r.floe_origin_mode[g];
+    if (mode < kFractureNone || mode > kFractureSplitting)
+      return "/geometry/floe_origin_mode is " + std::to_string(mode) + floe + "; expected 0..3";
+    if ((parent == -1) != (mode == kFractureNone))
+      return "/geometry/floe_parent_id is " + std::to_string(parent) + floe + " but /geometry/floe_origin_mode is " +
+             std::to_string(mode) + " (-1 goes with 0: a floe of the input field)";
+    if (parent != -1 && !known(parent))
+      return "/geometry/floe_parent_id " + std::to_string(parent) + floe + " is not in /geometry/floe_id";
+    if (r.floe_generation[g] < 0 || (parent == -1) != (r.floe_generation[g] == 0))
+      return "/geometry/floe_generation is " + std::to_string(r.floe_generation[g]) + floe +
+             "; expected 0 for an input floe, >= 1 for a piece";
+    if (!std::isfinite(r.floe_created_s[g])) return "/geometry/floe_created_s is not finite" + floe;
+    if (!(r.floe_ended_s[g] >= r.floe_created_s[g]))
+      return "/geometry/floe_ended_s is " + std::to_string(r.floe_ended_s[g]) + floe + ", before it was created (" +
+             std::to_string(r.floe_created_s[g]) + " s; +inf if it lasted)";
+  }
+  return "";
+}
+
 }  // namespace
 
 void write_results(const std::filesystem::path& path, const Results& r) {
@@ -137,6 +247,8 @@ void write_results(const std::filesystem::path& path, const Results& r) {
                       r.state_quaternion.size() == 4 * r.state_body_id.size(),
                   file, ": internal: state arrays disagree");
   FLOESIM_REQUIRE(r.floe_vertex_offset.size() == r.floe_id.size() + 1, file, ": internal: floe vertex offsets");
+  const std::string fracture = fracture_problem(r);
+  FLOESIM_REQUIRE(fracture.empty(), file, ": internal: ", fracture);
 
   AtomicFile out(path);
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are reported by us, with context
@@ -149,7 +261,7 @@ void write_results(const std::filesystem::path& path, const Results& r) {
     FLOESIM_REQUIRE(fid.id >= 0, file, ": cannot create (is the directory writable?)");
     H5Id gcpl(H5Pcreate(H5P_GROUP_CREATE), H5Pclose);
     H5Pset_obj_track_times(gcpl, false);
-    for (const char* g : {"/series", "/frames", "/states", "/geometry"}) {
+    for (const char* g : {"/series", "/frames", "/states", "/geometry", "/fracture"}) {
       H5Id gid(H5Gcreate2(fid, g, H5P_DEFAULT, gcpl, H5P_DEFAULT), H5Gclose);
     }
     for (const auto& f : series_fields())
@@ -163,11 +275,28 @@ void write_results(const std::filesystem::path& path, const Results& r) {
     write_ds(fid, "/geometry/floe_thickness_m", r.floe_thickness_m, 1, file);
     write_ds(fid, "/geometry/floe_vertex_offset", r.floe_vertex_offset, 1, file);
     write_ds(fid, "/geometry/floe_vertices_m", r.floe_vertices_m, 2, file);
+    write_ds(fid, "/geometry/floe_parent_id", r.floe_parent_id, 1, file);
+    write_ds(fid, "/geometry/floe_generation", r.floe_generation, 1, file);
+    write_ds(fid, "/geometry/floe_origin_mode", r.floe_origin_mode, 1, file);
+    write_ds(fid, "/geometry/floe_created_s", r.floe_created_s, 1, file);
+    write_ds(fid, "/geometry/floe_ended_s", r.floe_ended_s, 1, file);
     write_ds(fid, "/geometry/hull_vertices_m", r.hull_vertices_m, 3, file);
     write_ds(fid, "/geometry/hull_triangles", r.hull_triangles, 3, file);
+    write_ds(fid, "/fracture/time_s", r.fracture_time_s, 1, file);
+    write_ds(fid, "/fracture/parent_id", r.fracture_parent_id, 1, file);
+    write_ds(fid, "/fracture/mode", r.fracture_mode, 1, file);
+    write_ds(fid, "/fracture/at_structure", r.fracture_at_structure, 1, file);
+    write_ds(fid, "/fracture/force_n", r.fracture_force_n, 3, file);
+    write_ds(fid, "/fracture/threshold_n", r.fracture_threshold_n, 1, file);
+    write_ds(fid, "/fracture/point_m", r.fracture_point_m, 3, file);
+    write_ds(fid, "/fracture/width_m", r.fracture_width_m, 1, file);
+    write_ds(fid, "/fracture/theta_rad", r.fracture_theta_rad, 1, file);
+    write_ds(fid, "/fracture/brash_mass_kg", r.fracture_brash_mass_kg, 1, file);
+    write_ds(fid, "/fracture/child_offset", r.fracture_child_offset, 1, file);
+    write_ds(fid, "/fracture/child_id", r.fracture_child_id, 1, file);
 
     nlohmann::json attrs = r.attributes;
-    attrs["layout"] = "floesim-results/1";
+    attrs["layout"] = kLayout;
     const std::string text = attrs.dump();
     H5Id st(H5Tcopy(H5T_C_S1), H5Tclose);
     H5Tset_size(st, text.size() + 1);
@@ -198,13 +327,19 @@ Results read_results(const std::filesystem::path& path, bool with_states) {
     text.resize(std::strlen(text.c_str()));
     r.attributes = nlohmann::json::parse(text, nullptr, false);
     FLOESIM_REQUIRE(!r.attributes.is_discarded(), file, ": the 'floesim' attribute is not JSON");
-    FLOESIM_REQUIRE(r.attributes.value("layout", "") == "floesim-results/1", file, ": layout ",
-                    r.attributes.value("layout", "?"), " is not supported by this version");
   }
-  for (const auto& f : series_fields()) r.series[f.name] = read_ds<double>(fid, std::string("/series/") + f.name, f.cols, file);
+  const std::string layout = r.attributes.value("layout", "?");
+  FLOESIM_REQUIRE(layout == kLayout || layout == kLayoutBeforeFracture, file, ": layout ", layout,
+                  " is not supported by this version (it reads ", kLayout, " and ", kLayoutBeforeFracture,
+                  "; a newer floesim wrote it?)");
+  const bool before_fracture = layout == kLayoutBeforeFracture;
+  for (const auto& f : series_fields())
+    if (!(before_fracture && series_added_in_layout_2(f.name)))
+      r.series[f.name] = read_ds<double>(fid, std::string("/series/") + f.name, f.cols, file);
   const size_t n = r.steps();
   for (const auto& f : series_fields())
-    FLOESIM_REQUIRE(r.series[f.name].size() == n * f.cols, file, ": series ", f.name, " has the wrong length");
+    if (r.series.count(f.name))
+      FLOESIM_REQUIRE(r.series[f.name].size() == n * f.cols, file, ": series ", f.name, " has the wrong length");
   r.frame_time_s = read_ds<double>(fid, "/frames/time_s", 1, file);
   r.frame_offset = read_ds<int64_t>(fid, "/frames/offset", 1, file);
   FLOESIM_REQUIRE(r.frame_offset.size() == r.frame_time_s.size() + 1, file, ": /frames/offset has the wrong length");
@@ -223,6 +358,39 @@ Results read_results(const std::filesystem::path& path, bool with_states) {
   r.hull_vertices_m = read_ds<double>(fid, "/geometry/hull_vertices_m", 3, file);
   r.hull_triangles = read_ds<int32_t>(fid, "/geometry/hull_triangles", 3, file);
   FLOESIM_REQUIRE(r.floe_vertex_offset.size() == r.floe_id.size() + 1, file, ": floe vertex offsets disagree");
+
+  const size_t floes = r.floe_id.size();
+  if (before_fracture) {
+    // Nothing broke before fracture existed: every floe is an input floe that lasted, and every floe of the
+    // geometry was a body for the whole run.
+    r.floe_parent_id.assign(floes, -1);
+    r.floe_generation.assign(floes, 0);
+    r.floe_origin_mode.assign(floes, kFractureNone);
+    r.floe_created_s.assign(floes, 0.0);
+    r.floe_ended_s.assign(floes, std::numeric_limits<double>::infinity());
+    r.series["fracture_events"].assign(n, 0.0);
+    r.series["floe_bodies"].assign(n, static_cast<double>(floes));
+    return r;
+  }
+  r.floe_parent_id = read_ds<int32_t>(fid, "/geometry/floe_parent_id", 1, file);
+  r.floe_generation = read_ds<int32_t>(fid, "/geometry/floe_generation", 1, file);
+  r.floe_origin_mode = read_ds<int32_t>(fid, "/geometry/floe_origin_mode", 1, file);
+  r.floe_created_s = read_ds<double>(fid, "/geometry/floe_created_s", 1, file);
+  r.floe_ended_s = read_ds<double>(fid, "/geometry/floe_ended_s", 1, file);
+  r.fracture_time_s = read_ds<double>(fid, "/fracture/time_s", 1, file);
+  r.fracture_parent_id = read_ds<int32_t>(fid, "/fracture/parent_id", 1, file);
+  r.fracture_mode = read_ds<int32_t>(fid, "/fracture/mode", 1, file);
+  r.fracture_at_structure = read_ds<int32_t>(fid, "/fracture/at_structure", 1, file);
+  r.fracture_force_n = read_ds<double>(fid, "/fracture/force_n", 3, file);
+  r.fracture_threshold_n = read_ds<double>(fid, "/fracture/threshold_n", 1, file);
+  r.fracture_point_m = read_ds<double>(fid, "/fracture/point_m", 3, file);
+  r.fracture_width_m = read_ds<double>(fid, "/fracture/width_m", 1, file);
+  r.fracture_theta_rad = read_ds<double>(fid, "/fracture/theta_rad", 1, file);
+  r.fracture_brash_mass_kg = read_ds<double>(fid, "/fracture/brash_mass_kg", 1, file);
+  r.fracture_child_offset = read_ds<int64_t>(fid, "/fracture/child_offset", 1, file);
+  r.fracture_child_id = read_ds<int32_t>(fid, "/fracture/child_id", 1, file);
+  const std::string fracture = fracture_problem(r);
+  FLOESIM_REQUIRE(fracture.empty(), file, ": ", fracture, " (a damaged file, or not written by floesim-simulate?)");
   return r;
 }
 

@@ -12,8 +12,26 @@
 //   /geometry/floe_vertex_offset [n+1]    int64     outline of floe k: rows offset[k] .. offset[k+1]-1
 //   /geometry/floe_vertices_m    [V x 2]  float64   CCW outline in the floe's body frame (origin = centre of mass;
 //                                                   the slab spans z = -h/2 .. h/2 in that frame)
+//   /geometry/floe_parent_id     [n]      int32     -1 for a floe of the input field, else the id it broke from
+//   /geometry/floe_generation    [n]      int32     0 for input floes, the parent's + 1 for a piece
+//   /geometry/floe_origin_mode   [n]      int32     how it was made: 0 input, else the FractureMode of its event
+//   /geometry/floe_created_s     [n]      float64   time it appeared (0 for input floes)
+//   /geometry/floe_ended_s       [n]      float64   time it broke up (replaced by its pieces); +inf if it lasted
 //   /geometry/hull_vertices_m    [Vh x 3] float64   hull mesh in the vessel body frame (origin = centre of mass)
 //   /geometry/hull_triangles     [T x 3]  int32
+//   /fracture/time_s             [E]      float64   one row per fracture event (PHYSICS.md §2), in time order
+//   /fracture/parent_id          [E]      int32     the floe that broke (it ends at this time)
+//   /fracture/mode               [E]      int32     FractureMode: 1 bending, 2 radial, 3 splitting
+//   /fracture/at_structure       [E]      int32     1: at a contact with the vessel, 0: floe-floe contact
+//   /fracture/force_n            [E x 3]  float64   contact force on the floe at failure, world frame
+//   /fracture/threshold_n        [E]      float64   the failure load it reached (vertical for bending/radial,
+//                                                   horizontal for splitting)
+//   /fracture/point_m            [E x 3]  float64   contact point, world frame
+//   /fracture/width_m            [E]      float64   contact width used (never below the thickness)
+//   /fracture/theta_rad          [E]      float64   wedge angle (bending/radial), 0 for splitting
+//   /fracture/brash_mass_kg      [E]      float64   mass of pieces below the minimum size, removed (counted here)
+//   /fracture/child_offset       [E+1]    int64     pieces of event k: child_id[offset[k] .. offset[k+1]-1]
+//   /fracture/child_id           [C]      int32     floe ids of the pieces that became bodies
 //   attribute "floesim" on the root: JSON text with layout version, time_step_s, duration_s,
 //   output_interval_s and the provenance.
 #pragma once
@@ -26,6 +44,12 @@
 #include <nlohmann/json.hpp>
 
 namespace floesim {
+
+// How a fracture event broke a floe (PHYSICS.md §2.1-2.4): a wedge cut out when the circumferential (Nevel) load
+// P_f governs (bending) or when the radial-crack initiation load P_r governs (radial), or a split along the force
+// line (splitting). 0 marks a floe of the input field in /geometry/floe_origin_mode.
+enum FractureMode : int32_t { kFractureNone = 0, kFractureBending = 1, kFractureRadial = 2, kFractureSplitting = 3 };
+const char* fracture_mode_name(int32_t mode);  // "input", "bending", "radial", "splitting"
 
 struct FieldSpec {
   const char* name;
@@ -52,8 +76,28 @@ struct Results {
   std::vector<double> floe_thickness_m;
   std::vector<int64_t> floe_vertex_offset;  // size n+1
   std::vector<double> floe_vertices_m;      // [V x 2]
+  // Lineage of every floe that ever existed (same order as floe_id).
+  std::vector<int32_t> floe_parent_id;
+  std::vector<int32_t> floe_generation;
+  std::vector<int32_t> floe_origin_mode;
+  std::vector<double> floe_created_s;
+  std::vector<double> floe_ended_s;
   std::vector<double> hull_vertices_m;      // [Vh x 3]
   std::vector<int32_t> hull_triangles;      // [T x 3]
+
+  // Fracture events (see the layout above).
+  std::vector<double> fracture_time_s;
+  std::vector<int32_t> fracture_parent_id;
+  std::vector<int32_t> fracture_mode;
+  std::vector<int32_t> fracture_at_structure;
+  std::vector<double> fracture_force_n;      // [E x 3]
+  std::vector<double> fracture_threshold_n;
+  std::vector<double> fracture_point_m;      // [E x 3]
+  std::vector<double> fracture_width_m;
+  std::vector<double> fracture_theta_rad;
+  std::vector<double> fracture_brash_mass_kg;
+  std::vector<int64_t> fracture_child_offset = {0};  // size E+1
+  std::vector<int32_t> fracture_child_id;
 
   nlohmann::json attributes = nlohmann::json::object();
 

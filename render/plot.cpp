@@ -170,14 +170,30 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
   }
   s.raw_max_kN = *std::max_element(res.begin(), res.end());
 
+  // 4. Fracture events. Only those at the vessel are marked: the plot is of the load on the vessel, and a floe
+  // that breaks against another floe changes it only indirectly. Every event goes into fracture_events.csv.
+  const size_t events = r.fracture_time_s.size();
+  FLOESIM_REQUIRE(r.fracture_parent_id.size() == events && r.fracture_mode.size() == events &&
+                      r.fracture_at_structure.size() == events && r.fracture_force_n.size() == 3 * events &&
+                      r.fracture_threshold_n.size() == events && r.fracture_child_offset.size() == events + 1 &&
+                      static_cast<size_t>(r.fracture_child_offset.back()) == r.fracture_child_id.size(),
+                  source, ": the /fracture datasets disagree in length");
+  std::vector<double> split_t, bend_t;  // times of the events at the vessel, by marker style
+  for (size_t k = 0; k < events; ++k)
+    if (r.fracture_at_structure[k] == 1)
+      (r.fracture_mode[k] == kFractureSplitting ? split_t : bend_t).push_back(r.fracture_time_s[k]);
+  s.fracture_events = events;
+  s.vessel_splitting_events = split_t.size();
+  s.vessel_bending_radial_events = bend_t.size();
+
   ensure_directory(out_dir);
   AtomicFile png(out_dir / "surge_ice_load.png"), svg(out_dir / "surge_ice_load.svg"),
-      csv(out_dir / "surge_ice_load.csv"), side(out_dir / "plot.json");
+      csv(out_dir / "surge_ice_load.csv"), events_csv(out_dir / "fracture_events.csv"), side(out_dir / "plot.json");
   // Working files: AtomicFiles never committed, so they are removed whatever happens.
   AtomicFile data(out_dir / "surge_ice_load.plot-data.txt"), script(out_dir / "surge_ice_load.plot.gp"),
       log(out_dir / "surge_ice_load.gnuplot.log");
 
-  // 4. CSV with every sample.
+  // 5. CSVs: every sample, and every fracture event (force on the floe in the world frame, as recorded).
   {
     std::ofstream os(csv.tmp());
     os << "time_s,ice_resistance_kN,moving_average_kN\n";  // average empty where its window is cut
@@ -186,8 +202,23 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
          << (i >= f0 && i < f1 ? fmt("%.10g", ma[i]) : std::string()) << '\n';
     FLOESIM_REQUIRE(os.flush(), csv.path().string(), ": write failed (disk full?)");
   }
+  {
+    std::ofstream os(events_csv.tmp());
+    os << "time_s,mode,parent_id,at_structure,force_x_n,force_y_n,force_z_n,threshold_n,children\n";
+    for (size_t k = 0; k < events; ++k) {
+      os << fmt("%.10g", r.fracture_time_s[k]) << ',' << fracture_mode_name(r.fracture_mode[k]) << ','
+         << r.fracture_parent_id[k] << ',' << r.fracture_at_structure[k];
+      for (int c = 0; c < 3; ++c) os << ',' << fmt("%.10g", r.fracture_force_n[3 * k + c]);
+      os << ',' << fmt("%.10g", r.fracture_threshold_n[k]) << ',';
+      // The pieces' floe ids, space-separated in one field (a CSV cell per event, however many pieces).
+      for (int64_t c = r.fracture_child_offset[k]; c < r.fracture_child_offset[k + 1]; ++c)
+        os << (c > r.fracture_child_offset[k] ? " " : "") << r.fracture_child_id[c];
+      os << '\n';
+    }
+    FLOESIM_REQUIRE(os.flush(), events_csv.path().string(), ": write failed (disk full?)");
+  }
 
-  // 5. Plot data (decimated to ~2 points per pixel column) and the script.
+  // 6. Plot data (decimated to ~2 points per pixel column) and the script.
   const size_t bins = static_cast<size_t>(o.width_px);
   {
     std::ofstream os(data.tmp());
@@ -200,6 +231,12 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
     const double t_mean0 = std::max(s.steady_start_s, t.front());
     os << fmt("%.9g", t_mean0) << ' ' << fmt("%.9g", s.mean_kN) << '\n'
        << fmt("%.9g", t.back()) << ' ' << fmt("%.9g", s.mean_kN) << '\n';
+    // Event times only: the script places the markers along the bottom of the plot area.
+    for (const auto* times : {&split_t, &bend_t}) {
+      if (times->empty()) continue;  // an empty block would be an empty plot element (a gnuplot error)
+      os << "\n\n";
+      for (double te : *times) os << fmt("%.9g", te) << '\n';
+    }
     FLOESIM_REQUIRE(os.flush(), data.tmp().string(), ": write failed (disk full?)");
   }
   // Rigid contacts give single-step spikes one or two orders of magnitude above the average; "auto" keeps the
@@ -217,6 +254,7 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
   const double x_lo = t.front() > 0 && t.front() < 0.05 * t.back() ? 0.0 : t.front();
   {
     const bool clipped = s.raw_max_kN > y_hi || raw_min < y_lo;
+    const bool marked = !split_t.empty() || !bend_t.empty();  // two legend rows then
     std::ostringstream gp;
     gp << "set encoding utf8\n"
        << "set terminal pngcairo size " << o.width_px << "," << o.height_px
@@ -226,10 +264,10 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
     gp << "set xlabel 'Time (s)'\n"
        << "set ylabel 'Ice resistance  −F_x  (kN)'\n"
        << "set border lc rgb '#404040'\n"
-       << "set bmargin 6\n"
+       << "set bmargin " << (marked ? 8 : 6) << "\n"
        << "set grid xtics ytics mxtics lc rgb '#d9d9d9' lw 1 dt 1\n"
        << "set mxtics 2\n"
-       << "set key outside below center horizontal maxrows 1 samplen 2.5 width -6\n"
+       << "set key outside below center horizontal maxrows " << (marked ? 2 : 1) << " samplen 2.5 width -6\n"
        << "set style textbox opaque fillcolor rgb 'white' border lc rgb '#b0b0b0' margins 4,3\n"
        << "set xrange [" << fmt("%.9g", x_lo) << ":" << fmt("%.9g", t.back()) << "]\n"
        << "set yrange [" << fmt("%.9g", y_lo) << ":" << fmt("%.9g", y_hi) << "]\n"
@@ -249,7 +287,23 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
        << quoted("centred moving average, " + fmt("%g", s.window_s) + " s window" +
                   (s.moving_average_complete ? "" : " (longer than the run: cut windows)")) << " noenhanced, \\\n"
        << "  '' index 2 using 1:2 with lines lc rgb '#d1232a' lw 2.5 dt (8,4) title " << quoted(mean_title)
-       << " noenhanced\n"
+       << " noenhanced";
+    // Fracture markers in the margin below the lowest data (y_lo lies 3 % under it), in the video's colours:
+    // amber triangles for splitting, blue diamonds for bending and radial.
+    const std::string y_mark = fmt("%.9g", y_lo + 0.012 * (y_hi - y_lo));
+    auto events_title = [](const char* what, size_t n) {
+      return std::string(what) + " at the vessel: " + std::to_string(n) + (n == 1 ? " event" : " events");
+    };
+    int index = 3;
+    if (!split_t.empty())
+      gp << ", \\\n  '' index " << index++ << " using 1:(" << y_mark
+         << ") with points pt 9 ps 1.5 lc rgb '#e08a00' title "
+         << quoted(events_title("fracture by splitting", split_t.size())) << " noenhanced";
+    if (!bend_t.empty())
+      gp << ", \\\n  '' index " << index++ << " using 1:(" << y_mark
+         << ") with points pt 13 ps 1.5 lc rgb '#2f7fc1' title "
+         << quoted(events_title("fracture by bending or radial cracking", bend_t.size())) << " noenhanced";
+    gp << "\n"
        << "set terminal svg size " << o.width_px << "," << o.height_px
        << " dynamic enhanced font 'DejaVu Sans,11' background rgb 'white'\n"
        << "set output " << quoted(svg.tmp().string()) << "\n"
@@ -260,7 +314,7 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
     FLOESIM_REQUIRE(os.flush(), script.tmp().string(), ": write failed (disk full?)");
   }
 
-  // 6. gnuplot, checked: exit status, and both images non-empty.
+  // 7. gnuplot, checked: exit status, and both images non-empty.
   const int rc = run_program({FLOESIM_GNUPLOT, script.tmp().string()}, log.tmp());
   FLOESIM_REQUIRE(rc == 0, "gnuplot (", FLOESIM_GNUPLOT, ") failed with exit status ", rc, " drawing ",
                   png.path().string(), ":\n", read_text(log.tmp()));
@@ -268,7 +322,7 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
   FLOESIM_REQUIRE(fs::file_size(png.tmp(), e1) > 0 && !e1 && fs::file_size(svg.tmp(), e2) > 0 && !e2,
                   "gnuplot wrote no image to ", out_dir.string(), ":\n", read_text(log.tmp()));
 
-  // 7. The numbers, then everything into place.
+  // 8. The numbers, then everything into place.
   nlohmann::json j = {
       {"series", "ice_load column 0 (Fx, surge, body x)"},
       {"quantity", "ice resistance = -Fx"},
@@ -286,13 +340,19 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
       {"moving_average_std_kN", json_number(s.moving_average_std_kN)},
       {"moving_average_max_kN", json_number(s.moving_average_max_kN)},
       {"raw_max_kN", s.raw_max_kN},
-      {"files", {"surge_ice_load.png", "surge_ice_load.svg", "surge_ice_load.csv"}},
+      {"fracture",
+       {{"events", events},
+        {"at_vessel", {{"splitting", split_t.size()}, {"bending_or_radial", bend_t.size()}}},
+        {"marked", "events at the vessel (at_structure = 1), along the bottom of the plot"},
+        {"csv", "fracture_events.csv: every event; force on the floe in the world frame (N)"}}},
+      {"files", {"surge_ice_load.png", "surge_ice_load.svg", "surge_ice_load.csv", "fracture_events.csv"}},
       {"provenance", provenance},
   };
   write_text_atomic(side.tmp(), j.dump(2) + "\n");
   png.commit();
   svg.commit();
   csv.commit();
+  events_csv.commit();
   side.commit();
   return s;
 }

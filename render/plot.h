@@ -1,5 +1,7 @@
 // The plot stage: surge ice load against time, its centred moving average and the steady-state mean (like Fig. 5
-// of the SAMS paper), drawn by gnuplot to PNG and SVG, with the numbers in a CSV and a JSON sidecar.
+// of the SAMS paper), drawn by gnuplot to PNG and SVG, with the numbers in a CSV and a JSON sidecar. Fracture
+// events at the vessel are marked along the bottom of the plot (one marker style for splitting, one for bending
+// and radial), and every fracture event is listed in fracture_events.csv.
 // floesim-plot is a thin main over plot_surge_load().
 #pragma once
 #include <filesystem>
@@ -53,9 +55,13 @@ struct SurgeLoadSummary {
   double moving_average_std_kN = 0;  // of the moving average over the steady part, full windows only (NaN if none)
   double moving_average_max_kN = 0;
   double raw_max_kN = 0;           // over the whole run
+  size_t fracture_events = 0;                // all of /fracture (in fracture_events.csv)
+  size_t vessel_splitting_events = 0;        // at the vessel, marked on the plot
+  size_t vessel_bending_radial_events = 0;   // at the vessel, marked on the plot
 };
 
-// Writes DIR/surge_ice_load.{png,svg,csv} and DIR/plot.json; each appears only when complete.
+// Writes DIR/surge_ice_load.{png,svg,csv}, DIR/fracture_events.csv and DIR/plot.json; each appears only when
+// complete.
 SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const std::filesystem::path& out_dir,
                                  const nlohmann::json& provenance, const std::string& source);
 SurgeLoadSummary plot_surge_load(const std::filesystem::path& results, const std::filesystem::path& config,

@@ -1,4 +1,5 @@
-// floesim-plot: results HDF5 -> surge ice load plot (PNG, SVG), CSV and the numbers (plot.json).
+// floesim-plot: results HDF5 -> surge ice load plot (PNG, SVG) with fracture events marked, CSVs and the numbers
+// (plot.json).
 #include <iostream>
 
 #include "pipeline/stage_main.h"
@@ -17,8 +18,9 @@ int main(int argc, char** argv) {
   }, "print the plot options (key, default, unit, meaning) and exit");
   return floesim::run_stage(app, argc, argv, [&] {
     const auto s = floesim::render::plot_surge_load(results, config, out);
-    std::cout << "wrote " << out << "/surge_ice_load.{png,svg,csv} and plot.json: mean ice resistance "
-              << s.mean_kN << " kN over t >= " << s.steady_start_s << " s (" << s.contact_model
-              << " contacts, " << s.window_s << " s moving average)\n";
+    std::cout << "wrote " << out << "/surge_ice_load.{png,svg,csv}, fracture_events.csv and plot.json: mean ice "
+              << "resistance " << s.mean_kN << " kN over t >= " << s.steady_start_s << " s (" << s.contact_model
+              << " contacts, " << s.window_s << " s moving average); " << s.fracture_events << " fracture events, "
+              << s.vessel_splitting_events + s.vessel_bending_radial_events << " at the vessel\n";
   });
 }

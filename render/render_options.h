@@ -26,12 +26,14 @@ struct RenderOptions {
   double view_distance_m = 2500;       // chase view: far clip distance; floes beyond are not drawn
   bool fog = true;                     // chase view: haze that fades the far field into the sky
   int supersample = 2;                 // render at N x the size and downsample (anti-aliasing; cost ~ N^2)
-  bool overlay = true;                 // time, frame, speed text (and a scale bar in the top view)
+  bool overlay = true;                 // time, frame, speed, fracture count (and a scale bar in the top view)
   bool floe_edges = true;              // outline the top face of each floe (separates touching floes)
   std::string sky_colour = "#c5d0da";
   std::string water_colour = "#1f2d38";
-  std::string floe_top_colour = "#f4f8fb";
+  std::string floe_top_colour = "#f4f8fb";         // floes of the input field
   std::string floe_side_colour = "#9fc3d6";
+  std::string bending_piece_colour = "#a6d0f2";    // light blue: pieces of bending or radial fracture
+  std::string splitting_piece_colour = "#f5b860";  // amber: pieces of splitting fracture
   std::string edge_colour = "#5f7687";
   std::string hull_colour = "#a3322b";
   std::string deck_colour = "#9aa1a6";
@@ -57,12 +59,18 @@ struct RenderOptions {
     v.field("fog", fog, "-", "chase view: haze fading the far field into the sky");
     v.field("supersample", supersample, "-", "render at N x size and downsample (anti-aliasing, cost ~N^2)",
             int_in_range(1, 4));
-    v.field("overlay", overlay, "-", "draw time, frame and speed (and a scale bar in the top view)");
+    v.field("overlay", overlay, "-",
+            "draw time, frame, speed and fracture events so far (and a scale bar in the top view)");
     v.field("floe_edges", floe_edges, "-", "outline the top face of each floe");
     v.field("sky_colour", sky_colour, "#rrggbb", "background above the horizon", hex_colour());
     v.field("water_colour", water_colour, "#rrggbb", "open water", hex_colour());
-    v.field("floe_top_colour", floe_top_colour, "#rrggbb", "top face of the floes", hex_colour());
+    v.field("floe_top_colour", floe_top_colour, "#rrggbb", "top face of the floes of the input field",
+            hex_colour());
     v.field("floe_side_colour", floe_side_colour, "#rrggbb", "sides of the floes", hex_colour());
+    v.field("bending_piece_colour", bending_piece_colour, "#rrggbb",
+            "top face of pieces broken off by bending or radial fracture (darker per generation)", hex_colour());
+    v.field("splitting_piece_colour", splitting_piece_colour, "#rrggbb",
+            "top face of pieces of a split floe (darker per generation)", hex_colour());
     v.field("edge_colour", edge_colour, "#rrggbb", "floe outlines", hex_colour());
     v.field("hull_colour", hull_colour, "#rrggbb", "hull sides", hex_colour());
     v.field("deck_colour", deck_colour, "#rrggbb", "deck and other upward faces of the hull", hex_colour());

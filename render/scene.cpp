@@ -224,6 +224,9 @@ struct SceneRenderer::Impl {
       FLOESIM_REQUIRE(vessel_row[k] >= 0, source, ": frame ", k, " (t = ", r.frame_time_s[k],
                       " s) has no vessel state (body_id 0)");
     }
+    // The overlay counts the events up to each frame by bisection.
+    FLOESIM_REQUIRE(std::is_sorted(r.fracture_time_s.begin(), r.fracture_time_s.end()), source,
+                    ": /fracture/time_s is not in time order");
   }
 
   // Slabs in the body frame: top face at z = +h/2 (triangulated outline), sides as flat-shaded quads; no bottom
@@ -232,8 +235,11 @@ struct SceneRenderer::Impl {
     const size_t n = r.floe_id.size();
     FLOESIM_REQUIRE(r.floe_vertex_offset.size() == n + 1 && r.floe_thickness_m.size() == n, source,
                     ": /geometry floe arrays disagree in length");
-    float top[3], side[3];
-    parse_hex_colour(o.floe_top_colour, top);
+    FLOESIM_REQUIRE(r.floe_origin_mode.size() == n && r.floe_generation.size() == n, source,
+                    ": /geometry/floe_origin_mode and /geometry/floe_generation need one entry per floe of "
+                    "/geometry/floe_id (", n, "), got ", r.floe_origin_mode.size(), " and ",
+                    r.floe_generation.size());
+    float side[3];
     parse_hex_colour(o.floe_side_colour, side);
     floes.resize(n);
     std::vector<Vec2> ring;
@@ -256,6 +262,11 @@ struct SceneRenderer::Impl {
       if (area2 < 0) std::reverse(ring.begin(), ring.end());  // the layout says CCW; be lenient, not wrong
       // A deterministic shade per floe id (Knuth's multiplicative hash), 0.92 .. 1.0 of the top colour.
       const float shade = 0.92f + 0.08f * float((uint32_t(r.floe_id[g]) * 2654435761u >> 16) & 255u) / 255.f;
+      FLOESIM_REQUIRE(r.floe_origin_mode[g] >= kFractureNone && r.floe_origin_mode[g] <= kFractureSplitting, source,
+                      ": floe ", r.floe_id[g], " has origin mode ", r.floe_origin_mode[g],
+                      " in /geometry/floe_origin_mode; expected 0 (input) .. 3 (splitting)");
+      float top[3];
+      floe_top_colour(o, r.floe_origin_mode[g], r.floe_generation[g], top);
       const float t[3] = {top[0] * shade, top[1] * shade, top[2] * shade};
       FloeDraw& f = floes[g];
       f.first = vertex_count();
@@ -545,7 +556,12 @@ struct SceneRenderer::Impl {
                                       "frame " + std::to_string(k + 1) + " / " + std::to_string(r.frames())};
     const double v = speed(k);
     if (std::isfinite(v)) lines.push_back("speed " + fmt("%.2f m/s", v) + " (" + fmt("%.1f kn", v * 3600 / 1852) + ")");
-    const double scales[3] = {0.9 * s, 0.6 * s, 0.6 * s};
+    // Only for runs in which ice broke: without fracture a constant 0 says nothing.
+    if (!r.fracture_time_s.empty()) {
+      const auto so_far = std::upper_bound(r.fracture_time_s.begin(), r.fracture_time_s.end(), r.frame_time_s[k]);
+      lines.push_back("fracture events " + std::to_string(so_far - r.fracture_time_s.begin()));
+    }
+    const double scales[4] = {0.9 * s, 0.6 * s, 0.6 * s, 0.6 * s};
     int w = 0, h = int(12 * s);
     std::vector<int> heights;
     for (size_t i = 0; i < lines.size(); ++i) {
@@ -659,6 +675,18 @@ void SceneRenderer::render(size_t frame, cv::Mat& out) {
 const FrameStats& SceneRenderer::last_stats() const { return impl_->stats; }
 
 std::string SceneRenderer::gl_renderer() const { return impl_->ctx.renderer(); }
+
+void floe_top_colour(const RenderOptions& o, int32_t origin_mode, int32_t generation, float rgb[3]) {
+  switch (origin_mode) {
+    case kFractureNone: parse_hex_colour(o.floe_top_colour, rgb); return;
+    case kFractureBending:
+    case kFractureRadial: parse_hex_colour(o.bending_piece_colour, rgb); break;
+    case kFractureSplitting: parse_hex_colour(o.splitting_piece_colour, rgb); break;
+    default: throw Error("floe origin mode " + std::to_string(origin_mode) + " is not 0..3 (see FractureMode)");
+  }
+  const float dim = 1.0f - 0.15f * float(std::clamp(generation, 1, 4) - 1);
+  for (int i = 0; i < 3; ++i) rgb[i] *= dim;
+}
 
 cv::Point2d top_view_pixel(const Results& r, const RenderOptions& o, size_t frame, double x_m, double y_m) {
   FLOESIM_REQUIRE(frame < r.frames(), "internal: frame ", frame, " of ", r.frames());

@@ -1,7 +1,9 @@
 // Draws one results frame: water, floe slabs, the hull, seen from a camera that follows the vessel. All geometry
 // comes from the results file; the floe slabs and the hull are built once, in their body frames. Per frame, the
 // floes inside the view are posed (rotation + translation of the prebuilt slab) into one batch drawn with a
-// single call, and the hull is drawn with its pose matrix.
+// single call, and the hull is drawn with its pose matrix. Pieces of broken floes are bodies like any other
+// floe, coloured by how they were made (floe_top_colour below); a floe that broke has no state from then on
+// and so is not drawn.
 #pragma once
 #include <memory>
 #include <string>
@@ -44,6 +46,12 @@ class SceneRenderer {
 // lies inside another coplanar triangle (either orientation): an outer surface never overlaps itself.
 // v: [V x 3] vertices, t: [T x 3] triangles; returns one flag per triangle.
 std::vector<bool> hull_internal_faces(const std::vector<double>& v, const std::vector<int32_t>& t);
+
+// The top colour of a floe (before the small per-id shade and the lighting): floes of the input field (origin
+// mode 0) in floe_top_colour; a piece in the colour of the fracture that made it (bending and radial share one),
+// 15 % darker per generation after the first and no darker than generation 4, so that a piece stands out from
+// the floe it broke from and the viewer sees at a glance what broke and how.
+void floe_top_colour(const RenderOptions& o, int32_t origin_mode, int32_t generation, float rgb[3]);
 
 // The pixel at which the top view shows world point (x, y) in results frame `frame` (for tests and overlays):
 // the view is centred on the vessel, north up, top_width_m across.

@@ -60,6 +60,7 @@ struct SideSums {
   Vec3 moment = Vec3::Zero();    // sum of area x centroid over contact-surface faces
   double area = 0;               // sum of the areas of contact-surface faces
   double volume = 0;             // divergence theorem over all faces: (1/3) sum of area x (n . centroid)
+  std::vector<Vec3>* points = nullptr;  // if set: the vertices of the clipped contact-surface faces (local origin)
 };
 
 // Points up to this far outside a plane count as inside (1 nm): a face lying in the other part's face plane (the
@@ -117,6 +118,7 @@ void clip_faces(const ConvexPart& P, const PartWorld& pw, const Vec3& tp, const 
     const Vec3 centroid = c / (3 * a2);
     out.volume += area * nf.dot(centroid) / 3;
     if (P.face_internal[f]) continue;  // bounds the overlap, but is no surface of the body
+    if (out.points) out.points->insert(out.points->end(), poly.begin(), poly.end());
     out.vec_area += area * nf;
     out.moment += area * centroid;
     out.area += area;
@@ -129,12 +131,15 @@ constexpr double kMinPatchArea = 1e-6;
 // step_of(point, normal) gives the penetration step of the area's secant (see ContactPatch::area_step_m).
 template <class StepFn>
 ContactPatch overlap_patch(const ConvexPart& A, const PartWorld& wa, const ConvexPart& B, const PartWorld& wb,
-                           PatchSide side, StepFn step_of, std::vector<Vec3>& poly, std::vector<Vec3>& tmp) {
+                           PatchSide side, StepFn step_of, std::vector<Vec3>& poly, std::vector<Vec3>& tmp,
+                           std::vector<Vec3>& surface) {
   ContactPatch r;
   // Local origin: the centre of the intersection of the two boxes.
   const Vec3 origin = 0.5 * (wa.lo.cwiseMax(wb.lo) + wa.hi.cwiseMin(wb.hi));
   const Vec3 zero = Vec3::Zero();
   SideSums sa, sb;
+  surface.clear();
+  sa.points = sb.points = &surface;
   clip_faces(A, wa, zero, B, wb, zero, origin, false, poly, tmp, sa);
   clip_faces(B, wb, zero, A, wa, zero, origin, true, poly, tmp, sb);
   // The boundary of the overlap is closed, so sa.vec_area = -sb.vec_area up to the internal faces left out: the
@@ -163,6 +168,19 @@ ContactPatch overlap_patch(const ConvexPart& A, const PartWorld& wa, const Conve
     r.point = from_b ? Vec3(sb.moment / sb.area) : Vec3(sa.moment / sa.area);
   }
   r.point += origin;
+  // Horizontal extent of the contact surface across the normal (the contact width of PHYSICS.md §2.1). A normal
+  // close to vertical (a floe under a flat bottom) has no horizontal tangent: the span is then taken along x.
+  {
+    Vec3 t = Vec3::UnitZ().cross(r.normal);
+    t = t.norm() > 1e-6 ? Vec3(t.normalized()) : Vec3::UnitX();
+    double lo = 1e300, hi = -1e300;
+    for (const Vec3& p : surface) {
+      const double s = t.dot(p);
+      if (s < lo) lo = s, r.span_lo = p + origin;
+      if (s > hi) hi = s, r.span_hi = p + origin;
+    }
+    if (surface.empty()) r.span_lo = r.span_hi = r.point;
+  }
   // dA/d(delta): b moved by the step towards a along the normal, the same sides re-clipped, projected on this normal.
   const double eps = step_of(r.point, r.normal);
   const Vec3 t = -eps * r.normal;
@@ -192,7 +210,7 @@ struct PairCandidate {
 
 // Scratch of one worker.
 struct Scratch {
-  std::vector<Vec3> poly, tmp;
+  std::vector<Vec3> poly, tmp, surface;
   std::vector<Contact> contacts;      // contacts of this worker's pairs, in pair order
   long hits = 0, edges = 0, crushing = 0;
 };
@@ -207,7 +225,9 @@ struct CollisionWorld::Impl {
   // Two trees (Box2D's static/dynamic split): parts of sleeping bodies do not move and are never paired with each
   // other, so the per-step cost scales with the awake bodies: awake x awake and awake x sleeping.
   fcl::DynamicAABBTreeCollisionManagerd awake_tree, sleeping_tree;
-  std::vector<uint8_t> in_awake_tree;  // per body
+  // Per body: which tree holds its parts (the body table grows with fracture; removed bodies are in neither).
+  static constexpr uint8_t kSleepingTree = 0, kAwakeTree = 1, kRemoved = 2;
+  std::vector<uint8_t> in_awake_tree;
   std::vector<fcl::CollisionObjectd*> moved_awake, moved_sleeping;
   std::vector<uint8_t> box_changed;    // per part, written by update_bodies
   std::vector<PairCandidate> pairs;
@@ -253,7 +273,8 @@ struct CollisionWorld::Impl {
     };
     const ContactPatch patch =
         overlap_patch(model.parts[pc.part_a], world[pc.part_a], model.parts[pc.part_b], world[pc.part_b],
-                      structure ? PatchSide::a_is_structure : PatchSide::symmetric, step_of, sc.poly, sc.tmp);
+                      structure ? PatchSide::a_is_structure : PatchSide::symmetric, step_of, sc.poly, sc.tmp,
+                      sc.surface);
     if (!patch.valid) return false;
     Contact c;
     c.body_a = pc.body_a;
@@ -269,13 +290,40 @@ struct CollisionWorld::Impl {
     c.area_slope_m = patch.area_slope_m;
     c.area_end_m2 = patch.area_end_m2;
     c.area_step_m = patch.area_step_m;
+    c.span_lo = patch.span_lo;
+    c.span_hi = patch.span_hi;
     out.push_back(c);
     return true;
   }
 
+  static constexpr double kTreeMargin = 0.1;  // m, see place_part
+  // FCL shapes, objects and world data for the parts from `first` on (new parts of a grown table), placed at their
+  // bodies' poses in `state`; not yet in a tree.
+  void add_parts(const State& state, int first) {
+    const size_t np = model.parts.size();
+    shapes.resize(np);
+    objects.resize(np);
+    world.resize(np);
+    box_changed.resize(np, 0);
+    for (size_t p = first; p < np; ++p) {
+      const ConvexPart& cp = model.parts[p];
+      auto verts = std::make_shared<std::vector<Vec3>>(cp.vertices);
+      auto faces = std::make_shared<std::vector<int>>();
+      for (const auto& f : cp.faces) {
+        faces->push_back(static_cast<int>(f.size()));
+        faces->insert(faces->end(), f.begin(), f.end());
+      }
+      shapes[p] = std::make_shared<fcl::Convexd>(verts, static_cast<int>(cp.faces.size()), faces);
+      shapes[p]->computeLocalAABB();
+      objects[p] = std::make_unique<PartObject>(shapes[p], static_cast<int>(p));
+      place_part(static_cast<int>(p), state.position[cp.body], state.orientation[cp.body]);
+      // The object's first box is FCL's, of the part at the origin: always replace it with the placed fat box.
+      objects[p]->set_aabb(world[p].lo - Vec3::Constant(kTreeMargin), world[p].hi + Vec3::Constant(kTreeMargin));
+    }
+  }
+
   // Moves part p to the pose (x, q). Returns true when its box in the tree must change: the tree holds a box
   // enlarged by kTreeMargin (Box2D's fat boxes), so that small motions do not re-insert the leaf every step.
-  static constexpr double kTreeMargin = 0.1;  // m
   bool place_part(int p, const Vec3& x, const Quat& q) {
     PartWorld& w = world[p];
     const Mat3 R = q.toRotationMatrix();
@@ -352,6 +400,7 @@ struct CollisionWorld::Impl {
       c.normal = n;
       c.gap = gap;
       c.mu = mu;
+      c.span_lo = c.span_hi = p;
       out.push_back(c);
     };
 
@@ -483,31 +532,12 @@ struct CollisionWorld::Impl {
 CollisionWorld::CollisionWorld(const Model& model, const State& state, ThreadPool& pool)
     : impl_(std::make_unique<Impl>(model, pool)) {
   Impl& m = *impl_;
-  const size_t np = model.parts.size();
-  m.shapes.resize(np);
-  m.objects.resize(np);
-  m.world.resize(np);
-  for (size_t p = 0; p < np; ++p) {
-    const ConvexPart& cp = model.parts[p];
-    auto verts = std::make_shared<std::vector<Vec3>>(cp.vertices);
-    auto faces = std::make_shared<std::vector<int>>();
-    for (const auto& f : cp.faces) {
-      faces->push_back(static_cast<int>(f.size()));
-      faces->insert(faces->end(), f.begin(), f.end());
-    }
-    m.shapes[p] = std::make_shared<fcl::Convexd>(verts, static_cast<int>(cp.faces.size()), faces);
-    m.shapes[p]->computeLocalAABB();
-    m.objects[p] = std::make_unique<PartObject>(m.shapes[p], static_cast<int>(p));
-    m.world[p].v.resize(cp.vertices.size());
-    m.world[p].n.resize(cp.faces.size());
-    m.world[p].d.resize(cp.faces.size());
-    m.place_part(static_cast<int>(p), state.position[cp.body], state.orientation[cp.body]);
-  }
+  m.add_parts(state, 0);
   m.in_awake_tree.assign(model.bodies.size(), 0);
   std::vector<fcl::CollisionObjectd*> awake, sleeping;
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const Body& body = model.bodies[b];
-    m.in_awake_tree[b] = state.awake[b];
+    m.in_awake_tree[b] = state.awake[b] ? Impl::kAwakeTree : Impl::kSleepingTree;
     for (int p = body.first_part; p < body.first_part + body.part_count; ++p)
       (state.awake[b] ? awake : sleeping).push_back(m.objects[p].get());
   }
@@ -519,6 +549,29 @@ CollisionWorld::CollisionWorld(const Model& model, const State& state, ThreadPoo
 
 CollisionWorld::~CollisionWorld() = default;
 
+void CollisionWorld::add_bodies(const State& state, int first_new) {
+  Impl& m = *impl_;
+  const size_t nb = m.model.bodies.size();
+  if (static_cast<size_t>(first_new) >= nb) return;
+  m.add_parts(state, m.model.bodies[first_new].first_part);
+  m.in_awake_tree.resize(nb, Impl::kRemoved);
+  for (size_t b = first_new; b < nb; ++b) {
+    const Body& body = m.model.bodies[b];
+    m.in_awake_tree[b] = state.awake[b] ? Impl::kAwakeTree : Impl::kSleepingTree;
+    auto& tree = state.awake[b] ? m.awake_tree : m.sleeping_tree;
+    for (int p = body.first_part; p < body.first_part + body.part_count; ++p) tree.registerObject(m.objects[p].get());
+  }
+}
+
+void CollisionWorld::remove_body(int b) {
+  Impl& m = *impl_;
+  if (m.in_awake_tree[b] == Impl::kRemoved) return;
+  auto& tree = m.in_awake_tree[b] == Impl::kAwakeTree ? m.awake_tree : m.sleeping_tree;
+  const Body& body = m.model.bodies[b];
+  for (int p = body.first_part; p < body.first_part + body.part_count; ++p) tree.unregisterObject(m.objects[p].get());
+  m.in_awake_tree[b] = Impl::kRemoved;
+}
+
 void CollisionWorld::update_bodies(const State& state, const std::vector<int>& moved) {
   Impl& m = *impl_;
   m.moved_awake.clear();
@@ -528,29 +581,33 @@ void CollisionWorld::update_bodies(const State& state, const std::vector<int>& m
   m.pool.parallel_for(static_cast<int>(moved.size()), [&](int begin, int end, int) {
     for (int i = begin; i < end; ++i) {
       const int b = moved[i];
+      if (m.in_awake_tree[b] == Impl::kRemoved) continue;
       const Body& body = m.model.bodies[b];
       for (int p = body.first_part; p < body.first_part + body.part_count; ++p)
         m.box_changed[p] = m.place_part(p, state.position[b], state.orientation[b]);
     }
   });
   for (int b : moved) {
+    if (m.in_awake_tree[b] == Impl::kRemoved) continue;
     const Body& body = m.model.bodies[b];
     for (int p = body.first_part; p < body.first_part + body.part_count; ++p)
-      if (m.box_changed[p]) (m.in_awake_tree[b] ? m.moved_awake : m.moved_sleeping).push_back(m.objects[p].get());
+      if (m.box_changed[p])
+        (m.in_awake_tree[b] == Impl::kAwakeTree ? m.moved_awake : m.moved_sleeping).push_back(m.objects[p].get());
   }
   if (!m.moved_awake.empty()) m.awake_tree.update(m.moved_awake);
   if (!m.moved_sleeping.empty()) m.sleeping_tree.update(m.moved_sleeping);
   // Bodies that fell asleep or woke up since the last call change trees (their boxes are current).
   for (size_t b = 0; b < m.model.bodies.size(); ++b) {
-    if (m.in_awake_tree[b] == state.awake[b]) continue;
+    const uint8_t want = state.awake[b] ? Impl::kAwakeTree : Impl::kSleepingTree;
+    if (m.in_awake_tree[b] == Impl::kRemoved || m.in_awake_tree[b] == want) continue;
     const Body& body = m.model.bodies[b];
-    auto& from = m.in_awake_tree[b] ? m.awake_tree : m.sleeping_tree;
-    auto& to = m.in_awake_tree[b] ? m.sleeping_tree : m.awake_tree;
+    auto& from = m.in_awake_tree[b] == Impl::kAwakeTree ? m.awake_tree : m.sleeping_tree;
+    auto& to = want == Impl::kAwakeTree ? m.awake_tree : m.sleeping_tree;
     for (int p = body.first_part; p < body.first_part + body.part_count; ++p) {
       from.unregisterObject(m.objects[p].get());
       to.registerObject(m.objects[p].get());
     }
-    m.in_awake_tree[b] = state.awake[b];
+    m.in_awake_tree[b] = want;
   }
 }
 
@@ -608,8 +665,8 @@ ContactPatch convex_overlap(const ConvexPart& pa, const Vec3& xa, const Quat& qa
   PartWorld wa, wb;
   transform_part(pa, xa, qa.toRotationMatrix(), wa);
   transform_part(pb, xb, qb.toRotationMatrix(), wb);
-  std::vector<Vec3> poly, tmp;
-  return overlap_patch(pa, wa, pb, wb, side, [eps](const Vec3&, const Vec3&) { return eps; }, poly, tmp);
+  std::vector<Vec3> poly, tmp, surface;
+  return overlap_patch(pa, wa, pb, wb, side, [eps](const Vec3&, const Vec3&) { return eps; }, poly, tmp, surface);
 }
 
 }  // namespace floesim::sim

@@ -34,6 +34,8 @@ struct ContactPatch {
   double area_end_m2 = 0;
   double area_step_m = 0;
   double volume_m3 = 0;     // overlap volume (diagnostics; mean depth = volume / area)
+  // The contact surface's extreme points along the horizontal tangent z x normal (its width, PHYSICS.md §2.1).
+  Vec3 span_lo = Vec3::Zero(), span_hi = Vec3::Zero();
 };
 
 // Which side of the overlap carries the contact surface. A structure (the vessel) is hard: the crushing happens on
@@ -65,6 +67,11 @@ class CollisionWorld {
 
   // Moves the parts of the listed bodies to their poses in `state` and refreshes the broad phase for them only.
   void update_bodies(const State& state, const std::vector<int>& moved);
+  // The body table grew (fracture): the bodies from first_new on, with their parts, enter the broad phase at their
+  // poses in `state` (in the tree their awake flag says).
+  void add_bodies(const State& state, int first_new);
+  // Body b left the world (broken up or removed as brash): its parts leave the broad phase for good.
+  void remove_body(int b);
   // Contacts of the current poses, sorted by (body_a, part_a, body_b, part_b, point order); pairs of two sleeping
   // bodies are skipped. Solver fields are left for the solver to fill.
   void find_contacts(const State& state, std::vector<Contact>& out);

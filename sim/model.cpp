@@ -160,6 +160,80 @@ void set_added_mass(Body& b, const Vec3& added_mass, const Vec3& added_inertia) 
 
 }  // namespace
 
+Body make_floe_body(const Polygon& outline, double h, int id, int body_index, const Vec2& centre,
+                    const SimulateOptions& o, std::vector<ConvexPart>& parts) {
+  FLOESIM_REQUIRE(outline.size() >= 3 && signed_area(outline) > 0, "floe ", id,
+                  ": internal: a floe body needs a CCW outline of positive area");
+  const double rho_i = o.ice.density_kg_m3, draught_ratio = rho_i / o.water.density_kg_m3;
+  Body b;
+  b.kind = BodyKind::floe;
+  b.id = id;
+  b.thickness_m = h;
+  b.outline = outline;
+  b.buoyancy_mesh = extrude_polygon(b.outline, -h / 2, h);
+  // Second moments of the section (Green's theorem over the CCW outline, which is centred on its centroid).
+  for (size_t i = 0; i < b.outline.size(); ++i) {
+    const Vec2& p = b.outline[i];
+    const Vec2& q = b.outline[(i + 1) % b.outline.size()];
+    const double cr = p.x() * q.y() - q.x() * p.y();
+    b.section_area += cr / 2;
+    b.section_sxx += cr * (p.x() * p.x() + p.x() * q.x() + q.x() * q.x()) / 12;
+    b.section_syy += cr * (p.y() * p.y() + p.y() * q.y() + q.y() * q.y()) / 12;
+    b.section_sxy += cr * (p.x() * q.y() + 2 * p.x() * p.y() + 2 * q.x() * q.y() + q.x() * p.y()) / 24;
+    b.section_radius = std::max(b.section_radius, p.norm());
+  }
+  const MassProperties mp = mass_properties(b.buoyancy_mesh);
+  FLOESIM_REQUIRE(mp.volume > 0, "floe ", id, ": internal: non-positive slab volume");
+  b.mass_kg = rho_i * mp.volume;
+  b.inv_mass = 1 / b.mass_kg;
+  b.inertia = rho_i * mp.inertia;
+  b.inv_inertia = b.inertia.inverse();
+  // Heave added mass along the floe's normal (body z), C_a33 x mass, only with water (PHYSICS.md §3.3).
+  set_added_mass(b, Vec3(0, 0, o.water.enabled ? o.water.floe_heave_added_mass_ratio * b.mass_kg : 0.0),
+                 Vec3::Zero());
+  b.initial_position = Vec3(centre.x(), centre.y(), h / 2 - draught_ratio * h);
+  b.initial_orientation = Quat::Identity();
+  const std::vector<Polygon> pieces = convex_decompose(b.outline);
+  b.first_part = static_cast<int>(parts.size());
+  for (const Polygon& piece : pieces) parts.push_back(make_convex_part(extrude_polygon(piece, -h / 2, h), body_index));
+  b.part_count = static_cast<int>(pieces.size());
+  mark_shared_faces(parts, b.first_part, b.part_count);
+  // Drag faces: vertices 0..n-1 the bottom ring, n..2n-1 the top ring.
+  const int n = static_cast<int>(b.outline.size());
+  for (int i = 0; i < n; ++i) b.drag_vertices.emplace_back(b.outline[i].x(), b.outline[i].y(), -h / 2);
+  for (int i = 0; i < n; ++i) b.drag_vertices.emplace_back(b.outline[i].x(), b.outline[i].y(), h / 2);
+  auto add_face = [&](std::vector<int> idx, const Vec3& nrm) {
+    DragFace df;
+    df.first = static_cast<int>(b.drag_face_index.size());
+    df.count = static_cast<int>(idx.size());
+    df.normal = nrm;
+    std::vector<Vec3> pts;
+    for (int i : idx) pts.push_back(b.drag_vertices[i]);
+    const AreaCentroid ac = polygon_area_centroid(pts.data(), static_cast<int>(pts.size()));
+    df.area = ac.area;
+    df.centroid = ac.centroid;
+    b.drag_face_index.insert(b.drag_face_index.end(), idx.begin(), idx.end());
+    b.drag_faces.push_back(df);
+  };
+  std::vector<int> bottom, top;
+  for (int i = n - 1; i >= 0; --i) bottom.push_back(i);  // clockwise seen from above = CCW from below
+  for (int i = 0; i < n; ++i) top.push_back(n + i);
+  add_face(bottom, -Vec3::UnitZ());
+  b.top_face = static_cast<int>(b.drag_faces.size());
+  add_face(top, Vec3::UnitZ());
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    const Vec2 e = b.outline[j] - b.outline[i];
+    const Vec3 nrm = Vec3(e.y(), -e.x(), 0).normalized();  // outward for a CCW ring
+    add_face({i, j, n + j, n + i}, nrm);
+    b.drag_faces.back().side = i;
+  }
+  if (o.water.enabled)
+    set_damping(b, o, o.water.floe_heave_damping_ratio, o.water.floe_roll_pitch_damping_ratio,
+                o.water.floe_roll_pitch_damping_ratio);
+  return b;
+}
+
 ConvexPart make_convex_part(const TriMesh& mesh, int body) {
   ConvexPart part;
   part.body = body;
@@ -503,79 +577,11 @@ Model build_model(const FloeField& field, const HullModel* hull, const SimulateO
       model.removed_floe_ids.push_back(f.id);
       continue;
     }
-    const double h = f.thickness_m;
     const Vec2 c = centroid(fg.outline);
-    Body b;
-    b.kind = BodyKind::floe;
-    b.id = f.id;
-    b.thickness_m = h;
-    for (const Vec2& v : fg.outline) b.outline.push_back(v - c);
-    b.buoyancy_mesh = extrude_polygon(b.outline, -h / 2, h);
-    // Second moments of the section (Green's theorem over the CCW outline, which is centred on its centroid).
-    for (size_t i = 0; i < b.outline.size(); ++i) {
-      const Vec2& p = b.outline[i];
-      const Vec2& q = b.outline[(i + 1) % b.outline.size()];
-      const double cr = p.x() * q.y() - q.x() * p.y();
-      b.section_area += cr / 2;
-      b.section_sxx += cr * (p.x() * p.x() + p.x() * q.x() + q.x() * q.x()) / 12;
-      b.section_syy += cr * (p.y() * p.y() + p.y() * q.y() + q.y() * q.y()) / 12;
-      b.section_sxy += cr * (p.x() * q.y() + 2 * p.x() * p.y() + 2 * q.x() * q.y() + q.x() * p.y()) / 24;
-      b.section_radius = std::max(b.section_radius, p.norm());
-    }
-    const MassProperties mp = mass_properties(b.buoyancy_mesh);
-    FLOESIM_REQUIRE(mp.volume > 0, "floe ", f.id, ": internal: non-positive slab volume");
-    b.mass_kg = rho_i * mp.volume;
-    b.inv_mass = 1 / b.mass_kg;
-    b.inertia = rho_i * mp.inertia;
-    b.inv_inertia = b.inertia.inverse();
-    // Heave added mass along the floe's normal (body z), C_a33 x mass, only with water (PHYSICS.md §3.3).
-    set_added_mass(b, Vec3(0, 0, o.water.enabled ? o.water.floe_heave_added_mass_ratio * b.mass_kg : 0.0),
-                   Vec3::Zero());
-    b.initial_position = Vec3(c.x(), c.y(), h / 2 - draught_ratio * h);
-    b.initial_orientation = Quat::Identity();
-    const int body_index = static_cast<int>(model.bodies.size());
-    b.first_part = static_cast<int>(model.parts.size());
-    for (const Polygon& piece : fg.pieces) {
-      Polygon local;
-      for (const Vec2& v : piece) local.push_back(v - c);
-      model.parts.push_back(make_convex_part(extrude_polygon(local, -h / 2, h), body_index));
-    }
-    b.part_count = static_cast<int>(fg.pieces.size());
-    mark_shared_faces(model.parts, b.first_part, b.part_count);
-    // Drag faces: vertices 0..n-1 the bottom ring, n..2n-1 the top ring.
-    const int n = static_cast<int>(b.outline.size());
-    for (int i = 0; i < n; ++i) b.drag_vertices.emplace_back(b.outline[i].x(), b.outline[i].y(), -h / 2);
-    for (int i = 0; i < n; ++i) b.drag_vertices.emplace_back(b.outline[i].x(), b.outline[i].y(), h / 2);
-    auto add_face = [&](std::vector<int> idx, const Vec3& nrm) {
-      DragFace df;
-      df.first = static_cast<int>(b.drag_face_index.size());
-      df.count = static_cast<int>(idx.size());
-      df.normal = nrm;
-      std::vector<Vec3> pts;
-      for (int i : idx) pts.push_back(b.drag_vertices[i]);
-      const AreaCentroid ac = polygon_area_centroid(pts.data(), static_cast<int>(pts.size()));
-      df.area = ac.area;
-      df.centroid = ac.centroid;
-      b.drag_face_index.insert(b.drag_face_index.end(), idx.begin(), idx.end());
-      b.drag_faces.push_back(df);
-    };
-    std::vector<int> bottom, top;
-    for (int i = n - 1; i >= 0; --i) bottom.push_back(i);  // clockwise seen from above = CCW from below
-    for (int i = 0; i < n; ++i) top.push_back(n + i);
-    add_face(bottom, -Vec3::UnitZ());
-    b.top_face = static_cast<int>(b.drag_faces.size());
-    add_face(top, Vec3::UnitZ());
-    for (int i = 0; i < n; ++i) {
-      const int j = (i + 1) % n;
-      const Vec2 e = b.outline[j] - b.outline[i];
-      const Vec3 nrm = Vec3(e.y(), -e.x(), 0).normalized();  // outward for a CCW ring
-      add_face({i, j, n + j, n + i}, nrm);
-      b.drag_faces.back().side = i;
-    }
-    if (o.water.enabled)
-      set_damping(b, o, o.water.floe_heave_damping_ratio, o.water.floe_roll_pitch_damping_ratio,
-                  o.water.floe_roll_pitch_damping_ratio);
-    model.bodies.push_back(std::move(b));
+    Polygon local;
+    for (const Vec2& v : fg.outline) local.push_back(v - c);
+    model.bodies.push_back(make_floe_body(local, f.thickness_m, f.id, static_cast<int>(model.bodies.size()), c, o,
+                                          model.parts));
   }
 
   // 5. Domain walls: static boxes outside the sides of the domain rectangle, overlapping at the corners (two walls

@@ -1,6 +1,8 @@
-// The immutable model of a simulation (MuJoCo's mjModel idea): bodies addressed by integer index, their convex
-// collision parts, mass properties, hydrostatic data and the vessel's particulars. Everything that changes in time
-// lives in State (sim/state.h). Built once from the floes artefact, the hull and the options.
+// The model of a simulation (MuJoCo's mjModel idea): bodies addressed by integer index, their convex collision
+// parts, mass properties, hydrostatic data and the vessel's particulars. Everything that changes in time lives in
+// State (sim/state.h). Built once from the floes artefact, the hull and the options. The body and part tables only
+// grow: when ice breaks, the world appends the pieces as new bodies (sim/fracture.h); an entry, once made, never
+// changes (a broken floe stays in the table, marked dead in State::alive), so indices stay valid for a whole run.
 #pragma once
 #include <memory>
 #include <string>
@@ -43,7 +45,13 @@ struct DragFace {
 
 struct Body {
   BodyKind kind = BodyKind::floe;
-  int id = 0;              // 0 = vessel, else the floe id of the input file
+  int id = 0;              // 0 = vessel, else the floe id of the input file (pieces: new ids, never reused)
+  // Lineage (floes): the id of the floe this piece broke from (-1: input floe), its generation (0: input floe),
+  // how it was made (FractureMode of pipeline/results_io.h, 0: input) and when (s).
+  int parent_id = -1;
+  int generation = 0;
+  int origin_mode = 0;
+  double created_s = 0;
   double mass_kg = 0, inv_mass = 0;
   Mat3 inertia = Mat3::Zero();      // body frame, about the centre of mass, kg m^2
   Mat3 inv_inertia = Mat3::Zero();
@@ -101,6 +109,8 @@ struct Model {
   std::vector<double> thrust_time_s, thrust_n;  // thrust_series mode
 
   int wall_count = 0;                 // domain walls, the last bodies
+  // Floe bodies in the table: the input floes of a built model; in a world's grown table, every piece too (dead or
+  // alive).
   int floe_count() const { return static_cast<int>(bodies.size()) - (vessel >= 0 ? 1 : 0) - wall_count; }
 };
 
@@ -114,6 +124,13 @@ void read_thrust_series(const std::string& file, std::vector<double>& time_s, st
 
 // Thrust of an ITTC-57 resistance curve: R(u) = 1/2 rho S u|u| ((1 + k) C_F(Re) + C_A), the force opposing u.
 double ittc57_resistance(double u_mps, const VesselParticulars& v, const SimulateOptions& o);
+
+// A floe body: a slab of thickness h over `outline` (CCW, body frame: centred on its area centroid, which is the
+// body origin), at hydrostatic equilibrium at plan position `centre`, with mass and inertia from polygon x h x
+// rho_i, added mass, damping and drag faces from the options. Its convex parts (convex decomposition of the
+// outline) are appended to `parts` with body index `body_index`; first_part/part_count point at them.
+Body make_floe_body(const Polygon& outline, double thickness_m, int id, int body_index, const Vec2& centre,
+                    const SimulateOptions& o, std::vector<ConvexPart>& parts);
 
 // Convex part from a closed convex triangle mesh (body frame): merges coplanar triangles into faces.
 ConvexPart make_convex_part(const TriMesh& mesh, int body);

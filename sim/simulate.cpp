@@ -1,6 +1,8 @@
 #include "sim/simulate.h"
 
+#include <algorithm>
 #include <chrono>
+#include <map>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -10,6 +12,7 @@
 #include "pipeline/error.h"
 #include "pipeline/floes_io.h"
 #include "pipeline/provenance.h"
+#include "sim/fracture_laws.h"
 #include "sim/world.h"
 
 namespace floesim::sim {
@@ -39,6 +42,106 @@ std::string vessel_contact_model(const Model& model, const Results& r) {
   if (rigid) return "rigid";
   if (compliant) return "compliant";
   return model.options.contact.ice_structure;
+}
+
+// The world's fracture events into the /fracture table of the results.
+void record_fracture_events(const std::vector<FractureEvent>& events, Results& r) {
+  for (const FractureEvent& e : events) {
+    r.fracture_time_s.push_back(e.time_s);
+    r.fracture_parent_id.push_back(e.parent_id);
+    r.fracture_mode.push_back(e.mode);
+    r.fracture_at_structure.push_back(e.at_structure ? 1 : 0);
+    r.fracture_force_n.insert(r.fracture_force_n.end(), {e.force_n.x(), e.force_n.y(), e.force_n.z()});
+    r.fracture_threshold_n.push_back(e.threshold_n);
+    r.fracture_point_m.insert(r.fracture_point_m.end(), {e.point_m.x(), e.point_m.y(), e.point_m.z()});
+    r.fracture_width_m.push_back(e.width_m);
+    r.fracture_theta_rad.push_back(e.theta_rad);
+    r.fracture_brash_mass_kg.push_back(e.brash_mass_kg);
+    r.fracture_child_id.insert(r.fracture_child_id.end(), e.child_ids.begin(), e.child_ids.end());
+    r.fracture_child_offset.push_back(static_cast<int64_t>(r.fracture_child_id.size()));
+  }
+}
+
+// Quantiles of a sample (nearest rank), for the piece size distribution.
+nlohmann::json distribution(std::vector<double> x) {
+  if (x.empty()) return {{"count", 0}};
+  std::sort(x.begin(), x.end());
+  auto q = [&](double p) { return x[static_cast<size_t>(std::lround(p * (x.size() - 1)))]; };
+  double mean = 0;
+  for (double v : x) mean += v;
+  return {{"count", x.size()}, {"min", x.front()}, {"p10", q(0.1)}, {"p50", q(0.5)}, {"p90", q(0.9)},
+          {"max", x.back()}, {"mean", mean / x.size()}};
+}
+
+// The summary's fracture object, from the results alone: events per mode, pieces, ice mass at the start and the
+// end (bodies alive + brash removed: ice is neither made nor lost), the size distribution of the pieces, and for
+// the wedges (bending, radial) the load-to-crack distance R_b of PHYSICS.md §2.1 against the pieces' size.
+nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
+  nlohmann::json f;
+  f["enabled"] = o.fracture.enabled;
+  f["at_ice_ice_contacts"] = o.fracture.ice_ice;
+  int count[4] = {0, 0, 0, 0}, at_vessel = 0;
+  for (size_t e = 0; e < r.fracture_mode.size(); ++e) {
+    ++count[std::clamp(r.fracture_mode[e], 0, 3)];
+    at_vessel += r.fracture_at_structure[e];
+  }
+  f["events"] = {{"bending", count[kFractureBending]}, {"radial", count[kFractureRadial]},
+                 {"splitting", count[kFractureSplitting]}, {"total", r.fracture_mode.size()},
+                 {"at_vessel", at_vessel}};
+  std::map<int32_t, double> area;  // floe id -> area
+  double start = 0, end = 0, brash = 0;
+  std::vector<double> piece_area, piece_diameter;
+  for (size_t k = 0; k < r.floe_id.size(); ++k) {
+    Polygon p;
+    for (int64_t i = r.floe_vertex_offset[k]; i < r.floe_vertex_offset[k + 1]; ++i)
+      p.emplace_back(r.floe_vertices_m[2 * i], r.floe_vertices_m[2 * i + 1]);
+    const double a = signed_area(p), m = o.ice.density_kg_m3 * a * r.floe_thickness_m[k];
+    area[r.floe_id[k]] = a;
+    if (r.floe_parent_id[k] < 0) start += m;
+    if (std::isinf(r.floe_ended_s[k])) end += m;
+    if (r.floe_parent_id[k] >= 0) {
+      piece_area.push_back(a);
+      piece_diameter.push_back(std::sqrt(4 * a / 3.14159265358979323846));
+    }
+  }
+  for (double b : r.fracture_brash_mass_kg) brash += b;
+  f["pieces_created"] = piece_area.size();
+  f["ice_mass_start_kg"] = start;
+  f["ice_mass_end_kg"] = end + brash;
+  f["ice_mass_in_bodies_end_kg"] = end;
+  f["brash_removed_kg"] = brash;
+  f["min_piece_area_m2"] = o.fracture.min_piece_area_m2;
+  f["piece_area_m2"] = distribution(piece_area);
+  f["piece_equivalent_diameter_m"] = distribution(piece_diameter);
+  // Wedges: R_b from the table for each event's theta and width (static: without the speed correction), against
+  // the smallest child of the event (the wedge: the floe it broke from is longer than the wedge by the
+  // finite-floe rule, so the remainder is the larger piece).
+  std::vector<double> rb, wedge_size, wedge_ratio;
+  const double rho_w_g = o.water.density_kg_m3 * o.water.gravity_mps2;
+  for (size_t e = 0; e < r.fracture_mode.size(); ++e) {
+    if (r.fracture_mode[e] == kFractureSplitting || rho_w_g <= 0) continue;
+    double h = 0;
+    for (size_t k = 0; k < r.floe_id.size(); ++k)
+      if (r.floe_id[k] == r.fracture_parent_id[e]) h = r.floe_thickness_m[k];
+    const double lc = characteristic_length_m(o.fracture.youngs_modulus_pa, o.fracture.poisson_ratio, h, rho_w_g);
+    const double theta = r.fracture_theta_rad[e], w = r.fracture_width_m[e];
+    const double rb_e = wedge_failure(theta, o.fracture.flexural_strength_pa, h, w / (theta * lc)).rb_over_lc * lc;
+    double smallest = 0;
+    for (int64_t i = r.fracture_child_offset[e]; i < r.fracture_child_offset[e + 1]; ++i) {
+      const double a = area[r.fracture_child_id[i]];
+      if (smallest == 0 || a < smallest) smallest = a;
+    }
+    if (smallest <= 0) continue;
+    rb.push_back(rb_e);
+    wedge_size.push_back(std::sqrt(smallest));
+    // The wedge's area if the floe were wider than it: the sector of angle theta between radii a and a + R_b.
+    const double a0 = w / theta;
+    wedge_ratio.push_back(smallest / (0.5 * theta * ((a0 + rb_e) * (a0 + rb_e) - a0 * a0)));
+  }
+  f["wedges"] = {{"rb_m", distribution(rb)},
+                 {"sqrt_piece_area_m", distribution(wedge_size)},
+                 {"piece_area_over_sector_area", distribution(wedge_ratio)}};
+  return f;
 }
 
 }  // namespace
@@ -86,10 +189,12 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
   auto& c_iter = *col["solver_iterations"];
   auto& c_res = *col["solver_residual"];
   auto& c_awake = *col["awake_floes"];
-  FLOESIM_REQUIRE(col.size() == 16, "internal: the results table has ", col.size(),
-                  " series; the recorder writes 16 (update simulate.cpp)");
+  auto& c_fracture = *col["fracture_events"];
+  auto& c_floes = *col["floe_bodies"];
+  FLOESIM_REQUIRE(col.size() == 18, "internal: the results table has ", col.size(),
+                  " series; the recorder writes 18 (update simulate.cpp)");
 
-  const size_t nb = model.bodies.size();
+  const size_t nb = model.bodies.size();  // at the start; the world's table grows as ice breaks
   const size_t frames = static_cast<size_t>(steps / every);
   r.frame_offset.push_back(0);
   r.frame_time_s.reserve(frames);
@@ -125,6 +230,8 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
     c_iter.push_back(rep.solve.iterations);
     c_res.push_back(rep.solve.residual);
     c_awake.push_back(rep.awake_floes);
+    c_fracture.push_back(rep.fracture_events);
+    c_floes.push_back(rep.floe_bodies);
     awake_sum += rep.awake_floes;
     contact_sum += rep.contacts;
     iter_sum += rep.solve.iterations;
@@ -132,12 +239,14 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
     hit_sum += world.collision_stats().narrowphase_hits;
     edge_sum += world.collision_stats().edge_contacts;
     crush_sum += world.collision_stats().crushing_contacts;
-    // Frames at t = k * output_interval (k >= 1): all bodies, vessel first (body id 0).
+    // Frames at t = k * output_interval (k >= 1): the bodies alive, vessel first (body id 0), pieces in the order
+    // they were made.
     if (k % every == 0) {
       r.frame_time_s.push_back(s.time_s);
-      for (size_t b = 0; b < nb; ++b) {
-        const Body& body = model.bodies[b];
-        if (body.kind == BodyKind::wall) continue;  // fixed; not part of the results layout
+      const Model& wm = world.model();
+      for (size_t b = 0; b < wm.bodies.size(); ++b) {
+        const Body& body = wm.bodies[b];
+        if (body.kind == BodyKind::wall || !s.alive[b]) continue;  // walls are fixed: not in the results layout
         r.state_body_id.push_back(body.kind == BodyKind::vessel ? 0 : body.id);
         const Vec3& x = s.position[b];
         const Quat& qb = s.orientation[b];
@@ -166,15 +275,24 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
   stats.mean_edge_pairs = edge_sum / steps;
   stats.mean_crushing_pairs = crush_sum / steps;
 
-  // Geometry: floe outlines in the body frame with their thickness; the hull surface in the vessel body frame.
+  // Geometry: the outline of every floe that ever existed (pieces included) in its body frame, with its thickness
+  // and lineage; the hull surface in the vessel body frame.
+  const Model& wm = world.model();
   r.floe_vertex_offset.push_back(0);
-  for (const Body& b : model.bodies) {
+  for (size_t k = 0; k < wm.bodies.size(); ++k) {
+    const Body& b = wm.bodies[k];
     if (b.kind != BodyKind::floe) continue;
     r.floe_id.push_back(b.id);
     r.floe_thickness_m.push_back(b.thickness_m);
     for (const Vec2& p : b.outline) r.floe_vertices_m.insert(r.floe_vertices_m.end(), {p.x(), p.y()});
     r.floe_vertex_offset.push_back(static_cast<int64_t>(r.floe_vertices_m.size() / 2));
+    r.floe_parent_id.push_back(b.parent_id);
+    r.floe_generation.push_back(b.generation);
+    r.floe_origin_mode.push_back(b.origin_mode);
+    r.floe_created_s.push_back(b.created_s);
+    r.floe_ended_s.push_back(world.ended_s()[k]);
   }
+  record_fracture_events(world.fracture_events(), r);
   const TriMesh& hull = model.bodies[v].buoyancy_mesh;
   for (const Vec3& p : hull.vertices) r.hull_vertices_m.insert(r.hull_vertices_m.end(), {p.x(), p.y(), p.z()});
   for (const auto& t : hull.triangles) r.hull_triangles.insert(r.hull_triangles.end(), {t[0], t[1], t[2]});
@@ -281,6 +399,7 @@ nlohmann::json summarize(const Model& model, const Results& r) {
   s["removed_floes"] = model.removed_floe_ids.size();
   s["removed_floe_ids"] = model.removed_floe_ids;
   s["small_floe_overlaps"] = model.small_overlaps;
+  s["fracture"] = fracture_summary(o, r);
   const VesselParticulars& vp = model.vessel_info;
   s["vessel"] = {{"mass_kg", vp.mass_kg},
                  {"length_oa_m", vp.length_oa_m},
@@ -356,6 +475,12 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   rep << "mean surge ice load " << summary["mean_surge_ice_load_N"].get<double>() / 1e3 << " kN (resistance "
       << summary["mean_surge_ice_resistance_N"].get<double>() / 1e3 << " kN) from t = " << o.steady_start_s
       << " s, mean speed " << std::setprecision(3) << summary["mean_vessel_speed_mps"].get<double>() << " m/s\n";
+  const nlohmann::json& fr = summary["fracture"];
+  if (fr["enabled"].get<bool>())
+    rep << "fracture: " << fr["events"]["total"] << " events (bending " << fr["events"]["bending"] << ", radial "
+        << fr["events"]["radial"] << ", splitting " << fr["events"]["splitting"] << "), " << fr["pieces_created"]
+        << " pieces, " << std::setprecision(4) << fr["brash_removed_kg"].get<double>() / 1e3
+        << " t of brash removed\n";
   rep << "wrote " << (out_dir / "results.h5").string() << " and " << (out_dir / "summary.json").string() << "\n";
   return rep.str();
 }

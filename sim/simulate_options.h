@@ -308,6 +308,54 @@ struct DomainOptions {
   }
 };
 
+// Ice fracture (PHYSICS.md §2; the seed's third module): at each contact the converged force is compared with the
+// closed-form failure loads; the mode of lowest threshold happens (§2.4) and the floe is replaced by its pieces.
+// Material defaults are the seed's Table 1 (E = 5 GPa, nu = 0.3, K_IC = 150 kPa sqrt(m), sigma_f = 500 kPa).
+struct FractureOptions {
+  bool enabled = true;
+  bool ice_ice = false;                      // also at floe-floe contacts (a floe jammed between bow and ice)
+  double flexural_strength_pa = 5e5;         // sigma_f
+  double youngs_modulus_pa = 5e9;            // E (effective, of the floating plate)
+  double poisson_ratio = 0.3;                // nu
+  double fracture_toughness_pa_sqrtm = 1.5e5;  // K_IC
+  double splitting_coefficient = 2.0;        // C_s of F_split = C_s K_IC h sqrt(L) (§2.2: 2-3; §2.4's example: 2)
+  std::vector<double> wedge_angle_deg = {45.0, 90.0};  // theta drawn uniformly in [min, max] per event (§2.1)
+  int seed = 1;                              // of the theta draws (a hash of seed, floe id and step: reproducible)
+  bool speed_correction = false;             // R_b x (1 + C_v v_n) (§2.1, velocity effects)
+  double speed_coefficient_spm = -0.1;       // C_v, s/m
+  double min_piece_area_m2 = 1.0;            // smaller pieces become brash: removed, their mass counted
+  template <class V>
+  void visit(V& v) {
+    v.field("enabled", enabled, "-", "floes break (bending, radial cracking, splitting); false: they only crush");
+    v.field("ice_ice", ice_ice, "-", "fracture at floe-floe contacts too (default: only at the vessel)");
+    v.field("flexural_strength_pa", flexural_strength_pa, "Pa", "flexural strength sigma_f (bending, radial cracks)",
+            positive());
+    v.field("youngs_modulus_pa", youngs_modulus_pa, "Pa", "effective Young's modulus E of the ice plate (l_c)",
+            positive());
+    v.field("poisson_ratio", poisson_ratio, "-", "Poisson ratio nu of ice (l_c)", in_range(0, 0.49));
+    v.field("fracture_toughness_pa_sqrtm", fracture_toughness_pa_sqrtm, "Pa m^0.5",
+            "apparent fracture toughness K_IC (splitting)", positive());
+    v.field("splitting_coefficient", splitting_coefficient, "-",
+            "C_s of the splitting load C_s K_IC h sqrt(L), L the chord along the force line", positive());
+    v.field("wedge_angle_deg", wedge_angle_deg, "deg",
+            "[min, max] of the wedge angle theta between the two radial cracks, drawn per event; inside (0, 180)",
+            Check<std::vector<double>>([](const std::vector<double>& a) -> std::string {
+              if (a.size() != 2) return "must be [min, max] in degrees, e.g. [45, 90]";
+              if (!(a[0] > 0 && a[1] < 180)) return "both angles must lie inside (0, 180) degrees (0 < theta < pi)";
+              if (!(a[0] <= a[1])) return "needs min <= max";
+              return "";
+            }));
+    v.field("seed", seed, "-", "seed of the wedge-angle draws", int_in_range(0, 2147483647));
+    v.field("speed_correction", speed_correction, "-",
+            "shrink the broken piece with the normal speed: R_b x (1 + speed_coefficient_spm x v_n)");
+    v.field("speed_coefficient_spm", speed_coefficient_spm, "s/m", "C_v of the speed correction (< 0: smaller pieces)",
+            in_range(-10, 0));
+    v.field("min_piece_area_m2", min_piece_area_m2, "m^2",
+            "pieces smaller than this are brash: removed from the simulation, their mass counted in the summary",
+            non_negative());
+  }
+};
+
 struct SleepOptions {
   bool enabled = true;
   double linear_mps = 0.02;      // a floe slower than this ...
@@ -348,6 +396,7 @@ struct SimulateOptions {
   SolverOptions solver;
   ContactOptions contact;
   DomainOptions domain;
+  FractureOptions fracture;
   SleepOptions sleep;
   HealthOptions health;
   HullLoadOptions hull;
@@ -369,6 +418,7 @@ struct SimulateOptions {
     v.section("solver", solver, "contact solver");
     v.section("contact", contact, "contact laws (rigid or compliant crushing) per pair of body classes");
     v.section("domain", domain, "fixed walls around the floe field (floes pack against them)");
+    v.section("fracture", fracture, "ice fracture: bending, radial cracking and splitting (PHYSICS.md §2)");
     v.section("sleep", sleep, "sleeping of resting floes");
     v.section("health", health, "numerical health limits");
     v.section("hull", hull, "how the hull file is loaded (non-convex meshes)");

@@ -36,6 +36,11 @@ struct Contact {
   double area_end_m2 = 0;      // A(delta + step) >= A
   double area_step_m = 0;      // the step, m
   double area_slope_m = 0;     // (area_end - area) / step, m^2/m
+  // Horizontal extent of the contact (collide): the two extreme points of the contact surface (crushing) or the
+  // point itself (rigid manifold points) along the horizontal tangent z x normal. The fracture stage takes the
+  // contact width of a body pair from the spread of these over the pair's contacts (PHYSICS.md §2.1: the real
+  // width from the overlap).
+  Vec3 span_lo = Vec3::Zero(), span_hi = Vec3::Zero();
   // Crushing law (solve): F_0 = p_c(A) A, its secant gradient K_t = dF/d(delta) over the step, the cap
   // F_end = p_c(A_end) A_end, damping c_n, and W = 1/m_eff of the normal row.
   double crush_force_n = 0, crush_force_end_n = 0, crush_stiffness_npm = 0, crush_damping_nspm = 0, inv_mass_n = 0;
@@ -67,6 +72,8 @@ struct State {
   std::vector<Vec3> velocity;           // world, m/s
   std::vector<Vec3> angular_velocity;   // world, rad/s
   std::vector<uint8_t> awake;           // 0: sleeping (not integrated, no forces)
+  std::vector<uint8_t> alive;           // 0: broken up (replaced by its pieces) or removed as brash: never again
+                                        // awake, in the broad phase or in the results
   std::vector<double> still_time_s;     // time spent below the sleep thresholds without contacts
   std::vector<CachedContact> contact_cache;  // sorted by (body_a, part_a, body_b, part_b)
   // Vessel controllers.

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "pipeline/error.h"
@@ -9,7 +10,7 @@
 namespace floesim::sim {
 
 const char* stage_name(int stage) {
-  static const char* names[kStageCount] = {"collide", "forces", "solve", "integrate", "relax", "sleep"};
+  static const char* names[kStageCount] = {"collide", "forces", "solve", "integrate", "relax", "fracture", "sleep"};
   return names[stage];
 }
 
@@ -43,6 +44,9 @@ World::World(const Model& model) : model_(model), pool_(model.options.threads) {
   state_.angular_velocity.assign(n, Vec3::Zero());
   state_.awake.assign(n, start_asleep ? 0 : 1);
   state_.still_time_s.assign(n, 0.0);
+  state_.alive.assign(n, 1);
+  ended_s_.assign(n, std::numeric_limits<double>::infinity());
+  for (const Body& b : model.bodies) next_floe_id_ = std::max(next_floe_id_, b.id + 1);
   for (size_t b = 0; b < n; ++b) {
     state_.position[b] = model.bodies[b].initial_position;
     state_.orientation[b] = model.bodies[b].initial_orientation;
@@ -82,7 +86,7 @@ void World::sync() {
 }
 
 void World::wake(int body) {
-  if (model_.bodies[body].kind == BodyKind::wall) return;  // fixed bodies never move
+  if (model_.bodies[body].kind == BodyKind::wall || !state_.alive[body]) return;  // fixed or gone: never move
   state_.awake[body] = 1;
   state_.still_time_s[body] = 0;
 }
@@ -109,6 +113,7 @@ void World::step() {
   { StageTimer t(stage_seconds_[kSolve]); stage_solve(); }
   { StageTimer t(stage_seconds_[kIntegrate]); stage_integrate(); }
   { StageTimer t(stage_seconds_[kRelax]); stage_relax(); }
+  { StageTimer t(stage_seconds_[kFracture]); stage_fracture(); }
   { StageTimer t(stage_seconds_[kSleep]); stage_sleep(); }
   state_.time_s = (state_.step + 1) * model_.options.time_step_s;  // no drift from repeated addition
   ++state_.step;
@@ -242,6 +247,84 @@ void World::stage_relax() {
   }
 }
 
+void World::stage_fracture() {
+  std::vector<FractureCut> cuts = find_fractures(model_, state_, contacts_, model_.options.time_step_s);
+  for (FractureCut& c : cuts) apply_fracture(c);
+  report_.fracture_events = static_cast<int>(cuts.size());
+}
+
+void World::grow_body_arrays() {
+  const size_t n = model_.bodies.size();
+  state_.position.resize(n, Vec3::Zero());
+  state_.orientation.resize(n, Quat::Identity());
+  state_.velocity.resize(n, Vec3::Zero());
+  state_.angular_velocity.resize(n, Vec3::Zero());
+  state_.awake.resize(n, 1);
+  state_.alive.resize(n, 1);
+  state_.still_time_s.resize(n, 0.0);
+  solver_bodies_.inv_mass.resize(n, Mat3::Zero());
+  solver_bodies_.inv_inertia_world.resize(n, Mat3::Zero());
+  external_.resize(n);
+  island_.resize(n, 0);
+  island_ok_.resize(n, 0);
+  ended_s_.resize(n, std::numeric_limits<double>::infinity());
+}
+
+void World::apply_fracture(FractureCut& cut) {
+  const int parent = cut.body;
+  const Body parent_body = model_.bodies[parent];  // a copy: the table is about to grow
+  const double t = (state_.step + 1) * model_.options.time_step_s;
+  const Vec3 x = state_.position[parent], v = state_.velocity[parent], w = state_.angular_velocity[parent];
+  const Quat q = state_.orientation[parent];
+  const Mat3 R = q.toRotationMatrix();
+  const double min_area = model_.options.fracture.min_piece_area_m2;
+  const double rho_i = model_.options.ice.density_kg_m3, h = parent_body.thickness_m;
+  FractureEvent& e = cut.event;
+  // The floe leaves: no longer alive, awake or in the broad phase. Its contacts of this step stay in contacts_
+  // (the sleep stage skips them); its warm-start entries are never matched again (its parts are gone).
+  state_.alive[parent] = 0;
+  state_.awake[parent] = 0;
+  ended_s_[parent] = t;
+  collision_->remove_body(parent);
+  const int first_new = static_cast<int>(model_.bodies.size());
+  for (const Polygon& piece : cut.pieces) {
+    const double area = signed_area(piece);
+    if (area < min_area) {
+      // Brash: a piece this small is a block, not a plate (thickness comparable with its width), and a swarm of
+      // them would only add tiny masses to the solver's chains under the hull. It is removed; its mass is counted.
+      e.brash_mass_kg += rho_i * area * h;
+      continue;
+    }
+    const Vec2 c = centroid(piece);
+    Polygon local;
+    for (const Vec2& p : piece) local.push_back(p - c);
+    const int id = next_floe_id_++;
+    const int index = static_cast<int>(model_.bodies.size());
+    Body b = make_floe_body(local, h, id, index, Vec2::Zero(), model_.options, model_.parts);
+    b.parent_id = parent_body.id;
+    b.generation = parent_body.generation + 1;
+    b.origin_mode = e.mode;
+    b.created_s = t;
+    // The piece where it was in the floe, with the floe's velocity field v + w x r (momentum kept exactly).
+    const Vec3 r = R * Vec3(c.x(), c.y(), 0);
+    b.initial_position = x + r;
+    b.initial_orientation = q;
+    model_.bodies.push_back(std::move(b));
+    grow_body_arrays();
+    state_.position[index] = x + r;
+    state_.orientation[index] = q;
+    state_.velocity[index] = v + w.cross(r);
+    state_.angular_velocity[index] = w;
+    state_.awake[index] = 1;
+    solver_bodies_.inv_mass[index] = R * model_.bodies[index].inv_mass_added.asDiagonal() * R.transpose();
+    solver_bodies_.inv_inertia_world[index] = R * model_.bodies[index].inv_inertia_added * R.transpose();
+    e.child_ids.push_back(id);
+  }
+  brash_mass_kg_ += e.brash_mass_kg;
+  collision_->add_bodies(state_, first_new);
+  events_.push_back(std::move(e));
+}
+
 void World::stage_sleep() {
   const SleepOptions& s = model_.options.sleep;
   const HealthOptions& h = model_.options.health;
@@ -249,7 +332,10 @@ void World::stage_sleep() {
   if (!std::isfinite(report_.solve.residual) || !std::isfinite(report_.relax.residual))
     fail(-1, "the contact solver diverged (residual is not finite)");
   report_.awake_floes = static_cast<int>(awake_list_.size()) - (model_.vessel >= 0 ? 1 : 0);
+  for (size_t b = 0; b < model_.bodies.size(); ++b)
+    report_.floe_bodies += model_.bodies[b].kind == BodyKind::floe && state_.alive[b];
   for (int b : awake_list_) {
+    if (!state_.alive[b]) continue;  // broke up in this step
     const Vec3& v = state_.velocity[b];
     const Vec3& w = state_.angular_velocity[b];
     if (!finite(state_.position[b]) || !finite(v) || !finite(w) || !std::isfinite(state_.orientation[b].w()))
@@ -274,6 +360,7 @@ void World::stage_sleep() {
   for (int b : awake_list_) island_[b] = b;
   for (const Contact& c : contacts_) {
     if (model_.bodies[c.body_a].kind == BodyKind::wall || model_.bodies[c.body_b].kind == BodyKind::wall) continue;
+    if (!state_.alive[c.body_a] || !state_.alive[c.body_b]) continue;  // broke up in this step
     const int ra = find(c.body_a), rb = find(c.body_b);
     if (ra != rb) island_[std::max(ra, rb)] = std::min(ra, rb);
   }
@@ -281,7 +368,7 @@ void World::stage_sleep() {
   for (int b : awake_list_)
     if (b == model_.vessel || state_.still_time_s[b] < s.time_s) island_ok_[find(b)] = 0;
   for (int b : awake_list_) {
-    if (b == model_.vessel || !island_ok_[find(b)]) continue;
+    if (b == model_.vessel || !state_.alive[b] || !island_ok_[find(b)]) continue;
     state_.awake[b] = 0;
     state_.velocity[b].setZero();
     state_.angular_velocity[b].setZero();
@@ -291,6 +378,7 @@ void World::stage_sleep() {
 double World::kinetic_energy() const {
   double e = 0;
   for (size_t b = 0; b < model_.bodies.size(); ++b) {
+    if (!state_.alive[b]) continue;
     const Body& body = model_.bodies[b];
     const Mat3 R = state_.orientation[b].toRotationMatrix();
     const Vec3 wb = R.transpose() * state_.angular_velocity[b];
@@ -301,7 +389,8 @@ double World::kinetic_energy() const {
 
 Vec3 World::linear_momentum() const {
   Vec3 p = Vec3::Zero();
-  for (size_t b = 0; b < model_.bodies.size(); ++b) p += model_.bodies[b].mass_kg * state_.velocity[b];
+  for (size_t b = 0; b < model_.bodies.size(); ++b)
+    if (state_.alive[b]) p += model_.bodies[b].mass_kg * state_.velocity[b];
   return p;
 }
 

@@ -9,7 +9,12 @@
 //   integrate  semi-implicit Euler: x += dt v, q += dt/2 [0, w] q (normalised)
 //   relax      PGS without push-out bias, so that resolving overlap leaves no velocity (crushing rows keep their
 //              law, which has no bias anyway); impulses stored for warm start; the vessel's loads by contact law
+//   fracture   the converged contact forces against the closed-form failure loads (PHYSICS.md §2): a floe that
+//              fails leaves the world and its pieces enter it as new bodies (sim/fracture.h)
 //   sleep      islands of floes joined by contacts fall asleep together at rest; health checks (NaN, blow-up)
+//
+// The world owns its model: the body table only grows (pieces are appended, a broken floe stays in the table but
+// not alive), so the collision, solver, sleeping and recording stages all see new bodies the same way.
 //
 // Loads on the vessel are recorded per step in StepReport (world frame; the recorder turns them to body axes).
 #pragma once
@@ -20,6 +25,7 @@
 
 #include "sim/collision.h"
 #include "sim/forces.h"
+#include "sim/fracture.h"
 #include "sim/model.h"
 #include "sim/parallel.h"
 #include "sim/solver.h"
@@ -27,13 +33,15 @@
 
 namespace floesim::sim {
 
-enum Stage { kCollide, kForces, kSolve, kIntegrate, kRelax, kSleep, kStageCount };
+enum Stage { kCollide, kForces, kSolve, kIntegrate, kRelax, kFracture, kSleep, kStageCount };
 const char* stage_name(int stage);
 
 // What one step did and the loads on the vessel (world frame, about its centre of mass).
 struct StepReport {
   int contacts = 0, vessel_contacts = 0;
   int awake_floes = 0;
+  int fracture_events = 0;   // floes broken in this step
+  int floe_bodies = 0;       // floe bodies alive at the end of the step
   SolverReport solve, relax;
   Wrench ice_load, ice_load_rigid, ice_load_compliant;
   Wrench hydro_load, wind_load, propulsion_load;
@@ -42,6 +50,7 @@ struct StepReport {
 
 class World {
  public:
+  // Copies the model: the world's body table grows as ice breaks; the caller's model stays as built.
   explicit World(const Model& model);
   ~World();
 
@@ -57,11 +66,17 @@ class World {
 
   const StepReport& report() const { return report_; }
   const std::vector<Contact>& contacts() const { return contacts_; }
+  // Every fracture event so far, in time order (children ids are floe ids of bodies in model()).
+  const std::vector<FractureEvent>& fracture_events() const { return events_; }
+  // When each body left the world (broken up or removed), s; +inf while alive. Indexed like model().bodies.
+  const std::vector<double>& ended_s() const { return ended_s_; }
+  // Mass of brash removed so far (pieces below fracture.min_piece_area_m2), kg.
+  double brash_mass_kg() const { return brash_mass_kg_; }
   const CollisionStats& collision_stats() const { return collision_->stats(); }
   // Accumulated wall time per stage (s).
   const std::array<double, kStageCount>& stage_seconds() const { return stage_seconds_; }
 
-  // Kinetic energy of all bodies (J) and their total linear momentum (N s).
+  // Kinetic energy of all bodies alive (J) and their total linear momentum (N s).
   double kinetic_energy() const;
   Vec3 linear_momentum() const;
 
@@ -71,11 +86,17 @@ class World {
   void stage_solve();
   void stage_integrate();
   void stage_relax();
+  void stage_fracture();
   void stage_sleep();
+  // Replaces the floe of `cut` by its pieces (bodies appended at the floe's pose and velocity field) and records
+  // the event.
+  void apply_fracture(FractureCut& cut);
+  // Grows the per-body arrays to the body table's size (new bodies awake, at rest in their own frame).
+  void grow_body_arrays();
   [[noreturn]] void fail(int body, const std::string& what) const;
   std::string body_name(int body) const;
 
-  const Model& model_;
+  Model model_;
   State state_;
   ThreadPool pool_;
   std::unique_ptr<CollisionWorld> collision_;
@@ -89,6 +110,10 @@ class World {
   SolverBodies solver_bodies_;
   StepReport report_;
   bool sleep_allowed_ = false;
+  std::vector<FractureEvent> events_;
+  std::vector<double> ended_s_;
+  double brash_mass_kg_ = 0;
+  int next_floe_id_ = 1;            // ids of new pieces: above every id the world has seen, never reused
   std::array<double, kStageCount> stage_seconds_{};
 };
 

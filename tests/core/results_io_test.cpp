@@ -1,7 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <hdf5.h>
+
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <limits>
 
 #include "pipeline/error.h"
 #include "pipeline/provenance.h"
@@ -12,6 +16,8 @@ using namespace floesim;
 namespace fs = std::filesystem;
 
 namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
 Results small_results(int steps) {
   Results r;
   for (int k = 0; k < steps; ++k) {
@@ -30,10 +36,115 @@ Results small_results(int steps) {
   r.floe_thickness_m = {1.0};
   r.floe_vertex_offset = {0, 3};
   r.floe_vertices_m = {0, 0, 1, 0, 0, 1};
+  r.floe_parent_id = {-1};
+  r.floe_generation = {0};
+  r.floe_origin_mode = {kFractureNone};
+  r.floe_created_s = {0.0};
+  r.floe_ended_s = {kInf};
   r.hull_vertices_m = {0, 0, 0, 1, 0, 0, 0, 1, 0};
   r.hull_triangles = {0, 1, 2};
   r.attributes = {{"time_step_s", 0.01}};
   return r;
+}
+
+// Two input floes (1, 2). Event 0 at 0.15 s: floe 1 splits at the vessel into pieces 3 and 4. Event 1 at 0.2 s:
+// piece 3 loses a bending wedge, piece 5, at a floe-floe contact (the rest of it went to brash). Three pieces.
+Results fractured_results() {
+  Results r = small_results(7);
+  r.floe_id = {1, 2, 3, 4, 5};
+  r.floe_thickness_m = {1.0, 1.5, 1.0, 1.0, 1.0};
+  r.floe_vertex_offset = {0, 3, 6, 9, 12, 15};
+  r.floe_vertices_m.clear();
+  for (int k = 0; k < 5; ++k) r.floe_vertices_m.insert(r.floe_vertices_m.end(), {0, 0, 1.0 + k, 0, 0, 1.0 + k});
+  r.floe_parent_id = {-1, -1, 1, 1, 3};
+  r.floe_generation = {0, 0, 1, 1, 2};
+  r.floe_origin_mode = {kFractureNone, kFractureNone, kFractureSplitting, kFractureSplitting, kFractureBending};
+  r.floe_created_s = {0, 0, 0.15, 0.15, 0.2};
+  r.floe_ended_s = {0.15, kInf, 0.2, kInf, kInf};
+  r.fracture_time_s = {0.15, 0.2};
+  r.fracture_parent_id = {1, 3};
+  r.fracture_mode = {kFractureSplitting, kFractureBending};
+  r.fracture_at_structure = {1, 0};
+  r.fracture_force_n = {-2.5e6, 1e5, 0, 3e4, -2e4, -6e5};
+  r.fracture_threshold_n = {2.4e6, 5.5e5};
+  r.fracture_point_m = {10, 0.5, -0.2, 14, 3, 0.4};
+  r.fracture_width_m = {1.2, 2.5};
+  r.fracture_theta_rad = {0, 1.0471975511965976};
+  r.fracture_brash_mass_kg = {0, 1234.5};
+  r.fracture_child_offset = {0, 2, 3};
+  r.fracture_child_id = {3, 4, 5};
+  return r;
+}
+
+template <class T>
+hid_t native();
+template <>
+hid_t native<double>() { return H5T_NATIVE_DOUBLE; }
+template <>
+hid_t native<int32_t>() { return H5T_NATIVE_INT32; }
+template <>
+hid_t native<int64_t>() { return H5T_NATIVE_INT64; }
+
+// Edits a written file behind the writer's back (its checks would refuse the content), as a damaged or foreign
+// file would come.
+template <class T>
+void replace_dataset(const fs::path& file, const std::string& name, const std::vector<T>& v, size_t cols) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  ASSERT_GE(f, 0) << file;
+  ASSERT_GE(H5Ldelete(f, name.c_str(), H5P_DEFAULT), 0) << name;
+  const hsize_t dims[2] = {v.size() / cols, cols};
+  const hid_t sp = H5Screate_simple(cols == 1 ? 1 : 2, dims, nullptr);
+  const hid_t ds = H5Dcreate2(f, name.c_str(), native<T>(), sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  ASSERT_GE(ds, 0) << name;
+  if (!v.empty()) {
+    EXPECT_GE(H5Dwrite(ds, native<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), 0) << name;
+  }
+  H5Dclose(ds);
+  H5Sclose(sp);
+  H5Fclose(f);
+}
+
+// Writes dataset `name` of the file from the same field of `r`.
+void replace_from(const fs::path& file, const std::string& name, const Results& r) {
+  if (name == "/geometry/floe_parent_id") return replace_dataset(file, name, r.floe_parent_id, 1);
+  if (name == "/geometry/floe_generation") return replace_dataset(file, name, r.floe_generation, 1);
+  if (name == "/geometry/floe_origin_mode") return replace_dataset(file, name, r.floe_origin_mode, 1);
+  if (name == "/geometry/floe_created_s") return replace_dataset(file, name, r.floe_created_s, 1);
+  if (name == "/geometry/floe_ended_s") return replace_dataset(file, name, r.floe_ended_s, 1);
+  if (name == "/fracture/time_s") return replace_dataset(file, name, r.fracture_time_s, 1);
+  if (name == "/fracture/parent_id") return replace_dataset(file, name, r.fracture_parent_id, 1);
+  if (name == "/fracture/mode") return replace_dataset(file, name, r.fracture_mode, 1);
+  if (name == "/fracture/force_n") return replace_dataset(file, name, r.fracture_force_n, 3);
+  if (name == "/fracture/child_offset") return replace_dataset(file, name, r.fracture_child_offset, 1);
+  if (name == "/fracture/child_id") return replace_dataset(file, name, r.fracture_child_id, 1);
+  FAIL() << "the test cannot replace " << name;
+}
+
+// Replaces the root's "floesim" attribute (layout version and run settings).
+void replace_attributes(const fs::path& file, const nlohmann::json& attrs) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  ASSERT_GE(f, 0) << file;
+  ASSERT_GE(H5Adelete(f, "floesim"), 0);
+  const std::string text = attrs.dump();
+  const hid_t st = H5Tcopy(H5T_C_S1);
+  H5Tset_size(st, text.size() + 1);
+  const hid_t sp = H5Screate(H5S_SCALAR);
+  const hid_t at = H5Acreate2(f, "floesim", st, sp, H5P_DEFAULT, H5P_DEFAULT);
+  EXPECT_GE(H5Awrite(at, st, text.c_str()), 0);
+  H5Aclose(at);
+  H5Sclose(sp);
+  H5Tclose(st);
+  H5Fclose(f);
+}
+
+// The error of `f`, or "" if it did not throw.
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
 }
 }  // namespace
 
@@ -74,4 +185,132 @@ TEST(ResultsIo, ClearErrorsForMissingOrForeignFiles) {
   }
   fs::remove(p);
   EXPECT_THROW(read_results(fs::temp_directory_path() / "floesim_absent.h5"), Error);
+}
+
+TEST(ResultsIo, FractureEventsAndLineageRoundTrip) {
+  const fs::path p = fs::temp_directory_path() / "floesim_results_fracture.h5";
+  const Results r = fractured_results();
+  write_results(p, r);
+  const Results b = read_results(p);
+  EXPECT_EQ(b.attributes["layout"], "floesim-results/2");
+  EXPECT_EQ(b.floe_id, r.floe_id);
+  EXPECT_EQ(b.floe_vertices_m, r.floe_vertices_m);
+  EXPECT_EQ(b.floe_parent_id, r.floe_parent_id);
+  EXPECT_EQ(b.floe_generation, r.floe_generation);
+  EXPECT_EQ(b.floe_origin_mode, r.floe_origin_mode);
+  EXPECT_EQ(b.floe_created_s, r.floe_created_s);
+  EXPECT_EQ(b.floe_ended_s, r.floe_ended_s) << "+inf (the floe lasted) must survive the file";
+  EXPECT_EQ(b.fracture_time_s, r.fracture_time_s);
+  EXPECT_EQ(b.fracture_parent_id, r.fracture_parent_id);
+  EXPECT_EQ(b.fracture_mode, r.fracture_mode);
+  EXPECT_EQ(b.fracture_at_structure, r.fracture_at_structure);
+  EXPECT_EQ(b.fracture_force_n, r.fracture_force_n);
+  EXPECT_EQ(b.fracture_threshold_n, r.fracture_threshold_n);
+  EXPECT_EQ(b.fracture_point_m, r.fracture_point_m);
+  EXPECT_EQ(b.fracture_width_m, r.fracture_width_m);
+  EXPECT_EQ(b.fracture_theta_rad, r.fracture_theta_rad);
+  EXPECT_EQ(b.fracture_brash_mass_kg, r.fracture_brash_mass_kg);
+  EXPECT_EQ(b.fracture_child_offset, r.fracture_child_offset);
+  EXPECT_EQ(b.fracture_child_id, r.fracture_child_id);
+  EXPECT_EQ(b.get("fracture_events"), r.get("fracture_events"));
+  EXPECT_EQ(b.get("floe_bodies"), r.get("floe_bodies"));
+  // The plot reads without states; the fracture tables come all the same.
+  EXPECT_EQ(read_results(p, /*with_states=*/false).fracture_child_id, r.fracture_child_id);
+  EXPECT_STREQ(fracture_mode_name(b.fracture_mode[0]), "splitting");
+  EXPECT_STREQ(fracture_mode_name(b.fracture_mode[1]), "bending");
+  EXPECT_STREQ(fracture_mode_name(kFractureRadial), "radial");
+  EXPECT_STREQ(fracture_mode_name(b.floe_origin_mode[0]), "input");
+  EXPECT_THROW(fracture_mode_name(7), Error);
+  fs::remove(p);
+}
+
+TEST(ResultsIo, InconsistentFractureTablesAreRefusedOnWriteAndOnReadNamingTheDataset) {
+  struct Case {
+    const char* dataset;  // named by the error
+    const char* needle;   // what the error says about it
+    std::function<void(Results&)> apply;
+  };
+  const std::vector<Case> cases = {
+      {"/geometry/floe_parent_id", "expected 5", [](Results& r) { r.floe_parent_id.pop_back(); }},
+      {"/geometry/floe_generation", "expected 5", [](Results& r) { r.floe_generation.push_back(1); }},
+      {"/geometry/floe_origin_mode", "expected 5", [](Results& r) { r.floe_origin_mode.pop_back(); }},
+      {"/geometry/floe_created_s", "expected 5", [](Results& r) { r.floe_created_s.pop_back(); }},
+      {"/geometry/floe_ended_s", "expected 5", [](Results& r) { r.floe_ended_s.clear(); }},
+      {"/fracture/parent_id", "expected 2", [](Results& r) { r.fracture_parent_id.pop_back(); }},
+      {"/fracture/mode", "expected 2", [](Results& r) { r.fracture_mode.push_back(1); }},
+      {"/fracture/force_n", "expected 2 x 3", [](Results& r) { r.fracture_force_n.resize(3); }},
+      {"/fracture/child_offset", "expected 3", [](Results& r) { r.fracture_child_offset.pop_back(); }},
+      {"/fracture/child_offset", "starts at 1", [](Results& r) { r.fracture_child_offset = {1, 2, 3}; }},
+      {"/fracture/child_offset", "decreases", [](Results& r) { r.fracture_child_offset = {0, 3, 2}; }},
+      {"/fracture/child_offset", "ends at 2", [](Results& r) { r.fracture_child_offset = {0, 1, 2}; }},
+      {"/fracture/mode", "is 4", [](Results& r) { r.fracture_mode[1] = 4; }},
+      {"/fracture/mode", "is 0", [](Results& r) { r.fracture_mode[0] = 0; }},
+      {"/fracture/child_id", "99", [](Results& r) { r.fracture_child_id[2] = 99; }},
+      {"/fracture/parent_id", "42", [](Results& r) { r.fracture_parent_id[0] = 42; }},
+      {"/geometry/floe_parent_id", "77", [](Results& r) { r.floe_parent_id[4] = 77; }},
+      {"/fracture/time_s", "decreases", [](Results& r) { r.fracture_time_s = {0.2, 0.15}; }},
+  };
+  const fs::path good = fs::temp_directory_path() / "floesim_results_fracture_good.h5";
+  const fs::path bad = fs::temp_directory_path() / "floesim_results_fracture_bad.h5";
+  for (const Case& c : cases) {
+    SCOPED_TRACE(std::string(c.dataset) + ": " + c.needle);
+    Results r = fractured_results();
+    c.apply(r);
+    // Write: an internal error of the simulator; no file appears.
+    const std::string w = error_of([&] { write_results(bad, r); });
+    EXPECT_NE(w.find(c.dataset), std::string::npos) << w;
+    EXPECT_NE(w.find(c.needle), std::string::npos) << w;
+    EXPECT_NE(w.find("internal"), std::string::npos) << w;
+    EXPECT_FALSE(fs::exists(bad));
+    // Read: the same inconsistency in a file (edited behind the writer's back) names the file and the dataset.
+    write_results(good, fractured_results());
+    replace_from(good, c.dataset, r);
+    const std::string e = error_of([&] { read_results(good); });
+    EXPECT_NE(e.find(good.string()), std::string::npos) << e;
+    EXPECT_NE(e.find(c.dataset), std::string::npos) << e;
+    EXPECT_NE(e.find(c.needle), std::string::npos) << e;
+  }
+  fs::remove(good);
+}
+
+TEST(ResultsIo, LayoutOneFilesFromBeforeFractureReadWithDefaults) {
+  // A floesim-results/1 file: today's writer, then what /1 did not have removed and the layout set back.
+  const fs::path p = fs::temp_directory_path() / "floesim_results_layout1.h5";
+  write_results(p, small_results(4));
+  {
+    const hid_t f = H5Fopen(p.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(f, 0);
+    for (const char* name : {"/fracture", "/geometry/floe_parent_id", "/geometry/floe_generation",
+                             "/geometry/floe_origin_mode", "/geometry/floe_created_s", "/geometry/floe_ended_s",
+                             "/series/fracture_events", "/series/floe_bodies"})
+      ASSERT_GE(H5Ldelete(f, name, H5P_DEFAULT), 0) << name;
+    H5Fclose(f);
+  }
+  replace_attributes(p, {{"layout", "floesim-results/1"}, {"time_step_s", 0.01}});
+  const Results r = read_results(p);
+  EXPECT_EQ(r.attributes["layout"], "floesim-results/1");
+  EXPECT_EQ(r.floe_id, std::vector<int32_t>{1});
+  EXPECT_EQ(r.floe_parent_id, std::vector<int32_t>{-1});
+  EXPECT_EQ(r.floe_generation, std::vector<int32_t>{0});
+  EXPECT_EQ(r.floe_origin_mode, std::vector<int32_t>{kFractureNone});
+  EXPECT_EQ(r.floe_created_s, std::vector<double>{0.0});
+  EXPECT_EQ(r.floe_ended_s, std::vector<double>{kInf});
+  EXPECT_TRUE(r.fracture_time_s.empty());
+  EXPECT_TRUE(r.fracture_child_id.empty());
+  EXPECT_EQ(r.fracture_child_offset, std::vector<int64_t>{0});
+  EXPECT_EQ(r.get("fracture_events"), std::vector<double>(4, 0.0));
+  EXPECT_EQ(r.get("floe_bodies"), std::vector<double>(4, 1.0)) << "every floe was a body for the whole run";
+  EXPECT_EQ(r.get("ice_load").size(), 4u * 6u);
+  // Rewritten, it becomes a /2 file with the same content.
+  const fs::path q = fs::temp_directory_path() / "floesim_results_layout1_rewritten.h5";
+  write_results(q, r);
+  EXPECT_EQ(read_results(q).attributes["layout"], "floesim-results/2");
+  fs::remove(q);
+
+  // A layout from the future is refused, naming it.
+  write_results(p, small_results(2));
+  replace_attributes(p, {{"layout", "floesim-results/9"}});
+  const std::string e = error_of([&] { read_results(p); });
+  EXPECT_NE(e.find("floesim-results/9"), std::string::npos) << e;
+  fs::remove(p);
 }

@@ -1,6 +1,9 @@
 // convex_decompose: pieces are convex, counter-clockwise and tile the input (areas add up exactly).
+// Cutting floes: boolean operations, line splits, chords and sectors against closed forms; area conservation,
+// orientation, simplicity, no overlap and determinism on random polygons.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -8,6 +11,7 @@
 #include <sstream>
 #include <string>
 
+#include "pipeline/error.h"
 #include "pipeline/geometry2d.h"
 
 #ifndef FLOESIM_SHARED_DATA_DIR
@@ -155,6 +159,236 @@ TEST(ConvexDecompose, RealDigitisedFloes) {
   }
   EXPECT_GT(tested, 400);
   EXPECT_GE(pieces, static_cast<size_t>(tested));
+}
+
+
+// ---- Cutting floes ------------------------------------------------------------------------------------------------
+
+double total_area(const std::vector<Polygon>& pieces) {
+  double a = 0;
+  for (const Polygon& q : pieces) a += signed_area(q);
+  return a;
+}
+
+// The contract every result of the cutting functions keeps: at least a triangle, CCW, simple.
+void check_pieces(const std::vector<Polygon>& pieces, const std::string& what) {
+  for (const Polygon& q : pieces) {
+    EXPECT_GE(q.size(), 3u) << what;
+    EXPECT_GT(signed_area(q), 0) << what << ": a piece is not counter-clockwise";
+    EXPECT_EQ(find_self_intersection(q).first, -1) << what << ": a piece is not simple";
+  }
+}
+
+// Pieces of one cut must not overlap: every pairwise intersection has (near) zero area. `tol` is an area.
+void check_disjoint(const std::vector<Polygon>& pieces, double tol, const std::string& what) {
+  for (size_t i = 0; i < pieces.size(); ++i)
+    for (size_t j = i + 1; j < pieces.size(); ++j)
+      EXPECT_LE(total_area(polygon_intersection(pieces[i], pieces[j], 0.0)), tol) << what << ": pieces overlap";
+}
+
+// Random polygon, star-shaped about `c`: n vertices at increasing angles and radii in [r0, r1].
+Polygon random_star(std::mt19937& rng, const Vec2& c, int n, double r0, double r1) {
+  std::uniform_real_distribution<double> U(0, 1);
+  Polygon p;
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * kPi * (i + 0.8 * U(rng)) / n, r = r0 + (r1 - r0) * U(rng);
+    p.emplace_back(c.x() + r * std::cos(a), c.y() + r * std::sin(a));
+  }
+  return p;
+}
+
+TEST(SplitByLine, SquareCutByDiagonal) {
+  const Polygon square{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  const LineSplit s = split_by_line(square, Vec2(0, 0), Vec2(1, 1));
+  ASSERT_EQ(s.left.size(), 1u);
+  ASSERT_EQ(s.right.size(), 1u);
+  // The diagonal's end points are the square's own corners, so the halves are exact: no new vertex, no round-off.
+  // Rings start at their lexicographically smallest vertex and run counter-clockwise.
+  EXPECT_EQ(s.left[0], (Polygon{{0, 0}, {1, 1}, {0, 1}}));
+  EXPECT_EQ(s.right[0], (Polygon{{0, 0}, {1, 0}, {1, 1}}));
+  EXPECT_EQ(signed_area(s.left[0]), 0.5);
+  EXPECT_EQ(signed_area(s.right[0]), 0.5);
+  // The other direction swaps the sides; a clockwise input gives the same pieces.
+  const LineSplit r = split_by_line(Polygon(square.rbegin(), square.rend()), Vec2(1, 1), Vec2(-1, -1));
+  EXPECT_EQ(r.left, s.right);
+  EXPECT_EQ(r.right, s.left);
+}
+
+TEST(SplitByLine, LShapeCutTwiceGivesThreePieces) {
+  // The line x + y = 2.5 crosses both arms of the L (area 5): it cuts off the tip of each arm, a trapezoid of
+  // heights 1 and widths 0.5 and 1.5 (area 1), and leaves the corner (area 3) on its right.
+  const Polygon l{{0, 0}, {3, 0}, {3, 1}, {1, 1}, {1, 3}, {0, 3}};
+  const Vec2 point(1.25, 1.25), dir(1, -1);  // cross(dir, x - point) = x + y - 2.5
+  const LineSplit s = split_by_line(l, point, dir);
+  ASSERT_EQ(s.left.size(), 2u);
+  ASSERT_EQ(s.right.size(), 1u);
+  check_pieces(s.left, "L left");
+  check_pieces(s.right, "L right");
+  for (const Polygon& q : s.left) EXPECT_NEAR(signed_area(q), 1.0, 1e-14);
+  EXPECT_NEAR(signed_area(s.right[0]), 3.0, 1e-14);
+  for (const Polygon& q : s.left)
+    for (const Vec2& v : q) EXPECT_GE(v.x() + v.y(), 2.5 - 1e-14);
+  for (const Vec2& v : s.right[0]) EXPECT_LE(v.x() + v.y(), 2.5 + 1e-14);
+  // Pieces sorted by their first (smallest) vertex: the left arm's tip (x = 0) before the bottom arm's (x = 1.5).
+  EXPECT_NEAR(s.left[0][0].x(), 0.0, 1e-15);
+  EXPECT_NEAR(s.left[1][0].x(), 1.5, 1e-15);
+  EXPECT_EQ(s.right[0].size(), 6u);  // (0,0) (2.5,0) (1.5,1) (1,1) (1,1.5) (0,2.5)
+}
+
+TEST(BooleanOps, SquareAndSector) {
+  // Sector of radius r = 1.2 and half-angle pi/4 about +x, apex at the centre of the square [0,2]^2: the square's
+  // right edge x = 2 cuts it. In polar coordinates about the apex, the part inside the square is bounded by the
+  // edge for |phi| <= phi0 = acos(1/r) and by the arc beyond, so its area is tan(phi0) + r^2 (pi/4 - phi0).
+  const double r = 1.2, half = kPi / 4;
+  const int n = 1024;
+  const Polygon square{{0, 0}, {2, 0}, {2, 2}, {0, 2}};
+  const Polygon sector = circular_sector(Vec2(1, 1), Vec2(1, 0), half, r, n);
+  const double phi0 = std::acos(1 / r);
+  const double exact = std::tan(phi0) + r * r * (half - phi0);
+  // The polygon's arc is made of chords, inside the circle: the clipped area differs from the circular one by less
+  // than the polygon's whole deficit against the circular sector.
+  const double deficit = 0.5 * r * r * (2 * half - n * std::sin(2 * half / n));
+  const auto in = polygon_intersection(square, sector);
+  const auto out = polygon_difference(square, sector);
+  ASSERT_EQ(in.size(), 1u);
+  ASSERT_EQ(out.size(), 1u);
+  check_pieces(in, "square n sector");
+  check_pieces(out, "square \\ sector");
+  EXPECT_NEAR(total_area(in), exact, deficit);
+  EXPECT_LT(total_area(in), exact);
+  EXPECT_NEAR(total_area(out), 4 - exact, deficit);
+  // The two share their cut vertices, so they add up to the square to round-off.
+  EXPECT_NEAR(total_area(in) + total_area(out), 4.0, 4 * 1e-14);
+  check_disjoint({in[0], out[0]}, 1e-12, "square/sector");
+  // Intersection is symmetric.
+  EXPECT_NEAR(total_area(polygon_intersection(sector, square)), total_area(in), 1e-14);
+}
+
+TEST(BooleanOps, HoleAndBadInputThrow) {
+  const Polygon big{{0, 0}, {10, 0}, {10, 10}, {0, 10}};
+  const Polygon small{{4, 4}, {6, 4}, {6, 6}, {4, 6}};
+  // Removing an inner piece would leave a floe with a hole: an error, which callers treat as "no cut".
+  EXPECT_THROW(polygon_difference(big, small), Error);
+  // ... unless the hole is below the sliver threshold.
+  EXPECT_EQ(polygon_difference(big, small, 5.0).size(), 1u);
+  EXPECT_EQ(polygon_intersection(big, small), (std::vector<Polygon>{small}));
+  const Polygon bowtie{{0, 0}, {1, 1}, {1, 0}, {0, 1}};
+  EXPECT_THROW(polygon_intersection(bowtie, big), Error);
+  EXPECT_THROW(polygon_difference(big, Polygon{{0, 0}, {1, 0}}), Error);
+  EXPECT_THROW(split_by_line(big, Vec2(1, 1), Vec2(0, 0)), Error);
+  // Disjoint polygons: nothing in common, the difference is the first polygon.
+  const Polygon far{{20, 0}, {21, 0}, {21, 1}};
+  EXPECT_TRUE(polygon_intersection(big, far).empty());
+  EXPECT_EQ(polygon_difference(big, far), (std::vector<Polygon>{big}));
+}
+
+TEST(BooleanOps, RandomPolygonsConserveArea) {
+  // 200 random star-shaped polygons: split by a random line through a point near the centre, and cut by another
+  // random polygon whose centre lies outside the first (so a \ b can have no hole: b reaches the outside).
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> U(0, 1);
+  const Vec2 c(100, -50);
+  int two_sided_splits = 0, multi_piece_splits = 0, overlapping_pairs = 0;
+  for (int k = 0; k < 200; ++k) {
+    const std::string what = "case " + std::to_string(k);
+    const Polygon a = random_star(rng, c, 5 + static_cast<int>(U(rng) * 60), 5, 25);
+    const double area = signed_area(a);
+    ASSERT_EQ(find_self_intersection(a).first, -1) << what;
+
+    Vec2 point = c + Vec2(10 * U(rng) - 5, 10 * U(rng) - 5);
+    const double phi = 2 * kPi * U(rng);
+    Vec2 dir(std::cos(phi), std::sin(phi));
+    // Degenerate lines too, as a crack from a contact at a vertex makes them: through one vertex, through two.
+    const size_t i = static_cast<size_t>(U(rng) * a.size()), j = (i + 2 + a.size() / 2) % a.size();
+    if (k % 4 == 1) point = a[i];
+    if (k % 4 == 2) point = a[i], dir = a[j] - a[i];
+    const LineSplit s = split_by_line(a, point, dir, 0.0);
+    check_pieces(s.left, what + " left");
+    check_pieces(s.right, what + " right");
+    EXPECT_NEAR(total_area(s.left) + total_area(s.right), area, 1e-9 * area) << what;
+    // Each side's vertices lie on its side of the line (to round-off at a 100 m offset).
+    for (const Polygon& q : s.left)
+      for (const Vec2& v : q) EXPECT_GE(dir.x() * (v.y() - point.y()) - dir.y() * (v.x() - point.x()), -1e-12) << what;
+    for (const Polygon& q : s.right)
+      for (const Vec2& v : q) EXPECT_LE(dir.x() * (v.y() - point.y()) - dir.y() * (v.x() - point.x()), 1e-12) << what;
+    std::vector<Polygon> all = s.left;
+    all.insert(all.end(), s.right.begin(), s.right.end());
+    check_disjoint(all, 1e-9 * area, what + " split");
+    multi_piece_splits += all.size() > 2;
+    two_sided_splits += !s.left.empty() && !s.right.empty();
+
+    const double beta = 2 * kPi * U(rng);
+    const Polygon b = random_star(rng, c + 26 * Vec2(std::cos(beta), std::sin(beta)), 5 + static_cast<int>(U(rng) * 60), 5, 25);
+    const auto in = polygon_intersection(a, b, 0.0);
+    const auto out = polygon_difference(a, b, 0.0);
+    check_pieces(in, what + " a n b");
+    check_pieces(out, what + " a \\ b");
+    // Shared cut vertices: the two results tile a to round-off.
+    EXPECT_NEAR(total_area(in) + total_area(out), area, 1e-12 * area) << what;
+    std::vector<Polygon> cut = in;
+    cut.insert(cut.end(), out.begin(), out.end());
+    check_disjoint(cut, 1e-9 * area, what + " a n b, a \\ b");
+    overlapping_pairs += !in.empty();
+
+    // Deterministic: the same input gives the same bits.
+    const LineSplit s2 = split_by_line(a, point, dir, 0.0);
+    EXPECT_TRUE(s2.left == s.left && s2.right == s.right) << what;
+    EXPECT_TRUE(polygon_difference(a, b, 0.0) == out) << what;
+    if (HasFailure()) return;
+  }
+  // The random cases exercise what they are meant to: non-convex splits and real overlaps.
+  EXPECT_GT(two_sided_splits, 180);
+  EXPECT_GT(multi_piece_splits, 20);
+  EXPECT_GT(overlapping_pairs, 100);
+}
+
+TEST(ChordLength, SquareAndLShape) {
+  const Polygon square{{0, 0}, {2, 0}, {2, 2}, {0, 2}};
+  EXPECT_NEAR(chord_length(square, Vec2(1, 1), Vec2(1, 0)), 2.0, 1e-15);
+  EXPECT_NEAR(chord_length(square, Vec2(1, 1), Vec2(1, 1)), 2 * std::sqrt(2.0), 1e-15);
+  EXPECT_NEAR(chord_length(square, Vec2(0.5, 1.5), Vec2(-3, 0)), 2.0, 1e-15);  // length of dir is irrelevant
+  // A point on the boundary: the chord that starts there, whichever way dir points.
+  EXPECT_NEAR(chord_length(square, Vec2(0, 1), Vec2(1, 0)), 2.0, 1e-15);
+  EXPECT_NEAR(chord_length(square, Vec2(0, 1), Vec2(-1, 0)), 2.0, 1e-15);
+  EXPECT_NEAR(chord_length(square, Vec2(0, 0), Vec2(1, 1)), 2 * std::sqrt(2.0), 1e-15);  // corner to corner
+  EXPECT_NEAR(chord_length(square, Vec2(1, 0), Vec2(1, 0)), 2.0, 1e-15);  // along an edge: the edge
+  EXPECT_EQ(chord_length(square, Vec2(0, 0), Vec2(1, -1)), 0.0);         // grazing a corner
+  EXPECT_EQ(chord_length(square, Vec2(3, 1), Vec2(1, 0)), 0.0);          // outside
+  // L shape: the line x + y = 2.5 (direction (-1, 1)) runs through the bottom arm from (2.5, 0) to (1.5, 1), leaves
+  // the L across its notch and re-enters the vertical arm from (1, 1.5) to (0, 2.5): two chords of sqrt(2) each.
+  const Polygon l{{0, 0}, {3, 0}, {3, 1}, {1, 1}, {1, 3}, {0, 3}};
+  const Vec2 d(-1, 1);
+  EXPECT_NEAR(chord_length(l, Vec2(2, 0.5), d), std::sqrt(2.0), 1e-15);
+  EXPECT_NEAR(chord_length(l, Vec2(0.5, 2), d), std::sqrt(2.0), 1e-15);
+  EXPECT_NEAR(chord_length(l, Vec2(2.5, 0), d), std::sqrt(2.0), 1e-15);
+  EXPECT_EQ(chord_length(l, Vec2(1.25, 1.25), d), 0.0);  // in the notch
+  // Through the reflex corner along the notch's floor: the whole width of the bottom arm.
+  EXPECT_NEAR(chord_length(l, Vec2(0.5, 1), Vec2(1, 0)), 3.0, 1e-15);
+}
+
+TEST(CircularSector, ShapeAndArea) {
+  const Vec2 apex(3, -2);
+  const double r = 5, half = 0.6;
+  const int n = 7;
+  const Polygon s = circular_sector(apex, Vec2(0, 2), half, r, n);  // axis +y, not unit
+  ASSERT_EQ(s.size(), static_cast<size_t>(n + 2));
+  EXPECT_EQ(s[0], apex);
+  EXPECT_TRUE(is_convex(s));
+  // n isosceles triangles of apex angle 2 half / n.
+  EXPECT_NEAR(signed_area(s), 0.5 * r * r * n * std::sin(2 * half / n), 1e-13);
+  for (int k = 1; k <= n + 1; ++k) EXPECT_NEAR((s[k] - apex).norm(), r, 1e-14);
+  // The arc runs from -half to +half about the axis (+y): the first arc vertex is on the right (x > apex.x).
+  EXPECT_NEAR(s[1].x() - apex.x(), r * std::sin(half), 1e-14);
+  EXPECT_NEAR(s[n + 1].x() - apex.x(), -r * std::sin(half), 1e-14);
+  // A half disc is still a valid convex polygon.
+  const Polygon hd = circular_sector(Vec2(0, 0), Vec2(1, 0), kPi / 2, 1, 64);
+  EXPECT_GT(signed_area(hd), 0);
+  EXPECT_TRUE(is_convex(hd));
+  EXPECT_THROW(circular_sector(apex, Vec2(1, 0), 0, r, n), Error);
+  EXPECT_THROW(circular_sector(apex, Vec2(1, 0), 1.6, r, n), Error);
+  EXPECT_THROW(circular_sector(apex, Vec2(0, 0), half, r, n), Error);
+  EXPECT_THROW(circular_sector(apex, Vec2(1, 0), half, -1, n), Error);
+  EXPECT_THROW(circular_sector(apex, Vec2(1, 0), half, r, 0), Error);
 }
 
 }  // namespace

@@ -84,8 +84,13 @@ TEST(Plot, WritesPngSvgCsvAndTheSteadyMean) {
   EXPECT_EQ(j["moving_average"]["window_samples"], 10);
   EXPECT_EQ(j["provenance"]["program"], "floesim-plot");
   // Only the artefacts are left: no working files.
-  EXPECT_EQ(listing(dir / "plots"), (std::vector<std::string>{"plot.json", "surge_ice_load.csv",
-                                                               "surge_ice_load.png", "surge_ice_load.svg"}));
+  EXPECT_EQ(listing(dir / "plots"), (std::vector<std::string>{"fracture_events.csv", "plot.json",
+                                                               "surge_ice_load.csv", "surge_ice_load.png",
+                                                               "surge_ice_load.svg"}));
+  // No fracture: no markers, and a header-only event table.
+  EXPECT_EQ(svg.find("at the vessel"), std::string::npos);
+  EXPECT_EQ(slurp(dir / "plots" / "fracture_events.csv"),
+            "time_s,mode,parent_id,at_structure,force_x_n,force_y_n,force_z_n,threshold_n,children\n");
   fs::remove_all(dir);
 }
 
@@ -125,5 +130,40 @@ TEST(Plot, BadInputNamesTheProblemAndLeavesNothing) {
   expect_error(dir / "results.h5", write_config(dir, R"({"moving_average_window_s": "long"})"),
                "moving_average_window_s");
   expect_error(dir / "results.h5", write_config(dir, R"({"steady_start_s": 1e6})"), "steady");
+  fs::remove_all(dir);
+}
+
+TEST(Plot, FractureEventsAtTheVesselAreMarkedAndAllEventsListed) {
+  const fs::path dir = fresh_dir("plot_fracture");
+  // Splitting at the vessel at 2 s, bending at the vessel at 6 s, radial at a floe-floe contact at 9 s.
+  const Synthetic syn = fractured_synthetic();
+  write_results(dir / "results.h5", make_results(syn));
+  const SurgeLoadSummary s = plot_surge_load(dir / "results.h5", write_config(dir, "{}"), dir / "plots");
+  EXPECT_EQ(s.fracture_events, 3u);
+  EXPECT_EQ(s.vessel_splitting_events, 1u);
+  EXPECT_EQ(s.vessel_bending_radial_events, 1u) << "the radial event between floes is not at the vessel";
+
+  // The legend counts what is marked: one of each style (the floe-floe event is not marked).
+  const std::string svg = slurp(dir / "plots" / "surge_ice_load.svg");
+  EXPECT_NE(svg.find("fracture by splitting at the vessel: 1 event"), std::string::npos);
+  EXPECT_NE(svg.find("fracture by bending or radial cracking at the vessel: 1 event"), std::string::npos);
+
+  // One CSV row per event, equal to the events.
+  std::istringstream rows(slurp(dir / "plots" / "fracture_events.csv"));
+  std::string row;
+  std::getline(rows, row);
+  EXPECT_EQ(row, "time_s,mode,parent_id,at_structure,force_x_n,force_y_n,force_z_n,threshold_n,children");
+  std::vector<std::string> got;
+  while (std::getline(rows, row)) got.push_back(row);
+  EXPECT_EQ(got, (std::vector<std::string>{"2,splitting,1,1,-1800000,200000,-10000,1700000,2 3",
+                                           "6,bending,3,1,-300000,10000,-450000,420000,4",
+                                           "9,radial,5,0,20000,-10000,-250000,240000,6"}));
+  ASSERT_EQ(got.size(), syn.events.size());
+
+  const auto j = nlohmann::json::parse(slurp(dir / "plots" / "plot.json"));
+  EXPECT_EQ(j["fracture"]["events"], 3);
+  EXPECT_EQ(j["fracture"]["at_vessel"]["splitting"], 1);
+  EXPECT_EQ(j["fracture"]["at_vessel"]["bending_or_radial"], 1);
+  EXPECT_NE(std::find(j["files"].begin(), j["files"].end(), "fracture_events.csv"), j["files"].end());
   fs::remove_all(dir);
 }

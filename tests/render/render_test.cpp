@@ -80,6 +80,61 @@ TEST(Render, TopViewShowsFloesWhereTheyAreAndWaterElsewhere) {
   EXPECT_EQ(scene.last_stats().floes_culled, 1u) << "the floe at x = 150 m lies outside the 200 m wide view";
 }
 
+TEST(Render, PiecesOfBrokenFloesShowTheTintOfTheirFractureAndTheBrokenFloeIsGone) {
+  const Results r = make_results(fractured_synthetic());
+  const RenderOptions o = small_top_view();
+  SceneRenderer scene(r, o, "synthetic");
+  cv::Mat before, after;
+  scene.render(1, before);  // t = 1 s: floe 1 whole
+  scene.render(3, after);   // t = 3 s: split at t = 2 s into pieces 2 (centre 60, -8) and 3 (60, 8)
+  const cv::Vec3d was = patch(before, top_view_pixel(r, o, 1, 60, -8));
+  const cv::Vec3d piece = patch(after, top_view_pixel(r, o, 3, 60, -8));
+  // BGR. Before: the near-white input floe, red and blue alike. After: amber, red well above blue.
+  EXPECT_TRUE(bright(was)) << was;
+  EXPECT_LT(std::abs(was[2] - was[0]), 20.0) << "an input floe is not tinted: " << was;
+  EXPECT_GT(piece[2], piece[0] + 60) << "a splitting piece is amber: " << piece;
+  EXPECT_GT(piece[2], 170.0) << piece;
+  const cv::Vec3d north = patch(after, top_view_pixel(r, o, 3, 60, 8));
+  EXPECT_GT(north[2], north[0] + 60) << "piece 3: " << north;
+  // The crack between the pieces: floe 1 is no longer drawn, water shows.
+  EXPECT_TRUE(bright(patch(before, top_view_pixel(r, o, 1, 60, 0))));
+  EXPECT_TRUE(dark(patch(after, top_view_pixel(r, o, 3, 60, 0)))) << patch(after, top_view_pixel(r, o, 3, 60, 0));
+
+  // Bending (piece 4 of piece 3, generation 2, from t = 6 s) and radial (piece 6 of floe 5, from t = 9 s): blue.
+  cv::Mat img;
+  scene.render(7, img);
+  const cv::Vec3d wedge = patch(img, top_view_pixel(r, o, 7, 60, 8));
+  EXPECT_GT(wedge[0], wedge[2] + 30) << "a bending piece is light blue: " << wedge;
+  scene.render(10, img);
+  const cv::Vec3d radial = patch(img, top_view_pixel(r, o, 10, -40, -50));
+  EXPECT_GT(radial[0], radial[2] + 30) << "a radial piece is light blue: " << radial;
+  EXPECT_EQ(scene.last_stats().floes_drawn + scene.last_stats().floes_culled, 3u) << "pieces 2, 4 and 6 at t = 10 s";
+}
+
+TEST(Render, PieceColoursFollowTheModeAndDarkenPerGenerationUpToALimit) {
+  const RenderOptions o;
+  float input[3], top[3], bend[3], radial[3], split1[3], split2[3], split4[3], split9[3], amber[3];
+  floe_top_colour(o, kFractureNone, 0, input);
+  parse_hex_colour(o.floe_top_colour, top);
+  parse_hex_colour(o.splitting_piece_colour, amber);
+  floe_top_colour(o, kFractureBending, 1, bend);
+  floe_top_colour(o, kFractureRadial, 1, radial);
+  floe_top_colour(o, kFractureSplitting, 1, split1);
+  floe_top_colour(o, kFractureSplitting, 2, split2);
+  floe_top_colour(o, kFractureSplitting, 4, split4);
+  floe_top_colour(o, kFractureSplitting, 9, split9);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_FLOAT_EQ(input[i], top[i]) << "input floes keep floe_top_colour";
+    EXPECT_FLOAT_EQ(bend[i], radial[i]) << "bending and radial pieces share a colour";
+    EXPECT_FLOAT_EQ(split1[i], amber[i]);
+    EXPECT_LT(split2[i], split1[i]) << "a piece of a piece is darker than its parent";
+    EXPECT_FLOAT_EQ(split9[i], split4[i]) << "darkening stops at generation 4";
+    EXPECT_GT(split4[i], 0.4f * split1[i]) << "never near the water's colour";
+  }
+  EXPECT_GT(bend[2], bend[0]) << "bending pieces are bluish";
+  EXPECT_GT(split1[0], split1[2]) << "splitting pieces are amber";
+}
+
 TEST(Render, ChaseViewShowsSkyWaterIceAndTheRedHull) {
   const Results r = make_results(default_synthetic());
   RenderOptions o;
