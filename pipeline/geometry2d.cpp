@@ -288,28 +288,36 @@ using BgPoint = bg::model::d2::point_xy<double>;
 using BgPolygon = bg::model::polygon<BgPoint, /*ClockWise=*/false, /*Closed=*/true>;
 using BgMulti = bg::model::multi_polygon<BgPolygon>;
 
-// An operand of an overlay: its ring with repeated vertices dropped (what results are snapped back onto), and the
-// same ring as Boost's polygon, oriented and closed.
-struct Operand {
+// An input ring with repeated vertices dropped (consecutive and closing), checked for finite coordinates and size.
+Polygon distinct_ring(const Polygon& in, const char* what) {
   Polygon ring;
-  BgPolygon bg;
-};
-
-Operand prepare(const Polygon& in, const char* what) {
-  Operand o;
   for (const Vec2& v : in) {
     FLOESIM_REQUIRE(v.allFinite(), what, ": polygon has a non-finite vertex");
-    if (o.ring.empty() || v != o.ring.back()) o.ring.push_back(v);
+    if (ring.empty() || v != ring.back()) ring.push_back(v);
   }
-  while (o.ring.size() > 1 && o.ring.front() == o.ring.back()) o.ring.pop_back();
-  FLOESIM_REQUIRE(o.ring.size() >= 3, what, ": a polygon needs at least 3 distinct vertices, got ", o.ring.size());
-  for (const Vec2& v : o.ring) bg::append(o.bg.outer(), BgPoint(v.x(), v.y()));
-  bg::append(o.bg.outer(), BgPoint(o.ring[0].x(), o.ring[0].y()));
-  bg::correct(o.bg);  // orientation (either is accepted) and closure
-  // A self-intersecting ring makes the overlay meaningless; say so instead of returning garbage.
+  while (ring.size() > 1 && ring.front() == ring.back()) ring.pop_back();
+  FLOESIM_REQUIRE(ring.size() >= 3, what, ": a polygon needs at least 3 distinct vertices, got ", ring.size());
+  return ring;
+}
+
+// The ring as Boost's polygon, oriented and closed, and checked: a self-intersecting ring makes an overlay
+// meaningless, so say so instead of returning garbage.
+BgPolygon to_boost(const Polygon& ring, const char* what) {
+  BgPolygon g;
+  for (const Vec2& v : ring) bg::append(g.outer(), BgPoint(v.x(), v.y()));
+  bg::append(g.outer(), BgPoint(ring[0].x(), ring[0].y()));
+  bg::correct(g);  // orientation (either is accepted) and closure
   std::string why;
-  FLOESIM_REQUIRE(bg::is_valid(o.bg, why), what, ": input polygon is not simple (", why, ")");
-  return o;
+  FLOESIM_REQUIRE(bg::is_valid(g, why), what, ": input polygon is not simple (", why, ")");
+  return g;
+}
+
+// Largest coordinate magnitude or extent of the rings: round-off of anything computed from them scales with it.
+double coordinate_scale(const Polygon& a, const Polygon& b) {
+  Vec2 lo = a[0], hi = a[0];
+  for (const Polygon* p : {&a, &b})
+    for (const Vec2& v : *p) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  return std::max({lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff(), (hi - lo).maxCoeff()});
 }
 
 bool lex_less(const Vec2& u, const Vec2& v) { return u.x() < v.x() || (u.x() == v.x() && u.y() < v.y()); }
@@ -334,10 +342,7 @@ class Snapper {
     vertices_ = a;
     vertices_.insert(vertices_.end(), b.begin(), b.end());
     std::sort(vertices_.begin(), vertices_.end(), lex_less);
-    Vec2 lo = vertices_[0], hi = vertices_[0];
-    for (const Vec2& v : vertices_) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
-    // Round-off of a crossing computed from coordinates of this magnitude is a few ulps of the largest of them.
-    const double scale = std::max({lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff(), (hi - lo).maxCoeff()});
+    const double scale = coordinate_scale(a, b);
     vertex_tol_ = 1e-12 * scale;
     crossing_tol_ = 1e-9 * scale;
   }
@@ -384,6 +389,56 @@ class Snapper {
   double vertex_tol_ = 0, crossing_tol_ = 0;
 };
 
+// Puts the vertices of q that lie on an edge of p (within tol, away from its ends) into that edge, in order.
+void insert_touching(Polygon& p, const Polygon& q, double tol) {
+  Polygon out;
+  std::vector<std::pair<double, Vec2>> on;
+  for (size_t i = 0; i < p.size(); ++i) {
+    const Vec2 u = p[i], v = p[(i + 1) % p.size()], e = v - u;
+    out.push_back(u);
+    on.clear();
+    for (const Vec2& w : q)
+      if ((w - u).norm() > tol && (w - v).norm() > tol && segment_distance(w, u, v) <= tol)
+        on.emplace_back((w - u).dot(e) / e.squaredNorm(), w);
+    std::sort(on.begin(), on.end(), [](const auto& x, const auto& y) {
+      return x.first < y.first || (x.first == y.first && lex_less(x.second, y.second));
+    });
+    for (const auto& tw : on)
+      if (tw.second != out.back()) out.push_back(tw.second);
+  }
+  p = std::move(out);
+}
+
+// The two operands of an overlay, made consistent with each other before Boost sees them. Boost 1.74's
+// floating-point overlay misjudges a vertex of one polygon that lies on an edge of the other but misses it by an
+// ulp, as the vertices of a piece cut from a floe lie on the floe's edges (the area of a \ piece came out at twice
+// a's). So a vertex within round-off of the other polygon's vertex becomes that vertex, and one on the other's edge
+// becomes a vertex of that edge too: touching is then exact, which Boost decides correctly.
+struct Overlay {
+  Polygon a, b;
+  BgPolygon bg_a, bg_b;
+};
+
+Overlay make_overlay(const Polygon& a_in, const Polygon& b_in, const char* what) {
+  Overlay o;
+  o.a = distinct_ring(a_in, what);
+  o.b = distinct_ring(b_in, what);
+  const double tol = 1e-10 * coordinate_scale(o.a, o.b);
+  for (Vec2& w : o.b)
+    for (const Vec2& v : o.a)
+      if ((w - v).cwiseAbs().maxCoeff() <= tol) {
+        w = v;
+        break;
+      }
+  o.b = distinct_ring(o.b, what);
+  const Polygon a0 = o.a;
+  insert_touching(o.a, o.b, tol);
+  insert_touching(o.b, a0, tol);
+  o.bg_a = to_boost(o.a, what);
+  o.bg_b = to_boost(o.b, what);
+  return o;
+}
+
 double ring_area(const BgPolygon::ring_type& r) { return std::abs(bg::area(r)); }
 
 // Removes the tips of zero-width spikes (the path runs out and straight back, within tol metres) and repeated
@@ -428,21 +483,36 @@ void split_pinches(const Polygon& p, std::vector<Polygon>& out) {
   out.push_back(p);
 }
 
+// What a result leaves out of its pieces, so that a cut can still be checked against the whole: slivers dropped
+// (area to add back) and holes (area inside a piece's outer ring that is not part of it).
+struct Leftover {
+  double dropped = 0, holes = 0;
+};
+
 // Candidate rings (CCW where they are pieces) as the results we promise: spikes and pinches resolved, cleaned,
-// slivers below min_area_m2 dropped (their area added to `dropped`), simple, each starting at its smallest vertex,
-// sorted. A clockwise loop of at least min_area_m2 is a hole touching the boundary: an error.
+// slivers (below min_area_m2, or of zero width) dropped, simple, each starting at its smallest vertex, sorted. A
+// clockwise loop that is not a sliver is a hole touching the outer ring.
 std::vector<Polygon> finish(const std::vector<Polygon>& candidates, double min_area_m2, const char* what,
-                            double& dropped) {
+                            Leftover& left) {
   std::vector<Polygon> out, rings;
   for (const Polygon& c : candidates) {
     rings.clear();
     split_pinches(remove_spikes(c, 1e-9), rings);
     for (Polygon& q : rings) {
       q = clean_polygon(q);
-      const double area = q.size() < 3 ? 0.0 : signed_area(q);
-      FLOESIM_REQUIRE(area > -min_area_m2, what, ": the result has a hole of ", -area, " m^2");
-      if (area < min_area_m2 || area <= 0) {
-        dropped += std::abs(area);
+      if (q.size() < 3) continue;
+      const double area = signed_area(q);
+      // A ring no wider than clean_polygon's 1e-9 m has an area below 1e-9 m times its extent: a zero-width
+      // sliver, whatever its sign, never a piece or a hole.
+      Vec2 lo = q[0], hi = q[0];
+      for (const Vec2& v : q) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+      const double sliver = std::max(min_area_m2, 1e-9 * (hi - lo).maxCoeff());
+      if (area < -sliver) {
+        left.holes -= area;
+        continue;
+      }
+      if (area < sliver) {
+        left.dropped += area;
         continue;
       }
       // Boost 1.74's floating-point overlay can, in nearly degenerate configurations, return a self-intersecting
@@ -465,21 +535,25 @@ std::vector<Polygon> finish(const std::vector<Polygon>& candidates, double min_a
   return out;
 }
 
-// Boost's result as our polygons: holes refused, closing vertex dropped, vertices snapped, then finish().
+// Boost's result as our polygons: holes counted, closing vertex dropped, vertices snapped, then finish().
 std::vector<Polygon> from_boost(const BgMulti& m, const Snapper& snap, double min_area_m2, const char* what,
-                                double& dropped) {
+                                Leftover& left) {
   std::vector<Polygon> candidates;
   for (const BgPolygon& g : m) {
     for (const auto& hole : g.inners()) {
-      FLOESIM_REQUIRE(ring_area(hole) < min_area_m2, what, ": the result has a hole of ", ring_area(hole), " m^2");
-      dropped -= ring_area(hole);  // the outer ring's area counts it
+      // A hole below min_area_m2 is a sliver: the piece keeps its outer ring, which counts the hole's area.
+      const double h = ring_area(hole);
+      if (h < min_area_m2)
+        left.dropped -= h;
+      else
+        left.holes += h;
     }
     Polygon p;
     const auto& r = g.outer();
     for (size_t i = 0; i + 1 < r.size(); ++i) p.push_back(snap(Vec2(bg::get<0>(r[i]), bg::get<1>(r[i]))));
     candidates.push_back(std::move(p));
   }
-  return finish(candidates, min_area_m2, what, dropped);
+  return finish(candidates, min_area_m2, what, left);
 }
 
 double total_area(const std::vector<Polygon>& pieces) {
@@ -490,42 +564,57 @@ double total_area(const std::vector<Polygon>& pieces) {
 
 // The pieces of one cut must tile the polygon: a floating-point overlay that went wrong in a nearly degenerate
 // configuration shows up here, and the caller gets an error (no cut) instead of ice created or lost.
-void require_tiling(double whole, double pieces, double dropped, const char* what) {
-  FLOESIM_REQUIRE(std::abs(pieces + dropped - whole) <= 1e-9 * std::abs(whole), what,
-                  ": the pieces do not add up to the polygon (", pieces, " + ", dropped, " dropped vs ", whole,
-                  " m^2)");
+void require_tiling(double whole, double pieces, const Leftover& left, const char* what) {
+  const double net = pieces + left.dropped - left.holes;
+  FLOESIM_REQUIRE(std::abs(net - whole) <= 1e-9 * std::abs(whole), what, ": the pieces do not add up to the polygon (",
+                  pieces, " + ", left.dropped, " dropped - ", left.holes, " holes vs ", whole, " m^2)");
+}
+
+// Intersection and difference from one prepared overlay, snapped alike and checked to tile a (holes included).
+struct CheckedCut {
+  PolygonCut cut;
+  Leftover in, out;
+};
+
+CheckedCut checked_cut(const Polygon& a, const Polygon& b, double min_area_m2, const char* what) {
+  const Overlay o = make_overlay(a, b, what);
+  const Snapper snap(o.a, o.b);
+  BgMulti in, out;
+  bg::intersection(o.bg_a, o.bg_b, in);
+  bg::difference(o.bg_a, o.bg_b, out);
+  CheckedCut c;
+  c.cut.inside = from_boost(in, snap, min_area_m2, what, c.in);
+  c.cut.outside = from_boost(out, snap, min_area_m2, what, c.out);
+  const Leftover both{c.in.dropped + c.out.dropped, c.in.holes + c.out.holes};
+  require_tiling(std::abs(signed_area(o.a)), total_area(c.cut.inside) + total_area(c.cut.outside), both, what);
+  return c;
+}
+
+void require_no_hole(const Leftover& left, const char* what) {
+  FLOESIM_REQUIRE(left.holes == 0, what, ": the result has a hole of ", left.holes, " m^2");
 }
 
 }  // namespace
 
+// Both parts are always computed: the check that they tile a is what catches a failed overlay, and it costs one
+// more overlay per cut, which is rare.
 std::vector<Polygon> polygon_intersection(const Polygon& a, const Polygon& b, double min_area_m2) {
-  const Operand oa = prepare(a, "polygon_intersection"), ob = prepare(b, "polygon_intersection");
-  BgMulti out;
-  bg::intersection(oa.bg, ob.bg, out);
-  double dropped = 0;
-  return from_boost(out, Snapper(oa.ring, ob.ring), min_area_m2, "polygon_intersection", dropped);
+  CheckedCut c = checked_cut(a, b, min_area_m2, "polygon_intersection");
+  require_no_hole(c.in, "polygon_intersection");
+  return std::move(c.cut.inside);
 }
 
 std::vector<Polygon> polygon_difference(const Polygon& a, const Polygon& b, double min_area_m2) {
-  const Operand oa = prepare(a, "polygon_difference"), ob = prepare(b, "polygon_difference");
-  BgMulti out;
-  bg::difference(oa.bg, ob.bg, out);
-  double dropped = 0;
-  return from_boost(out, Snapper(oa.ring, ob.ring), min_area_m2, "polygon_difference", dropped);
+  CheckedCut c = checked_cut(a, b, min_area_m2, "polygon_difference");
+  require_no_hole(c.out, "polygon_difference");
+  return std::move(c.cut.outside);
 }
 
 PolygonCut cut_polygon(const Polygon& a, const Polygon& b, double min_area_m2) {
-  const Operand oa = prepare(a, "cut_polygon"), ob = prepare(b, "cut_polygon");
-  const Snapper snap(oa.ring, ob.ring);
-  BgMulti in, out;
-  bg::intersection(oa.bg, ob.bg, in);
-  bg::difference(oa.bg, ob.bg, out);
-  double dropped = 0;
-  PolygonCut cut{from_boost(in, snap, min_area_m2, "cut_polygon", dropped),
-                 from_boost(out, snap, min_area_m2, "cut_polygon", dropped)};
-  require_tiling(std::abs(signed_area(oa.ring)), total_area(cut.inside) + total_area(cut.outside), dropped,
-                 "cut_polygon");
-  return cut;
+  CheckedCut c = checked_cut(a, b, min_area_m2, "cut_polygon");
+  require_no_hole(c.in, "cut_polygon");
+  require_no_hole(c.out, "cut_polygon");
+  return std::move(c.cut);
 }
 
 LineSplit split_by_line(const Polygon& in, const Vec2& point, const Vec2& dir, double min_area_m2) {
@@ -534,12 +623,18 @@ LineSplit split_by_line(const Polygon& in, const Vec2& point, const Vec2& dir, d
   // Our own walk rather than an overlay with a half-plane: Boost 1.74's floating-point overlay misjudges a line
   // through a vertex (the half-plane's edge then misses the vertex by an ulp), which is exactly where cracks from
   // contacts at vertices run. Here every decision is the sign of one number per vertex, computed once.
-  Polygon p = prepare(in, "split_by_line").ring;  // validates: finite, >= 3 distinct vertices, simple
+  Polygon p = distinct_ring(in, "split_by_line");
+  to_boost(p, "split_by_line");  // validates: simple
   make_ccw(p);
   const size_t n = p.size();
   const Vec2 d = dir.normalized();
   std::vector<double> s(n), t(n);  // signed distance to the line (> 0 left) and position along it
-  for (size_t i = 0; i < n; ++i) s[i] = cross(d, p[i] - point), t[i] = d.dot(p[i] - point);
+  for (size_t i = 0; i < n; ++i) {
+    s[i] = cross(d, p[i] - point), t[i] = d.dot(p[i] - point);
+    // Within clean_polygon's 1e-9 m is on the line: a vertex an ulp to one side would leave a piece with a neck of
+    // that width (valid, but a trap for any later overlay); on the line, the pinch is resolved below.
+    if (std::abs(s[i]) <= 1e-9) s[i] = 0;
+  }
   // Simulation of simplicity: a vertex on the line (s = 0) counts as left, as if the line were moved right by an
   // infinitesimal amount. No vertex is then on the line, every crossing is a proper one, and along the line the
   // crossings alternate between leaving and entering the polygon (Jordan). Zero-width spikes and sliver pieces
@@ -620,10 +715,11 @@ LineSplit split_by_line(const Polygon& in, const Vec2& point, const Vec2& dir, d
     }
     (side ? left : right).push_back(std::move(piece));
   }
-  double dropped = 0;
-  LineSplit out{finish(left, min_area_m2, "split_by_line", dropped),
-                finish(right, min_area_m2, "split_by_line", dropped)};
-  require_tiling(signed_area(p), total_area(out.left) + total_area(out.right), dropped, "split_by_line");
+  Leftover leftover;
+  LineSplit out{finish(left, min_area_m2, "split_by_line", leftover),
+                finish(right, min_area_m2, "split_by_line", leftover)};
+  require_no_hole(leftover, "split_by_line");  // a side of a line has no hole; this would be a bug
+  require_tiling(signed_area(p), total_area(out.left) + total_area(out.right), leftover, "split_by_line");
   return out;
 }
 

@@ -23,24 +23,25 @@ std::vector<Polygon> convex_decompose(const Polygon& ccw_simple_polygon);
 
 // ---- Cutting floes (Boost.Geometry inside; no Boost type appears here) ----
 // Boolean operations on simple polygons (either orientation; a self-intersecting input throws floesim::Error).
-// Results: simple CCW polygons, cleaned (clean_polygon), pieces below min_area_m2 dropped, each ring starting at
-// its lexicographically smallest (x, y) vertex and the pieces sorted by that vertex, so the same input gives the
-// same output bits. A result with a hole of at least min_area_m2 throws floesim::Error (callers treat it as
-// "no cut"). The intersection and the difference of the same pair share their cut vertices bit for bit, so
-// area(a) = area(a n b) + area(a \ b) to round-off.
+// Results: simple CCW polygons, cleaned (clean_polygon), pieces below min_area_m2 (or of zero width) dropped, each
+// ring starting at its lexicographically smallest (x, y) vertex and the pieces sorted by that vertex, so the same
+// input gives the same output bits. Two pieces that touch at a point are two pieces. A result with a hole throws
+// floesim::Error (callers treat it as "no cut"). The intersection and the difference of the same pair share their
+// cut vertices bit for bit, so area(a) = area(a n b) + area(a \ b) to round-off; that is checked on every call
+// (both are computed), and a violation throws floesim::Error: Boost 1.74's floating-point overlay can fail in a
+// nearly degenerate configuration (a polygon whose vertices lie on the other's edges to within an ulp, such as a
+// piece cut from it), and a failed cut must be no cut rather than ice created or lost.
 std::vector<Polygon> polygon_intersection(const Polygon& a, const Polygon& b, double min_area_m2 = 1e-9);
 std::vector<Polygon> polygon_difference(const Polygon& a, const Polygon& b, double min_area_m2 = 1e-9);
-// a n b and a \ b together, checked against each other: their areas (with any dropped slivers) must add up to a's
-// to 1e-9 relative, else floesim::Error. Boost 1.74's floating-point overlay can go wrong in nearly degenerate
-// configurations; this is what a caller that cuts a floe in two should use, so that a bad cut is no cut.
+// Both of the above from one overlay, for a caller that keeps both parts (a floe and the piece broken off it).
 struct PolygonCut {
   std::vector<Polygon> inside, outside;  // a n b, a \ b
 };
 PolygonCut cut_polygon(const Polygon& a, const Polygon& b, double min_area_m2 = 1e-9);
 // Splits a simple polygon by the infinite line through `point` with direction `dir`: pieces left of the line
-// (cross(dir, x - point) > 0) and right of it, cleaned and ordered as above. Not an overlay but a walk along the
-// ring with one side test per vertex, robust for lines through vertices and along edges. The areas add up to the
-// polygon's to round-off (with any dropped slivers; checked, else floesim::Error).
+// (cross(dir, x - point) > 0) and right of it, cleaned and ordered as above; a vertex within 1e-9 m of the line is
+// on it. Not an overlay but a walk along the ring with one side test per vertex, so it is robust for lines through
+// vertices and along edges. The areas add up to the polygon's to round-off (checked, else floesim::Error).
 struct LineSplit {
   std::vector<Polygon> left, right;
 };

@@ -32,6 +32,8 @@
 //   /fracture/brash_mass_kg      [E]      float64   mass of pieces below the minimum size, removed (counted here)
 //   /fracture/child_offset       [E+1]    int64     pieces of event k: child_id[offset[k] .. offset[k+1]-1]
 //   /fracture/child_id           [C]      int32     floe ids of the pieces that became bodies
+//   Layout "floesim-results/2" (this one) added /fracture and the lineage datasets; "/1" files are still read
+//   (input floes only, no events).
 //   attribute "floesim" on the root: JSON text with layout version, time_step_s, duration_s,
 //   output_interval_s and the provenance.
 #pragma once

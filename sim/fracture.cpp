@@ -161,11 +161,10 @@ std::vector<Polygon> cut(const Body& body, const Candidate& c, const FractureOpt
       // the inward normal, the circumferential crack on the arc R_b beyond the load point.
       const Vec2 apex = c.point - c.apex_distance * c.direction;
       const Polygon sector = circular_sector(apex, c.direction, 0.5 * c.theta, c.apex_distance + c.rb, 16);
-      const std::vector<Polygon> wedge = polygon_intersection(body.outline, sector);
-      const std::vector<Polygon> rest = polygon_difference(body.outline, sector);
-      if (wedge.empty() || rest.empty()) return {};
-      pieces = wedge;
-      pieces.insert(pieces.end(), rest.begin(), rest.end());
+      const PolygonCut wedge = cut_polygon(body.outline, sector);
+      if (wedge.inside.empty() || wedge.outside.empty()) return {};
+      pieces = wedge.inside;
+      pieces.insert(pieces.end(), wedge.outside.begin(), wedge.outside.end());
     }
   } catch (const Error&) {
     return {};  // a cut the boolean operations cannot represent (a hole): the floe stays whole this step

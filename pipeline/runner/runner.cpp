@@ -239,11 +239,13 @@ std::vector<Artefact> prepare_run(const RunOptions& o) {
     FLOESIM_REQUIRE(p.is_object(), cf, ": plot must be an object");
     const fs::path dir = run / "plots";
     Stage st{"plot", "surge ice load plots", {results, stage_config("plot", p)},
-             {dir / "surge_ice_load.png", dir / "surge_ice_load.svg"}, bin / "floesim-plot", ""};
+             {dir / "surge_ice_load.png", dir / "surge_ice_load.svg", dir / "fracture_events.csv"},
+             bin / "floesim-plot", ""};
     st.args = "--results " + sh(results) + " --config " + sh(st.inputs[1]) + " --out " + sh(dir);
     stages.push_back(st);
     arts.push_back({"plot", "plots/surge_ice_load.png", "surge ice load, moving average and mean (PNG)"});
     arts.push_back({"plot", "plots/surge_ice_load.svg", "the same (SVG)"});
+    arts.push_back({"plot", "plots/fracture_events.csv", "every fracture event: time, mode, floe, force, children"});
   }
 
   // --- the Ninja file ---
