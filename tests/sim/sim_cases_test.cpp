@@ -100,10 +100,12 @@ TEST(SimCases, FloesGivenDirectlySkipImageAndDigitise) {
   fs::remove_all(root);
 }
 
-// The single-floe case: struck on its south-west part by the port bow shoulder (the floe's centre is to port of
-// the track), the floe is pushed ahead and to port and turns counter-clockwise (the contact force acts south of its
-// centre: a positive yaw moment); the vessel carries the crushing load only while they touch.
-TEST(SimCases, SingleFloeStruckOffCentreTurnsAndIsPushedToPort) {
+// The single-floe case (the seed's Fig. 8, off-centre collision): struck on its south-west part by the port bow
+// shoulder (the floe's centre is to port of the track), the floe fails locally in bending at the flared bow (a wedge
+// breaks off, and the broken ice under the bow breaks further), and what is left of it (by far the largest piece) is
+// pushed ahead and to port and turns counter-clockwise (the contact force acts south of its centre); the ice mass
+// is kept (pieces + brash); the vessel carries the crushing load only while they touch.
+TEST(SimCases, SingleFloeStruckOffCentreBendsAtTheBowAndIsPushedToPort) {
   const fs::path dir = kSource / "cases" / "single-floe-offcentre";
   const Json c = load_json_file(dir / "case.json");
   SimulateOptions o = read_options<SimulateOptions>(c["simulate"], "case.json", "simulate");
@@ -119,6 +121,7 @@ TEST(SimCases, SingleFloeStruckOffCentreTurnsAndIsPushedToPort) {
   }
   const Model m = build_model(field, &hull, o);
   ASSERT_EQ(m.floe_count(), 1);  // not removed: the vessel starts clear of it
+  ASSERT_TRUE(m.options.fracture.enabled);
   World w(m);
   const Vec3 x0 = w.state().position[1];
   double peak = 0;
@@ -128,16 +131,34 @@ TEST(SimCases, SingleFloeStruckOffCentreTurnsAndIsPushedToPort) {
     if (w.report().vessel_contacts > 0) ++contact_steps;
     peak = std::max(peak, -w.report().ice_load.force.dot(w.state().orientation[0] * Vec3::UnitX()));
   }
-  const Mat3 R = w.state().orientation[1].toRotationMatrix();
+  // The largest floe alive at the end, and the ice mass (alive + brash) against the floe's.
+  const Model& wm = w.model();
+  int big = -1;
+  double mass = w.brash_mass_kg();
+  for (size_t b = 0; b < wm.bodies.size(); ++b) {
+    if (wm.bodies[b].kind != BodyKind::floe || !w.state().alive[b]) continue;
+    mass += wm.bodies[b].mass_kg;
+    if (big < 0 || wm.bodies[b].section_area > wm.bodies[big].section_area) big = static_cast<int>(b);
+  }
+  ASSERT_GE(big, 0);
+  int bending_of_floe1 = 0;
+  for (const FractureEvent& e : w.fracture_events())
+    bending_of_floe1 += e.parent_id == 1 && e.at_structure && e.mode != kFractureSplitting;
+  const Mat3 R = w.state().orientation[big].toRotationMatrix();
   const double yaw = std::atan2(R(1, 0), R(0, 0)) * 180 / 3.14159265358979323846;
-  const Vec3 d = w.state().position[1] - x0;
-  std::printf("[measured] %d steps in contact, peak surge ice load %.0f kN; floe moved (%.1f, %.1f) m, yaw %+.1f deg\n",
-              contact_steps, peak / 1e3, d.x(), d.y(), yaw);
-  EXPECT_GT(contact_steps, 300);  // several seconds of contact
-  EXPECT_GT(d.x(), 20);           // pushed ahead
-  EXPECT_GT(d.y(), 5);            // and to port
-  EXPECT_GT(yaw, 10);             // turned counter-clockwise
-  EXPECT_LT(peak, 2e7);           // compliant contact: bounded (sigma_c x the contact area of a 1 m thick edge)
+  const Vec3 d = w.state().position[big] - x0;
+  std::printf("[measured] %d steps in contact, peak surge ice load %.0f kN, %zu fracture events; largest piece "
+              "(%.0f of %.0f m^2) moved (%.1f, %.1f) m, yaw %+.1f deg\n",
+              contact_steps, peak / 1e3, w.fracture_events().size(), wm.bodies[big].section_area,
+              m.bodies[1].section_area, d.x(), d.y(), yaw);
+  EXPECT_GT(contact_steps, 100);                     // a second or more of contact
+  EXPECT_EQ(bending_of_floe1, 1);                    // the floe itself fails once, in bending at the bow
+  EXPECT_GT(wm.bodies[big].section_area, 0.9 * m.bodies[1].section_area);  // the wedges are small (l_c = 14.6 m)
+  EXPECT_NEAR(mass, m.bodies[1].mass_kg, 1e-9 * m.bodies[1].mass_kg);
+  EXPECT_GT(d.x(), 10);                              // pushed ahead
+  EXPECT_GT(d.y(), 5);                               // and to port
+  EXPECT_GT(yaw, 10);                                // turned counter-clockwise
+  EXPECT_LT(peak, 2e7);  // compliant contact: bounded (sigma_c x the contact area of a 1 m thick edge)
 }
 
 
@@ -167,11 +188,15 @@ TEST(SimBench, GeneratedFieldsAndLastLine) {
     }
   }
   std::printf("[measured] fields: %d floes (c = %.3f), %d floes (c = %.3f); last line '%s'\n", floes.at(0), conc.at(0),
-              floes.at(1), conc.at(1), last.c_str());
-  ASSERT_EQ(floes.size(), 2u) << out;
+              floes.at(2), conc.at(2), last.c_str());
+  // The Oden-size field without and with fracture (the same field), then the 4x field with fracture.
+  ASSERT_EQ(floes.size(), 3u) << out;
+  EXPECT_EQ(floes[0], floes[1]);
   EXPECT_GT(floes[0], 700);
   EXPECT_LT(floes[0], 1300);
-  EXPECT_NEAR(floes[1] / double(floes[0]), 4.0, 0.5);
+  EXPECT_NEAR(floes[2] / double(floes[0]), 4.0, 0.5);
+  EXPECT_NE(out.find("\nfracture_speed_ratio "), std::string::npos) << out;
+  EXPECT_NE(out.find("  fracture: "), std::string::npos) << out;
   for (double c : conc) EXPECT_NEAR(c, 0.60, 0.01);
   EXPECT_EQ(last.rfind("realtime_factor ", 0), 0u) << last;
   EXPECT_GT(std::stod(last.substr(16)), 0.0);
