@@ -80,15 +80,22 @@ Candidate evaluate(const Model& model, const State& state, const PairLoad& pl, l
   }
   c.width = width;
 
-  // 1. Out-of-plane: radial cracks at P_r, the wedge's circumferential crack at P_f; the larger governs (§2.3).
+  // The plate's wedge under this load (§2.1): it sets the bending threshold and the piece, and its R_b is the
+  // smallest floe that still splits (below).
   const double rho_w_g = model.options.water.density_kg_m3 * model.options.water.gravity_mps2;
+  double lc = 0, theta = 0, alpha = 0;
+  WedgeFailure wf;
+  if (rho_w_g > 0) {
+    lc = characteristic_length_m(fo.youngs_modulus_pa, fo.poisson_ratio, h, rho_w_g);
+    theta = wedge_angle_rad(fo, body.id, step);
+    alpha = width / (theta * lc);  // a = w / theta: the load spread over the wedge's arc
+    wf = wedge_failure(theta, fo.flexural_strength_pa, h, alpha);
+  }
+
+  // 1. Out-of-plane: radial cracks at P_r, the wedge's circumferential crack at P_f; the larger governs (§2.3).
   double r_bend = 0;
   Candidate bend = c;
   if (edge && f_v > 0 && rho_w_g > 0) {
-    const double lc = characteristic_length_m(fo.youngs_modulus_pa, fo.poisson_ratio, h, rho_w_g);
-    const double theta = wedge_angle_rad(fo, body.id, step);
-    const double alpha = width / (theta * lc);  // a = w / theta: the load spread over the wedge's arc
-    const WedgeFailure wf = wedge_failure(theta, fo.flexural_strength_pa, h, alpha);
     const double pr = radial_crack_load_n(fo.flexural_strength_pa, h, width / lc);
     double rb = wf.rb_over_lc * lc;
     if (fo.speed_correction) {
@@ -129,7 +136,11 @@ Candidate evaluate(const Model& model, const State& state, const PairLoad& pl, l
       at = c.point + (0.25 * k * width) * d;
       length = chord_length(body.outline, at, d);
     }
-    if (length > 0) {
+    // Metrikin's rule (PHYSICS.md §2.2, [READ]): a floe splits only if its chord is at least the bending radius
+    // R_b; a smaller piece is a block that moves, tilts or crushes (without it, the broken ice under the bow would
+    // split again and again into ever smaller pieces within a few steps).
+    const double min_chord = rho_w_g > 0 ? wf.rb_over_lc * lc : 0.0;
+    if (length > 0 && length >= min_chord) {
       split.threshold = splitting_load_n(fo.splitting_coefficient, fo.fracture_toughness_pa_sqrtm, h, length);
       split.mode = kFractureSplitting;
       split.point = at;
@@ -155,7 +166,7 @@ std::vector<Polygon> cut(const Body& body, const Candidate& c, const FractureOpt
       pieces.insert(pieces.end(), s.right.begin(), s.right.end());
       // A split that leaves a sliver is no split (Metrikin's rule, PHYSICS.md §2.2): the floe crushes instead.
       for (const Polygon& p : pieces)
-        if (signed_area(p) < fo.min_piece_area_m2) return {};
+        if (is_brash(p, body.thickness_m, fo.min_piece_area_m2)) return {};
     } else {
       // The wedge: apex a = alpha l_c behind the contact point (outside the ice), radial cracks at +-theta/2 about
       // the inward normal, the circumferential crack on the arc R_b beyond the load point.
@@ -178,6 +189,14 @@ std::vector<Polygon> cut(const Body& body, const Candidate& c, const FractureOpt
 }
 
 }  // namespace
+
+bool is_brash(const Polygon& piece, double thickness_m, double min_area_m2) {
+  const double area = signed_area(piece);
+  if (area < min_area_m2) return true;
+  double perimeter = 0;
+  for (size_t i = 0; i < piece.size(); ++i) perimeter += (piece[(i + 1) % piece.size()] - piece[i]).norm();
+  return 4 * area / perimeter < thickness_m;
+}
 
 double wedge_angle_rad(const FractureOptions& o, int floe_id, long step) {
   const uint64_t key = splitmix64(static_cast<uint64_t>(o.seed) ^ splitmix64(static_cast<uint64_t>(floe_id) ^

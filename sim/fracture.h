@@ -57,6 +57,11 @@ struct FractureCut {
 std::vector<FractureCut> find_fractures(const Model& model, const State& state, const std::vector<Contact>& contacts,
                                         double dt);
 
+// Whether a piece is brash (removed, its mass counted) rather than a floe: smaller than min_area_m2, or narrower
+// than the ice is thick (plan width 4 A / perimeter below h: a sliver is a block, not a plate, and its tiny
+// inertia about its long axis would only destabilise the contacts it sits in).
+bool is_brash(const Polygon& piece, double thickness_m, double min_area_m2);
+
 // The wedge angle drawn for a floe at a step: uniform in fracture.wedge_angle_deg (radians), from a hash.
 double wedge_angle_rad(const FractureOptions& o, int floe_id, long step);
 

@@ -288,11 +288,10 @@ void World::apply_fracture(FractureCut& cut) {
   collision_->remove_body(parent);
   const int first_new = static_cast<int>(model_.bodies.size());
   for (const Polygon& piece : cut.pieces) {
-    const double area = signed_area(piece);
-    if (area < min_area) {
+    if (is_brash(piece, h, min_area)) {
       // Brash: a piece this small is a block, not a plate (thickness comparable with its width), and a swarm of
       // them would only add tiny masses to the solver's chains under the hull. It is removed; its mass is counted.
-      e.brash_mass_kg += rho_i * area * h;
+      e.brash_mass_kg += rho_i * signed_area(piece) * h;
       continue;
     }
     const Vec2 c = centroid(piece);
