@@ -246,11 +246,14 @@ struct SolverOptions {
 // Contact laws per pair of body classes (PHYSICS.md §1.7-1.8). Rigid: non-penetration with ERP push-out and a
 // manifold of up to 4 points. Compliant: crushing (§1.8(c)), one row per pair of convex parts at the centroid of the
 // overlap's contact surface, normal force capped by p_c(A) A of the overlap's nominal contact area A, hardening with
-// K_t = dF/d(delta) inside the implicit step, no push-out and no spring-back. Defaults as SAMS: the vessel crushes ice,
-// floes meet rigidly.
+// K_t = dF/d(delta) inside the implicit step, no push-out and no spring-back. Both compliant by default, as in SAMS
+// (PHYSICS.md §1.7: compliant ice-structure and ice-ice contacts, "large rubble accumulation and ice-ice
+// contact-induced failure"): with fracture, broken pieces are squeezed between floes, and rigid ice-ice rows there
+// have no ceiling (a 15 m^2 piece jammed between two floes drove the PGS solve to 3e10 N and a blow-up on one of five
+// starts of the default case); a compliant row is capped at p_c A and never pushes out.
 struct ContactOptions {
   std::string ice_structure = "compliant";  // contacts between a floe and the vessel
-  std::string ice_ice = "rigid";            // contacts between two floes
+  std::string ice_ice = "compliant";        // contacts between two floes
   double pressure_area_exponent = 0.0;      // e_x of p_c(A) = sigma_c (A / 1 m^2)^e_x; 0: constant pressure sigma_c
   double area_gradient_step_m = 0.005;      // smallest step of the secant dA/d(delta) = (A(delta + step) - A) / step
   double crushing_damping_ratio = 0.0;      // zeta of c_n = 2 zeta sqrt(m_eff K_t) added to the crushing force
