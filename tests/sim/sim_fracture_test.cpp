@@ -328,6 +328,29 @@ TEST(Fracture, EventsConserveMassAndMomentumAndPiecesDoNotOverlap) {
             overlap += signed_area(piece);
           EXPECT_LE(overlap, 1e-6) << "pieces of floe " << P.id;
         }
+      // Nor does a piece overlap its neighbours more than the floe it came from did (it sits where that part of the
+      // floe was): plan overlap with every other floe alive, against the broken floe's own.
+      auto plan_of = [&](int b) {
+        Polygon q;
+        const Mat3 R = s.orientation[b].toRotationMatrix();
+        for (const Vec2& v : m.bodies[b].outline) {
+          const Vec3 x = s.position[b] + R * Vec3(v.x(), v.y(), 0);
+          q.emplace_back(x.x(), x.y());
+        }
+        return q;
+      };
+      auto overlap_area = [](const Polygon& a, const Polygon& b) {
+        double area = 0;
+        for (const Polygon& piece : polygon_intersection(a, b, 0.0)) area += signed_area(piece);
+        return area;
+      };
+      for (size_t o = 0; o < m.bodies.size(); ++o) {
+        if (m.bodies[o].kind != BodyKind::floe || !s.alive[o] || m.bodies[o].parent_id == P.id) continue;
+        const double before = overlap_area(plan_of(parent), plan_of(static_cast<int>(o)));
+        double after = 0;
+        for (int c : kids) after += overlap_area(plan_of(c), plan_of(static_cast<int>(o)));
+        EXPECT_LE(after, before + 1e-6) << "pieces of floe " << P.id << " against floe " << m.bodies[o].id;
+      }
       ++checked;
     }
   }

@@ -140,6 +140,16 @@ TEST(SimInput, BadInputsNameFileAndItemAndWriteNothing) {
   run("floes.geojson", "hull.obj", "strength.json", {"strength.json", "ice.crushing_strength_pa", "> 0"});
   std::ofstream(dir / "unknown.json") << R"({"duration_s": 1.0, "steady_start_s": 0.5, "water": {"curent_speed_mps": 1}})";
   run("floes.geojson", "hull.obj", "unknown.json", {"unknown.json", "water.curent_speed_mps"});
+  // Fracture options (issue #7): a wedge angle range outside (0, 180) deg, a zero toughness, a negative piece size.
+  std::ofstream(dir / "theta.json") << R"({"duration_s": 1.0, "steady_start_s": 0.5,
+                                           "fracture": {"wedge_angle_deg": [30, 200]}})";
+  run("floes.geojson", "hull.obj", "theta.json", {"theta.json", "fracture.wedge_angle_deg", "(0, 180)"});
+  std::ofstream(dir / "kic.json") << R"({"duration_s": 1.0, "steady_start_s": 0.5,
+                                         "fracture": {"fracture_toughness_pa_sqrtm": 0}})";
+  run("floes.geojson", "hull.obj", "kic.json", {"kic.json", "fracture.fracture_toughness_pa_sqrtm", "> 0"});
+  std::ofstream(dir / "piece.json") << R"({"duration_s": 1.0, "steady_start_s": 0.5,
+                                           "fracture": {"min_piece_area_m2": -1}})";
+  run("floes.geojson", "hull.obj", "piece.json", {"piece.json", "fracture.min_piece_area_m2"});
   // A thrust series with a gap (an empty line, a missing value) or with time going back.
   auto thrust_case = [&](const std::string& csv, std::initializer_list<const char*> pieces) {
     std::ofstream(dir / "thrust.csv") << csv;
