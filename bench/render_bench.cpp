@@ -18,12 +18,12 @@
 #include "pipeline/results_io.h"
 #include "render/scene.h"
 #include "render/video.h"
+#include "pipeline/geometry2d.h"
 
 using namespace floesim;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // Ship-shaped hull: waterplane outline with a parallel body and a rounded bow, extruded keel to deck, plus a
 // deckhouse. Body frame: x forward, origin at the centre of mass on the waterline.

@@ -36,6 +36,7 @@
 #include "sim/hull.h"
 #include "sim/simulate.h"
 #include "sim/world.h"
+#include "pipeline/geometry2d.h"
 
 using namespace floesim;
 using namespace floesim::sim;
@@ -43,7 +44,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 struct FieldSpec {
   double width_m = 1300, height_m = 700;

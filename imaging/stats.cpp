@@ -5,11 +5,11 @@
 #include <cstdio>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
+#include "pipeline/geometry2d.h"
 
 namespace floesim::imaging {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 // Mean and variance of u = ln(D / d_min) under p(D) ~ D^-alpha on [d_min, d_max], U = ln(d_max / d_min):
 // u follows a truncated exponential of rate beta = alpha - 1 on [0, U].

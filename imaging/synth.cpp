@@ -12,11 +12,11 @@
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
 #include "pipeline/provenance.h"
+#include "pipeline/geometry2d.h"
 
 namespace floesim::imaging {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 // Inverse-CDF sample of the truncated power law p(D) ~ D^-alpha on [dmin, dmax].
 double sample_diameter(std::mt19937_64& rng, double alpha, double dmin, double dmax) {

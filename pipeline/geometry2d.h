@@ -9,6 +9,8 @@ namespace floesim {
 using Vec2 = Eigen::Vector2d;
 using Polygon = std::vector<Vec2>;  // open ring (last vertex != first)
 
+inline constexpr double kPi = 3.14159265358979323846;  // the one copy (geometry, hydrodynamics, imaging, tests)
+
 double signed_area(const Polygon& p);  // > 0 for counter-clockwise
 Vec2 centroid(const Polygon& p);        // area centroid; requires non-zero area
 void make_ccw(Polygon& p);

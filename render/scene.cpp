@@ -11,6 +11,7 @@
 
 #include "pipeline/error.h"
 #include "render/gl_context.h"
+#include "pipeline/geometry2d.h"
 
 namespace floesim::render {
 
@@ -20,7 +21,6 @@ using Mat4 = Eigen::Matrix4d;  // column-major, like GL
 using Vec3 = Eigen::Vector3d;
 using Vec2 = Eigen::Vector2d;
 
-constexpr double kPi = 3.14159265358979323846;
 
 // Sun from the south-west, ~50 degrees up (unit vector towards the sun, world frame). With the ambient term below,
 // ambient + diffuse * sun_z = 1: faces looking straight up (floe tops, the deck) show exactly their configured

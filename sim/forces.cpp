@@ -4,11 +4,11 @@
 #include <cmath>
 
 #include "sim/geometry.h"
+#include "pipeline/geometry2d.h"
 
 namespace floesim::sim {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 }
 
 double heading_of(const Mat3& R) { return std::atan2(R(1, 0), R(0, 0)); }

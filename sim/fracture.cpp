@@ -11,7 +11,7 @@ namespace floesim::sim {
 
 namespace {
 
-constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+constexpr double kDegToRad = kPi / 180.0;
 
 // SplitMix64 (Steele, Lea & Flood 2014): a counter-based generator, so a draw depends only on its key (no shared
 // generator state, hence independent of the order in which floes are visited).

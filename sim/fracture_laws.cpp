@@ -5,11 +5,11 @@
 #include <cstddef>
 
 #include "pipeline/error.h"
+#include "pipeline/geometry2d.h"
 
 namespace floesim::sim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // ---- Tables (data) ----------------------------------------------------------------------------------------------
 

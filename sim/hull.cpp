@@ -18,6 +18,7 @@
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
 #include "pipeline/provenance.h"
+#include "pipeline/geometry2d.h"
 
 namespace floesim::sim {
 
@@ -25,7 +26,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 double deg(double d) { return d * kPi / 180.0; }
 
 // 0 -> 0, 1 -> 1 with zero slope at both ends (for blending hull parameters along x without kinks).

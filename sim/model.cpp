@@ -8,12 +8,12 @@
 
 #include "pipeline/error.h"
 #include "sim/geometry.h"
+#include "pipeline/geometry2d.h"
 
 namespace floesim::sim {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // Buoyancy of a body-frame mesh placed at (position, orientation): submerged volume and centre of buoyancy.
 Submerged submerged_at(const TriMesh& mesh, const Vec3& position, const Quat& orientation) {

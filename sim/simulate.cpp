@@ -101,7 +101,7 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
     if (std::isinf(r.floe_ended_s[k])) end += m;
     if (r.floe_parent_id[k] >= 0) {
       piece_area.push_back(a);
-      piece_diameter.push_back(std::sqrt(4 * a / 3.14159265358979323846));
+      piece_diameter.push_back(std::sqrt(4 * a / kPi));
     }
   }
   for (double b : r.fracture_brash_mass_kg) brash += b;

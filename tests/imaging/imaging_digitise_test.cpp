@@ -18,11 +18,11 @@
 #include "imaging/synth.h"
 #include "pipeline/provenance.h"
 #include "test_util.h"
+#include "pipeline/geometry2d.h"
 
 namespace floesim::imaging {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // ---- the pieces on known answers ----
 

@@ -13,11 +13,11 @@
 #include "imaging/synth.h"
 #include "pipeline/provenance.h"
 #include "test_util.h"
+#include "pipeline/geometry2d.h"
 
 namespace floesim::imaging {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 TEST(Synth, SameSeedSameBytesOtherSeedOtherImage) {
   test::ScratchDir a, b;

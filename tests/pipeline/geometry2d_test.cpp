@@ -21,7 +21,6 @@
 namespace floesim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // Checks the decomposition's contract and returns the number of pieces.
 size_t check_decomposition(const Polygon& p, const std::string& what) {

@@ -9,11 +9,11 @@
 
 #include "pipeline/error.h"
 #include "sim/mesh.h"
+#include "pipeline/geometry2d.h"
 
 namespace floesim::sim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // Axis-aligned box [0,a] x [0,b] x [0,c], outward triangles.
 TriMesh box(double a, double b, double c) {

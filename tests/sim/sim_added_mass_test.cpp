@@ -9,13 +9,13 @@
 #include "sim/forces.h"
 #include "sim/world.h"
 #include "sim_fixtures.h"
+#include "pipeline/geometry2d.h"
 
 namespace floesim::sim {
 namespace {
 
 using testing::coarse_hull;
 using testing::rect_floe;
-constexpr double kPi = 3.14159265358979323846;
 
 // A vessel at rest in calm water, not steered, not driven.
 SimulateOptions still_vessel() {

@@ -145,7 +145,7 @@ TEST(SimCases, SingleFloeStruckOffCentreBendsAtTheBowAndIsPushedToPort) {
   for (const FractureEvent& e : w.fracture_events())
     bending_of_floe1 += e.parent_id == 1 && e.at_structure && e.mode != kFractureSplitting;
   const Mat3 R = w.state().orientation[big].toRotationMatrix();
-  const double yaw = std::atan2(R(1, 0), R(0, 0)) * 180 / 3.14159265358979323846;
+  const double yaw = std::atan2(R(1, 0), R(0, 0)) * 180 / kPi;
   const Vec3 d = w.state().position[big] - x0;
   std::printf("[measured] %d steps in contact, peak surge ice load %.0f kN, %zu fracture events; largest piece "
               "(%.0f of %.0f m^2) moved (%.1f, %.1f) m, yaw %+.1f deg\n",

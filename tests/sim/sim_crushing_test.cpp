@@ -12,13 +12,13 @@
 #include "sim/simulate.h"
 #include "sim/world.h"
 #include "sim_fixtures.h"
+#include "pipeline/geometry2d.h"
 
 namespace floesim::sim {
 namespace {
 
 using testing::contact_force_on;
 
-constexpr double kPi = 3.14159265358979323846;
 
 // A vertical wall (box lx x ly x hz, centred on the origin in x and y, z from z0) as a single-part hull.
 HullModel box_hull(double lx, double ly, double z0, double hz) {

@@ -9,11 +9,11 @@
 
 #include "pipeline/error.h"
 #include "sim/fracture_laws.h"
+#include "pipeline/geometry2d.h"
 
 namespace floesim::sim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kRhoWG = 1025 * 9.81;
 // Flexural strength and thickness for the load tests; the laws scale as sigma_f h^2, so any pair serves.
 constexpr double kSigma = 5e5, kH = 1.3;

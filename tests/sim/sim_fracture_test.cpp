@@ -13,6 +13,7 @@
 #include "sim/fracture.h"
 #include "sim/simulate.h"
 #include "sim_fixtures.h"
+#include "pipeline/geometry2d.h"
 
 namespace floesim::sim {
 namespace {
@@ -20,7 +21,6 @@ namespace {
 using testing::coarse_hull;
 using testing::rect_floe;
 
-constexpr double kPi = 3.14159265358979323846;
 
 // l_c for the defaults (E = 5 GPa, nu = 0.3, h = 1 m, rho_w g = 1025 x 9.81): (D / rho_w g)^(1/4) by hand.
 double lc_by_hand(double h) {

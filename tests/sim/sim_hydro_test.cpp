@@ -8,13 +8,13 @@
 #include "sim/geometry.h"
 #include "sim/world.h"
 #include "sim_fixtures.h"
+#include "pipeline/geometry2d.h"
 
 namespace floesim::sim {
 namespace {
 
 using testing::floe_options;
 using testing::rect_floe;
-constexpr double kPi = 3.14159265358979323846;
 
 // A floe released 5 cm above equilibrium settles at draught rho_i/rho_w h (bottom at -draught).
 TEST(SimHydro, FloeFloatsAtDraught) {

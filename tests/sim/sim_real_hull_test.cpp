@@ -11,12 +11,12 @@
 
 #include "sim/world.h"
 #include "tests/sim/obj_faces.h"
+#include "pipeline/geometry2d.h"
 
 namespace floesim::sim {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kPi = 3.14159265358979323846;
 
 fs::path hull_file(const std::string& name) {
   const fs::path p = fs::path(FLOESIM_SHARED_DATA_DIR) / "hulls" / name;

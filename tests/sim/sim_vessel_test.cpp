@@ -10,12 +10,12 @@
 #include "sim/simulate.h"
 #include "sim/world.h"
 #include "sim_fixtures.h"
+#include "pipeline/geometry2d.h"
 
 namespace floesim::sim {
 namespace {
 
 using testing::coarse_hull;
-constexpr double kPi = 3.14159265358979323846;
 
 double surge_speed(const World& w) {
   const int v = w.model().vessel;
