@@ -227,7 +227,7 @@ struct CollisionWorld::Impl {
   fcl::DynamicAABBTreeCollisionManagerd awake_tree, sleeping_tree;
   // Per body: which tree holds its parts (the body table grows with fracture; removed bodies are in neither).
   static constexpr uint8_t kSleepingTree = 0, kAwakeTree = 1, kRemoved = 2;
-  std::vector<uint8_t> in_awake_tree;
+  std::vector<uint8_t> tree_of;
   std::vector<fcl::CollisionObjectd*> moved_awake, moved_sleeping;
   std::vector<uint8_t> box_changed;    // per part, written by update_bodies
   std::vector<PairCandidate> pairs;
@@ -533,11 +533,11 @@ CollisionWorld::CollisionWorld(const Model& model, const State& state, ThreadPoo
     : impl_(std::make_unique<Impl>(model, pool)) {
   Impl& m = *impl_;
   m.add_parts(state, 0);
-  m.in_awake_tree.assign(model.bodies.size(), 0);
+  m.tree_of.assign(model.bodies.size(), 0);
   std::vector<fcl::CollisionObjectd*> awake, sleeping;
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const Body& body = model.bodies[b];
-    m.in_awake_tree[b] = state.awake[b] ? Impl::kAwakeTree : Impl::kSleepingTree;
+    m.tree_of[b] = state.awake[b] ? Impl::kAwakeTree : Impl::kSleepingTree;
     for (int p = body.first_part; p < body.first_part + body.part_count; ++p)
       (state.awake[b] ? awake : sleeping).push_back(m.objects[p].get());
   }
@@ -554,10 +554,10 @@ void CollisionWorld::add_bodies(const State& state, int first_new) {
   const size_t nb = m.model.bodies.size();
   if (static_cast<size_t>(first_new) >= nb) return;
   m.add_parts(state, m.model.bodies[first_new].first_part);
-  m.in_awake_tree.resize(nb, Impl::kRemoved);
+  m.tree_of.resize(nb, Impl::kRemoved);
   for (size_t b = first_new; b < nb; ++b) {
     const Body& body = m.model.bodies[b];
-    m.in_awake_tree[b] = state.awake[b] ? Impl::kAwakeTree : Impl::kSleepingTree;
+    m.tree_of[b] = state.awake[b] ? Impl::kAwakeTree : Impl::kSleepingTree;
     auto& tree = state.awake[b] ? m.awake_tree : m.sleeping_tree;
     for (int p = body.first_part; p < body.first_part + body.part_count; ++p) tree.registerObject(m.objects[p].get());
   }
@@ -565,11 +565,11 @@ void CollisionWorld::add_bodies(const State& state, int first_new) {
 
 void CollisionWorld::remove_body(int b) {
   Impl& m = *impl_;
-  if (m.in_awake_tree[b] == Impl::kRemoved) return;
-  auto& tree = m.in_awake_tree[b] == Impl::kAwakeTree ? m.awake_tree : m.sleeping_tree;
+  if (m.tree_of[b] == Impl::kRemoved) return;
+  auto& tree = m.tree_of[b] == Impl::kAwakeTree ? m.awake_tree : m.sleeping_tree;
   const Body& body = m.model.bodies[b];
   for (int p = body.first_part; p < body.first_part + body.part_count; ++p) tree.unregisterObject(m.objects[p].get());
-  m.in_awake_tree[b] = Impl::kRemoved;
+  m.tree_of[b] = Impl::kRemoved;
 }
 
 void CollisionWorld::update_bodies(const State& state, const std::vector<int>& moved) {
@@ -581,33 +581,33 @@ void CollisionWorld::update_bodies(const State& state, const std::vector<int>& m
   m.pool.parallel_for(static_cast<int>(moved.size()), [&](int begin, int end, int) {
     for (int i = begin; i < end; ++i) {
       const int b = moved[i];
-      if (m.in_awake_tree[b] == Impl::kRemoved) continue;
+      if (m.tree_of[b] == Impl::kRemoved) continue;
       const Body& body = m.model.bodies[b];
       for (int p = body.first_part; p < body.first_part + body.part_count; ++p)
         m.box_changed[p] = m.place_part(p, state.position[b], state.orientation[b]);
     }
   });
   for (int b : moved) {
-    if (m.in_awake_tree[b] == Impl::kRemoved) continue;
+    if (m.tree_of[b] == Impl::kRemoved) continue;
     const Body& body = m.model.bodies[b];
     for (int p = body.first_part; p < body.first_part + body.part_count; ++p)
       if (m.box_changed[p])
-        (m.in_awake_tree[b] == Impl::kAwakeTree ? m.moved_awake : m.moved_sleeping).push_back(m.objects[p].get());
+        (m.tree_of[b] == Impl::kAwakeTree ? m.moved_awake : m.moved_sleeping).push_back(m.objects[p].get());
   }
   if (!m.moved_awake.empty()) m.awake_tree.update(m.moved_awake);
   if (!m.moved_sleeping.empty()) m.sleeping_tree.update(m.moved_sleeping);
   // Bodies that fell asleep or woke up since the last call change trees (their boxes are current).
   for (size_t b = 0; b < m.model.bodies.size(); ++b) {
     const uint8_t want = state.awake[b] ? Impl::kAwakeTree : Impl::kSleepingTree;
-    if (m.in_awake_tree[b] == Impl::kRemoved || m.in_awake_tree[b] == want) continue;
+    if (m.tree_of[b] == Impl::kRemoved || m.tree_of[b] == want) continue;
     const Body& body = m.model.bodies[b];
-    auto& from = m.in_awake_tree[b] == Impl::kAwakeTree ? m.awake_tree : m.sleeping_tree;
+    auto& from = m.tree_of[b] == Impl::kAwakeTree ? m.awake_tree : m.sleeping_tree;
     auto& to = want == Impl::kAwakeTree ? m.awake_tree : m.sleeping_tree;
     for (int p = body.first_part; p < body.first_part + body.part_count; ++p) {
       from.unregisterObject(m.objects[p].get());
       to.registerObject(m.objects[p].get());
     }
-    m.in_awake_tree[b] = want;
+    m.tree_of[b] = want;
   }
 }
 

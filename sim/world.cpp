@@ -289,8 +289,8 @@ void World::apply_fracture(FractureCut& cut) {
   const int first_new = static_cast<int>(model_.bodies.size());
   for (const Polygon& piece : cut.pieces) {
     if (is_brash(piece, h, min_area)) {
-      // Brash: a piece this small is a block, not a plate (thickness comparable with its width), and a swarm of
-      // them would only add tiny masses to the solver's chains under the hull. It is removed; its mass is counted.
+      // Brash (below the minimum area, or a sliver narrower than the ice is thick): a block, not a plate, that
+      // would only add tiny masses and inertias to the solver's chains under the hull. Removed; its mass counted.
       e.brash_mass_kg += rho_i * signed_area(piece) * h;
       continue;
     }
