@@ -9,14 +9,6 @@ namespace floesim::imaging {
 namespace {
 double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
 
-double point_segment_distance(const Vec2& p, const Vec2& a, const Vec2& b) {
-  const Vec2 ab = b - a;
-  const double l2 = ab.squaredNorm();
-  double t = l2 > 0 ? (p - a).dot(ab) / l2 : 0.0;
-  t = std::clamp(t, 0.0, 1.0);
-  return (a + t * ab - p).norm();
-}
-
 bool segments_touch(const Vec2& p1, const Vec2& p2, const Vec2& q1, const Vec2& q2) {
   const double d1 = cross(q2 - q1, p1 - q1), d2 = cross(q2 - q1, p2 - q1);
   const double d3 = cross(p2 - p1, q1 - p1), d4 = cross(p2 - p1, q2 - p1);

@@ -20,6 +20,13 @@
 
 namespace floesim {
 
+double point_segment_distance(const Vec2& v, const Vec2& p, const Vec2& q) {
+  const Vec2 e = q - p;
+  const double l2 = e.squaredNorm();
+  const double t = l2 > 0 ? std::clamp((v - p).dot(e) / l2, 0.0, 1.0) : 0.0;
+  return (v - (p + t * e)).norm();
+}
+
 double signed_area(const Polygon& p) {
   double a = 0;
   const size_t n = p.size();
@@ -322,13 +329,6 @@ double coordinate_scale(const Polygon& a, const Polygon& b) {
 
 bool lex_less(const Vec2& u, const Vec2& v) { return u.x() < v.x() || (u.x() == v.x() && u.y() < v.y()); }
 
-double segment_distance(const Vec2& v, const Vec2& p, const Vec2& q) {
-  const Vec2 e = q - p;
-  const double l2 = e.squaredNorm();
-  const double t = l2 > 0 ? std::clamp((v - p).dot(e) / l2, 0.0, 1.0) : 0.0;
-  return (v - (p + t * e)).norm();
-}
-
 // Puts each vertex of an overlay's result where it belongs. Boost computes the crossing of an edge of a with an edge
 // of b afresh in every operation, from the segments in the order and orientation that operation sees them
 // (difference reverses b), so a n b and a \ b may place the same cut vertex a few ulps apart, and an input vertex
@@ -377,7 +377,7 @@ class Snapper {
     size_t best = 0;
     double best_d = HUGE_VAL;
     for (size_t i = 0; i < p.size(); ++i) {
-      const double d = segment_distance(v, p[i], p[(i + 1) % p.size()]);
+      const double d = point_segment_distance(v, p[i], p[(i + 1) % p.size()]);
       if (d < best_d) best = i, best_d = d;
     }
     return {p[best], p[(best + 1) % p.size()]};
@@ -398,7 +398,7 @@ void insert_touching(Polygon& p, const Polygon& q, double tol) {
     out.push_back(u);
     on.clear();
     for (const Vec2& w : q)
-      if ((w - u).norm() > tol && (w - v).norm() > tol && segment_distance(w, u, v) <= tol)
+      if ((w - u).norm() > tol && (w - v).norm() > tol && point_segment_distance(w, u, v) <= tol)
         on.emplace_back((w - u).dot(e) / e.squaredNorm(), w);
     std::sort(on.begin(), on.end(), [](const auto& x, const auto& y) {
       return x.first < y.first || (x.first == y.first && lex_less(x.second, y.second));

@@ -11,6 +11,7 @@ using Polygon = std::vector<Vec2>;  // open ring (last vertex != first)
 
 inline constexpr double kPi = 3.14159265358979323846;  // the one copy (geometry, hydrodynamics, imaging, tests)
 
+double point_segment_distance(const Vec2& v, const Vec2& p, const Vec2& q);  // to the segment pq
 double signed_area(const Polygon& p);  // > 0 for counter-clockwise
 Vec2 centroid(const Polygon& p);        // area centroid; requires non-zero area
 void make_ccw(Polygon& p);

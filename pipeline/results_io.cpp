@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <type_traits>
 
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
@@ -143,8 +144,34 @@ constexpr const char* kLayoutBeforeFracture = "floesim-results/1";
 // Series that floesim-results/1 did not have, and what reading such a file fills in (see read_results).
 bool series_added_in_layout_2(const std::string& name) { return name == "fracture_events" || name == "floe_bodies"; }
 
-// The lineage and the fracture events, checked alike on write (then a bug in simulate) and on read (a damaged or
-// foreign file): returns the first problem found, naming the dataset, or "" if there is none.
+// How many rows a dataset of layout /2 holds.
+enum class Rows { per_floe, per_event, events_plus_one, any };
+
+// The lineage and fracture-event datasets of layout /2, one list for the writer, the reader and the length checks:
+// f(name, the Results member, columns, rows). R is Results or const Results.
+template <class R, class F>
+void for_each_fracture_dataset(R& r, F&& f) {
+  f("/geometry/floe_parent_id", r.floe_parent_id, 1, Rows::per_floe);
+  f("/geometry/floe_generation", r.floe_generation, 1, Rows::per_floe);
+  f("/geometry/floe_origin_mode", r.floe_origin_mode, 1, Rows::per_floe);
+  f("/geometry/floe_created_s", r.floe_created_s, 1, Rows::per_floe);
+  f("/geometry/floe_ended_s", r.floe_ended_s, 1, Rows::per_floe);
+  f("/fracture/time_s", r.fracture_time_s, 1, Rows::per_event);
+  f("/fracture/parent_id", r.fracture_parent_id, 1, Rows::per_event);
+  f("/fracture/mode", r.fracture_mode, 1, Rows::per_event);
+  f("/fracture/at_structure", r.fracture_at_structure, 1, Rows::per_event);
+  f("/fracture/force_n", r.fracture_force_n, 3, Rows::per_event);
+  f("/fracture/threshold_n", r.fracture_threshold_n, 1, Rows::per_event);
+  f("/fracture/point_m", r.fracture_point_m, 3, Rows::per_event);
+  f("/fracture/width_m", r.fracture_width_m, 1, Rows::per_event);
+  f("/fracture/theta_rad", r.fracture_theta_rad, 1, Rows::per_event);
+  f("/fracture/brash_mass_kg", r.fracture_brash_mass_kg, 1, Rows::per_event);
+  f("/fracture/child_offset", r.fracture_child_offset, 1, Rows::events_plus_one);
+  f("/fracture/child_id", r.fracture_child_id, 1, Rows::any);
+}
+
+}  // namespace
+
 std::string fracture_problem(const Results& r) {
   std::string e;  // the first length problem
   const size_t n = r.floe_id.size();
@@ -153,23 +180,12 @@ std::string fracture_problem(const Results& r) {
     e = std::string(name) + " has " + std::to_string(size) + (cols == 1 ? " rows" : " values") + ", expected " +
         std::to_string(expected) + (cols == 1 ? "" : " x " + std::to_string(cols)) + " (" + what + ")";
   };
-  rows("/geometry/floe_parent_id", r.floe_parent_id.size(), 1, n, "one per /geometry/floe_id");
-  rows("/geometry/floe_generation", r.floe_generation.size(), 1, n, "one per /geometry/floe_id");
-  rows("/geometry/floe_origin_mode", r.floe_origin_mode.size(), 1, n, "one per /geometry/floe_id");
-  rows("/geometry/floe_created_s", r.floe_created_s.size(), 1, n, "one per /geometry/floe_id");
-  rows("/geometry/floe_ended_s", r.floe_ended_s.size(), 1, n, "one per /geometry/floe_id");
   const size_t E = r.fracture_time_s.size();
-  const char* per_event = "one per event of /fracture/time_s";
-  rows("/fracture/parent_id", r.fracture_parent_id.size(), 1, E, per_event);
-  rows("/fracture/mode", r.fracture_mode.size(), 1, E, per_event);
-  rows("/fracture/at_structure", r.fracture_at_structure.size(), 1, E, per_event);
-  rows("/fracture/force_n", r.fracture_force_n.size(), 3, E, per_event);
-  rows("/fracture/threshold_n", r.fracture_threshold_n.size(), 1, E, per_event);
-  rows("/fracture/point_m", r.fracture_point_m.size(), 3, E, per_event);
-  rows("/fracture/width_m", r.fracture_width_m.size(), 1, E, per_event);
-  rows("/fracture/theta_rad", r.fracture_theta_rad.size(), 1, E, per_event);
-  rows("/fracture/brash_mass_kg", r.fracture_brash_mass_kg.size(), 1, E, per_event);
-  rows("/fracture/child_offset", r.fracture_child_offset.size(), 1, E + 1, "events + 1");
+  for_each_fracture_dataset(r, [&](const char* name, const auto& v, size_t cols, Rows per) {
+    if (per == Rows::per_floe) rows(name, v.size(), cols, n, "one per /geometry/floe_id");
+    if (per == Rows::per_event) rows(name, v.size(), cols, E, "one per event of /fracture/time_s");
+    if (per == Rows::events_plus_one) rows(name, v.size(), cols, E + 1, "events + 1");
+  });
   if (!e.empty()) return e;
 
   // Offsets into child_id: 0, non-decreasing, ending at its size.
@@ -231,6 +247,8 @@ std::string fracture_problem(const Results& r) {
   return "";
 }
 
+namespace {
+
 }  // namespace
 
 void write_results(const std::filesystem::path& path, const Results& r) {
@@ -275,25 +293,11 @@ void write_results(const std::filesystem::path& path, const Results& r) {
     write_ds(fid, "/geometry/floe_thickness_m", r.floe_thickness_m, 1, file);
     write_ds(fid, "/geometry/floe_vertex_offset", r.floe_vertex_offset, 1, file);
     write_ds(fid, "/geometry/floe_vertices_m", r.floe_vertices_m, 2, file);
-    write_ds(fid, "/geometry/floe_parent_id", r.floe_parent_id, 1, file);
-    write_ds(fid, "/geometry/floe_generation", r.floe_generation, 1, file);
-    write_ds(fid, "/geometry/floe_origin_mode", r.floe_origin_mode, 1, file);
-    write_ds(fid, "/geometry/floe_created_s", r.floe_created_s, 1, file);
-    write_ds(fid, "/geometry/floe_ended_s", r.floe_ended_s, 1, file);
     write_ds(fid, "/geometry/hull_vertices_m", r.hull_vertices_m, 3, file);
     write_ds(fid, "/geometry/hull_triangles", r.hull_triangles, 3, file);
-    write_ds(fid, "/fracture/time_s", r.fracture_time_s, 1, file);
-    write_ds(fid, "/fracture/parent_id", r.fracture_parent_id, 1, file);
-    write_ds(fid, "/fracture/mode", r.fracture_mode, 1, file);
-    write_ds(fid, "/fracture/at_structure", r.fracture_at_structure, 1, file);
-    write_ds(fid, "/fracture/force_n", r.fracture_force_n, 3, file);
-    write_ds(fid, "/fracture/threshold_n", r.fracture_threshold_n, 1, file);
-    write_ds(fid, "/fracture/point_m", r.fracture_point_m, 3, file);
-    write_ds(fid, "/fracture/width_m", r.fracture_width_m, 1, file);
-    write_ds(fid, "/fracture/theta_rad", r.fracture_theta_rad, 1, file);
-    write_ds(fid, "/fracture/brash_mass_kg", r.fracture_brash_mass_kg, 1, file);
-    write_ds(fid, "/fracture/child_offset", r.fracture_child_offset, 1, file);
-    write_ds(fid, "/fracture/child_id", r.fracture_child_id, 1, file);
+    for_each_fracture_dataset(r, [&](const char* name, const auto& v, size_t cols, Rows) {
+      write_ds(fid, name, v, cols, file);
+    });
 
     nlohmann::json attrs = r.attributes;
     attrs["layout"] = kLayout;
@@ -372,23 +376,9 @@ Results read_results(const std::filesystem::path& path, bool with_states) {
     r.series["floe_bodies"].assign(n, static_cast<double>(floes));
     return r;
   }
-  r.floe_parent_id = read_ds<int32_t>(fid, "/geometry/floe_parent_id", 1, file);
-  r.floe_generation = read_ds<int32_t>(fid, "/geometry/floe_generation", 1, file);
-  r.floe_origin_mode = read_ds<int32_t>(fid, "/geometry/floe_origin_mode", 1, file);
-  r.floe_created_s = read_ds<double>(fid, "/geometry/floe_created_s", 1, file);
-  r.floe_ended_s = read_ds<double>(fid, "/geometry/floe_ended_s", 1, file);
-  r.fracture_time_s = read_ds<double>(fid, "/fracture/time_s", 1, file);
-  r.fracture_parent_id = read_ds<int32_t>(fid, "/fracture/parent_id", 1, file);
-  r.fracture_mode = read_ds<int32_t>(fid, "/fracture/mode", 1, file);
-  r.fracture_at_structure = read_ds<int32_t>(fid, "/fracture/at_structure", 1, file);
-  r.fracture_force_n = read_ds<double>(fid, "/fracture/force_n", 3, file);
-  r.fracture_threshold_n = read_ds<double>(fid, "/fracture/threshold_n", 1, file);
-  r.fracture_point_m = read_ds<double>(fid, "/fracture/point_m", 3, file);
-  r.fracture_width_m = read_ds<double>(fid, "/fracture/width_m", 1, file);
-  r.fracture_theta_rad = read_ds<double>(fid, "/fracture/theta_rad", 1, file);
-  r.fracture_brash_mass_kg = read_ds<double>(fid, "/fracture/brash_mass_kg", 1, file);
-  r.fracture_child_offset = read_ds<int64_t>(fid, "/fracture/child_offset", 1, file);
-  r.fracture_child_id = read_ds<int32_t>(fid, "/fracture/child_id", 1, file);
+  for_each_fracture_dataset(r, [&](const char* name, auto& v, size_t cols, Rows) {
+    v = read_ds<typename std::decay_t<decltype(v)>::value_type>(fid, name, cols, file);
+  });
   const std::string fracture = fracture_problem(r);
   FLOESIM_REQUIRE(fracture.empty(), file, ": ", fracture, " (a damaged file, or not written by floesim-simulate?)");
   return r;

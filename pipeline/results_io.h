@@ -110,6 +110,11 @@ struct Results {
   const std::vector<double>& get(const std::string& name) const;  // Error if absent
 };
 
+// The lineage and the fracture events checked for consistency (lengths, offsets, modes, time order, ids known to
+// /geometry), as write_results and read_results do; for code that builds Results in memory. Returns the first
+// problem found, naming the dataset, or "" if there is none.
+std::string fracture_problem(const Results& r);
+
 // Checks consistency (every series has steps x cols values, offsets monotone, ...) and writes atomically.
 void write_results(const std::filesystem::path& file, const Results& r);
 // Reads and validates; errors name the file and the dataset.

@@ -173,11 +173,8 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
   // 4. Fracture events. Only those at the vessel are marked: the plot is of the load on the vessel, and a floe
   // that breaks against another floe changes it only indirectly. Every event goes into fracture_events.csv.
   const size_t events = r.fracture_time_s.size();
-  FLOESIM_REQUIRE(r.fracture_parent_id.size() == events && r.fracture_mode.size() == events &&
-                      r.fracture_at_structure.size() == events && r.fracture_force_n.size() == 3 * events &&
-                      r.fracture_threshold_n.size() == events && r.fracture_child_offset.size() == events + 1 &&
-                      static_cast<size_t>(r.fracture_child_offset.back()) == r.fracture_child_id.size(),
-                  source, ": the /fracture datasets disagree in length");
+  const std::string problem = fracture_problem(r);
+  FLOESIM_REQUIRE(problem.empty(), source, ": ", problem);
   std::vector<double> split_t, bend_t;  // times of the events at the vessel, by marker style
   for (size_t k = 0; k < events; ++k)
     if (r.fracture_at_structure[k] == 1)

@@ -224,9 +224,9 @@ struct SceneRenderer::Impl {
       FLOESIM_REQUIRE(vessel_row[k] >= 0, source, ": frame ", k, " (t = ", r.frame_time_s[k],
                       " s) has no vessel state (body_id 0)");
     }
-    // The overlay counts the events up to each frame by bisection.
-    FLOESIM_REQUIRE(std::is_sorted(r.fracture_time_s.begin(), r.fracture_time_s.end()), source,
-                    ": /fracture/time_s is not in time order");
+    // Lineage (the piece colours) and events in time order (the overlay counts them by bisection).
+    const std::string problem = fracture_problem(r);
+    FLOESIM_REQUIRE(problem.empty(), source, ": ", problem);
   }
 
   // Slabs in the body frame: top face at z = +h/2 (triangulated outline), sides as flat-shaded quads; no bottom
@@ -235,10 +235,6 @@ struct SceneRenderer::Impl {
     const size_t n = r.floe_id.size();
     FLOESIM_REQUIRE(r.floe_vertex_offset.size() == n + 1 && r.floe_thickness_m.size() == n, source,
                     ": /geometry floe arrays disagree in length");
-    FLOESIM_REQUIRE(r.floe_origin_mode.size() == n && r.floe_generation.size() == n, source,
-                    ": /geometry/floe_origin_mode and /geometry/floe_generation need one entry per floe of "
-                    "/geometry/floe_id (", n, "), got ", r.floe_origin_mode.size(), " and ",
-                    r.floe_generation.size());
     float side[3];
     parse_hex_colour(o.floe_side_colour, side);
     floes.resize(n);
@@ -262,9 +258,6 @@ struct SceneRenderer::Impl {
       if (area2 < 0) std::reverse(ring.begin(), ring.end());  // the layout says CCW; be lenient, not wrong
       // A deterministic shade per floe id (Knuth's multiplicative hash), 0.92 .. 1.0 of the top colour.
       const float shade = 0.92f + 0.08f * float((uint32_t(r.floe_id[g]) * 2654435761u >> 16) & 255u) / 255.f;
-      FLOESIM_REQUIRE(r.floe_origin_mode[g] >= kFractureNone && r.floe_origin_mode[g] <= kFractureSplitting, source,
-                      ": floe ", r.floe_id[g], " has origin mode ", r.floe_origin_mode[g],
-                      " in /geometry/floe_origin_mode; expected 0 (input) .. 3 (splitting)");
       float top[3];
       floe_top_colour(o, r.floe_origin_mode[g], r.floe_generation[g], top);
       const float t[3] = {top[0] * shade, top[1] * shade, top[2] * shade};

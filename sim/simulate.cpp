@@ -88,7 +88,7 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
   f["events"] = {{"bending", count[kFractureBending]}, {"radial", count[kFractureRadial]},
                  {"splitting", count[kFractureSplitting]}, {"total", r.fracture_mode.size()},
                  {"at_vessel", at_vessel}};
-  std::map<int32_t, double> area;  // floe id -> area
+  std::map<int32_t, double> area, thickness;  // by floe id
   double start = 0, end = 0, brash = 0;
   std::vector<double> piece_area, piece_diameter;
   for (size_t k = 0; k < r.floe_id.size(); ++k) {
@@ -97,6 +97,7 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
       p.emplace_back(r.floe_vertices_m[2 * i], r.floe_vertices_m[2 * i + 1]);
     const double a = signed_area(p), m = o.ice.density_kg_m3 * a * r.floe_thickness_m[k];
     area[r.floe_id[k]] = a;
+    thickness[r.floe_id[k]] = r.floe_thickness_m[k];
     if (r.floe_parent_id[k] < 0) start += m;
     if (std::isinf(r.floe_ended_s[k])) end += m;
     if (r.floe_parent_id[k] >= 0) {
@@ -120,9 +121,7 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
   const double rho_w_g = o.water.density_kg_m3 * o.water.gravity_mps2;
   for (size_t e = 0; e < r.fracture_mode.size(); ++e) {
     if (r.fracture_mode[e] == kFractureSplitting || rho_w_g <= 0) continue;
-    double h = 0;
-    for (size_t k = 0; k < r.floe_id.size(); ++k)
-      if (r.floe_id[k] == r.fracture_parent_id[e]) h = r.floe_thickness_m[k];
+    const double h = thickness[r.fracture_parent_id[e]];
     const double lc = characteristic_length_m(o.fracture.youngs_modulus_pa, o.fracture.poisson_ratio, h, rho_w_g);
     const double theta = r.fracture_theta_rad[e], w = r.fracture_width_m[e];
     const double rb_e = wedge_failure(theta, o.fracture.flexural_strength_pa, h, w / (theta * lc)).rb_over_lc * lc;

@@ -47,6 +47,7 @@ World::World(const Model& model) : model_(model), pool_(model.options.threads) {
   state_.alive.assign(n, 1);
   ended_s_.assign(n, std::numeric_limits<double>::infinity());
   for (const Body& b : model.bodies) next_floe_id_ = std::max(next_floe_id_, b.id + 1);
+  floes_alive_ = model.floe_count();
   for (size_t b = 0; b < n; ++b) {
     state_.position[b] = model.bodies[b].initial_position;
     state_.orientation[b] = model.bodies[b].initial_orientation;
@@ -284,6 +285,7 @@ void World::apply_fracture(FractureCut& cut) {
   // (the sleep stage skips them); its warm-start entries are never matched again (its parts are gone).
   state_.alive[parent] = 0;
   state_.awake[parent] = 0;
+  --floes_alive_;
   ended_s_[parent] = t;
   collision_->remove_body(parent);
   const int first_new = static_cast<int>(model_.bodies.size());
@@ -318,6 +320,7 @@ void World::apply_fracture(FractureCut& cut) {
     solver_bodies_.inv_mass[index] = R * model_.bodies[index].inv_mass_added.asDiagonal() * R.transpose();
     solver_bodies_.inv_inertia_world[index] = R * model_.bodies[index].inv_inertia_added * R.transpose();
     e.child_ids.push_back(id);
+    ++floes_alive_;
   }
   brash_mass_kg_ += e.brash_mass_kg;
   collision_->add_bodies(state_, first_new);
@@ -331,8 +334,7 @@ void World::stage_sleep() {
   if (!std::isfinite(report_.solve.residual) || !std::isfinite(report_.relax.residual))
     fail(-1, "the contact solver diverged (residual is not finite)");
   report_.awake_floes = static_cast<int>(awake_list_.size()) - (model_.vessel >= 0 ? 1 : 0);
-  for (size_t b = 0; b < model_.bodies.size(); ++b)
-    report_.floe_bodies += model_.bodies[b].kind == BodyKind::floe && state_.alive[b];
+  report_.floe_bodies = floes_alive_;
   for (int b : awake_list_) {
     if (!state_.alive[b]) continue;  // broke up in this step
     const Vec3& v = state_.velocity[b];

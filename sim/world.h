@@ -114,6 +114,7 @@ class World {
   std::vector<double> ended_s_;
   double brash_mass_kg_ = 0;
   int next_floe_id_ = 1;            // ids of new pieces: above every id the world has seen, never reused
+  int floes_alive_ = 0;             // floe bodies alive (changes only in the fracture stage)
   std::array<double, kStageCount> stage_seconds_{};
 };
 

@@ -311,25 +311,7 @@ TEST(Fracture, EventsConserveMassAndMomentumAndPiecesDoNotOverlap) {
         EXPECT_LE((p - p0).norm(), 1e-9 * (p0.norm() + P.mass_kg * 1e-3));
         EXPECT_LE((L - L0).norm(), 1e-8 * (L0.norm() + P.inertia.norm() * 1e-3));
       }
-      // No two pieces overlap: their outlines (world plan) intersect in zero area.
-      for (size_t i = 0; i < kids.size(); ++i)
-        for (size_t j = i + 1; j < kids.size(); ++j) {
-          auto plan = [&](int b) {
-            Polygon q;
-            const Mat3 R = s.orientation[b].toRotationMatrix();
-            for (const Vec2& v : m.bodies[b].outline) {
-              const Vec3 x = s.position[b] + R * Vec3(v.x(), v.y(), 0);
-              q.emplace_back(x.x(), x.y());
-            }
-            return q;
-          };
-          double overlap = 0;
-          for (const Polygon& piece : polygon_intersection(plan(kids[i]), plan(kids[j]), 0.0))
-            overlap += signed_area(piece);
-          EXPECT_LE(overlap, 1e-6) << "pieces of floe " << P.id;
-        }
-      // Nor does a piece overlap its neighbours more than the floe it came from did (it sits where that part of the
-      // floe was): plan overlap with every other floe alive, against the broken floe's own.
+      // A body's outline in the world plan, and the area two such outlines share.
       auto plan_of = [&](int b) {
         Polygon q;
         const Mat3 R = s.orientation[b].toRotationMatrix();
@@ -344,6 +326,12 @@ TEST(Fracture, EventsConserveMassAndMomentumAndPiecesDoNotOverlap) {
         for (const Polygon& piece : polygon_intersection(a, b, 0.0)) area += signed_area(piece);
         return area;
       };
+      // No two pieces overlap: their outlines intersect in zero area.
+      for (size_t i = 0; i < kids.size(); ++i)
+        for (size_t j = i + 1; j < kids.size(); ++j)
+          EXPECT_LE(overlap_area(plan_of(kids[i]), plan_of(kids[j])), 1e-6) << "pieces of floe " << P.id;
+      // Nor does a piece overlap its neighbours more than the floe it came from did (it sits where that part of the
+      // floe was): plan overlap with every other floe alive, against the broken floe's own.
       for (size_t o = 0; o < m.bodies.size(); ++o) {
         if (m.bodies[o].kind != BodyKind::floe || !s.alive[o] || m.bodies[o].parent_id == P.id) continue;
         const double before = overlap_area(plan_of(parent), plan_of(static_cast<int>(o)));
