@@ -31,8 +31,18 @@ const std::vector<FieldSpec>& series_fields() {
       {"solver_iterations", 1, "-", "contact solver sweeps in the step"},
       {"solver_residual", 1, "m/s", "largest velocity change of the last sweep"},
       {"awake_floes", 1, "-", "floes integrated this step (others sleep)"},
-      {"fracture_events", 1, "-", "fracture events in the step (floes broken, /fracture holds each event)"},
-      {"floe_bodies", 1, "-", "floe bodies in the world at the end of the step (pieces included)"},
+      {"fracture_events", 1, "-", "fracture events in the step (floes broken, /fracture holds each event)", 2},
+      {"floe_bodies", 1, "-", "floe bodies in the world at the end of the step (pieces included)", 2},
+      {"solver_subspace_solves", 1, "-", "subspace minimisations (exact sparse solves of the settled rows) in the solve",
+       3},
+      {"solver_capped", 1, "-", "1 if the solve stopped at the sweep cap with the tolerance unmet, else 0", 3},
+      {"solver_complementarity", 1, "m/s",
+       "largest contact-law violation left by the solve (how far one more exact row update would move a velocity)", 3},
+      {"relax_iterations", 1, "-", "sweeps of the relax pass (no push-out bias), whose impulses are the recorded loads",
+       3},
+      {"relax_residual", 1, "m/s", "largest velocity change of the relax pass's last sweep", 3},
+      {"relax_capped", 1, "-", "1 if the relax pass stopped at its sweep cap with the tolerance unmet, else 0", 3},
+      {"relax_complementarity", 1, "m/s", "largest contact-law violation left by the relax pass", 3},
   };
   return k;
 }
@@ -137,12 +147,20 @@ std::vector<T> read_ds(hid_t file_id, const std::string& name, size_t cols, cons
   return v;
 }
 
-// The layout this version writes, and the one before fracture (no /fracture, no lineage, fewer series), which it
-// still reads so that old artefacts still plot and render.
-constexpr const char* kLayout = "floesim-results/2";
-constexpr const char* kLayoutBeforeFracture = "floesim-results/1";
-// Series that floesim-results/1 did not have, and what reading such a file fills in (see read_results).
-bool series_added_in_layout_2(const std::string& name) { return name == "fracture_events" || name == "floe_bodies"; }
+// The layout this version writes (floesim-results/N); it still reads every earlier one so that old artefacts still
+// plot and render: /1 had no fracture (no /fracture, no lineage), /2 no solver series beyond sweeps and residual.
+constexpr int kLayoutVersion = 3;
+constexpr const char* kLayoutPrefix = "floesim-results/";
+std::string layout_name(int version) { return kLayoutPrefix + std::to_string(version); }
+
+// What reading a file of an earlier layout puts in a series that layout did not have: nothing broke before
+// fracture existed (no events, every floe of the geometry a body throughout); solver figures were not recorded.
+std::vector<double> missing_series(const FieldSpec& f, size_t steps, size_t floes) {
+  const std::string name = f.name;
+  if (name == "fracture_events") return std::vector<double>(steps, 0.0);
+  if (name == "floe_bodies") return std::vector<double>(steps, static_cast<double>(floes));
+  return std::vector<double>(steps * f.cols, std::numeric_limits<double>::quiet_NaN());
+}
 
 // How many rows a dataset of layout /2 holds.
 enum class Rows { per_floe, per_event, events_plus_one, any };
@@ -300,7 +318,7 @@ void write_results(const std::filesystem::path& path, const Results& r) {
     });
 
     nlohmann::json attrs = r.attributes;
-    attrs["layout"] = kLayout;
+    attrs["layout"] = layout_name(kLayoutVersion);
     const std::string text = attrs.dump();
     H5Id st(H5Tcopy(H5T_C_S1), H5Tclose);
     H5Tset_size(st, text.size() + 1);
@@ -333,13 +351,14 @@ Results read_results(const std::filesystem::path& path, bool with_states) {
     FLOESIM_REQUIRE(!r.attributes.is_discarded(), file, ": the 'floesim' attribute is not JSON");
   }
   const std::string layout = r.attributes.value("layout", "?");
-  FLOESIM_REQUIRE(layout == kLayout || layout == kLayoutBeforeFracture, file, ": layout ", layout,
-                  " is not supported by this version (it reads ", kLayout, " and ", kLayoutBeforeFracture,
-                  "; a newer floesim wrote it?)");
-  const bool before_fracture = layout == kLayoutBeforeFracture;
+  int version = 0;
+  for (int v = 1; v <= kLayoutVersion; ++v)
+    if (layout == layout_name(v)) version = v;
+  FLOESIM_REQUIRE(version > 0, file, ": layout ", layout, " is not supported by this version (it reads ",
+                  layout_name(1), " to ", layout_name(kLayoutVersion), "; a newer floesim wrote it?)");
+  const bool before_fracture = version < 2;
   for (const auto& f : series_fields())
-    if (!(before_fracture && series_added_in_layout_2(f.name)))
-      r.series[f.name] = read_ds<double>(fid, std::string("/series/") + f.name, f.cols, file);
+    if (f.since <= version) r.series[f.name] = read_ds<double>(fid, std::string("/series/") + f.name, f.cols, file);
   const size_t n = r.steps();
   for (const auto& f : series_fields())
     if (r.series.count(f.name))
@@ -372,10 +391,10 @@ Results read_results(const std::filesystem::path& path, bool with_states) {
     r.floe_origin_mode.assign(floes, kFractureNone);
     r.floe_created_s.assign(floes, 0.0);
     r.floe_ended_s.assign(floes, std::numeric_limits<double>::infinity());
-    r.series["fracture_events"].assign(n, 0.0);
-    r.series["floe_bodies"].assign(n, static_cast<double>(floes));
-    return r;
   }
+  for (const auto& f : series_fields())
+    if (f.since > version) r.series[f.name] = missing_series(f, n, floes);
+  if (before_fracture) return r;
   for_each_fracture_dataset(r, [&](const char* name, auto& v, size_t cols, Rows) {
     v = read_ds<typename std::decay_t<decltype(v)>::value_type>(fid, name, cols, file);
   });

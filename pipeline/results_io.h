@@ -32,8 +32,10 @@
 //   /fracture/brash_mass_kg      [E]      float64   mass of pieces below the minimum size, removed (counted here)
 //   /fracture/child_offset       [E+1]    int64     pieces of event k: child_id[offset[k] .. offset[k+1]-1]
 //   /fracture/child_id           [C]      int32     floe ids of the pieces that became bodies
-//   Layout "floesim-results/2" (this one) added /fracture and the lineage datasets; "/1" files are still read
-//   (input floes only, no events).
+//   Layout "floesim-results/3" (this one) added the solver series (relax sweeps and residual, subspace solves,
+//   capped steps, contact-law violations); "/2" added /fracture and the lineage datasets. "/1" and "/2" files are
+//   still read: a series a file lacks is filled as FieldSpec::since says (input floes only, no events; solver
+//   figures NaN: not recorded).
 //   attribute "floesim" on the root: JSON text with layout version, time_step_s, duration_s,
 //   output_interval_s and the provenance.
 #pragma once
@@ -58,6 +60,7 @@ struct FieldSpec {
   int cols;
   const char* unit;
   const char* doc;
+  int since = 1;  // the layout version (floesim-results/N) that added it
 };
 
 // Per-step series written by simulate. Loads on the vessel are in body axes (x forward = surge, y = sway to port,

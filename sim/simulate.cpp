@@ -159,6 +159,33 @@ std::vector<double> moving_average(const std::vector<double>& x, size_t n) {
   return y;
 }
 
+namespace {
+
+// The per-step scalar series and where each comes from in the step report (the vessel's state and loads are
+// written by hand: they need its pose). write_results checks that every series of the layout was recorded.
+struct ScalarSeries {
+  const char* name;
+  double (*get)(const StepReport&);
+};
+constexpr ScalarSeries kScalarSeries[] = {
+    {"contact_count", [](const StepReport& r) { return double(r.contacts); }},
+    {"vessel_contact_count", [](const StepReport& r) { return double(r.vessel_contacts); }},
+    {"solver_iterations", [](const StepReport& r) { return double(r.solve.iterations); }},
+    {"solver_residual", [](const StepReport& r) { return r.solve.residual; }},
+    {"awake_floes", [](const StepReport& r) { return double(r.awake_floes); }},
+    {"fracture_events", [](const StepReport& r) { return double(r.fracture_events); }},
+    {"floe_bodies", [](const StepReport& r) { return double(r.floe_bodies); }},
+    {"solver_subspace_solves", [](const StepReport& r) { return double(r.solve.subspace_solves); }},
+    {"solver_capped", [](const StepReport& r) { return r.solve.capped ? 1.0 : 0.0; }},
+    {"solver_complementarity", [](const StepReport& r) { return r.solve.complementarity; }},
+    {"relax_iterations", [](const StepReport& r) { return double(r.relax.iterations); }},
+    {"relax_residual", [](const StepReport& r) { return r.relax.residual; }},
+    {"relax_capped", [](const StepReport& r) { return r.relax.capped ? 1.0 : 0.0; }},
+    {"relax_complementarity", [](const StepReport& r) { return r.relax.complementarity; }},
+};
+
+}  // namespace
+
 Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
   FLOESIM_REQUIRE(model.vessel >= 0, "simulate: the model has no vessel");
   const SimulateOptions& o = model.options;
@@ -183,16 +210,6 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
   auto& c_hydro = *col["hydro_load"];
   auto& c_wind = *col["wind_load"];
   auto& c_prop = *col["propulsion_load"];
-  auto& c_contacts = *col["contact_count"];
-  auto& c_vcontacts = *col["vessel_contact_count"];
-  auto& c_iter = *col["solver_iterations"];
-  auto& c_res = *col["solver_residual"];
-  auto& c_awake = *col["awake_floes"];
-  auto& c_fracture = *col["fracture_events"];
-  auto& c_floes = *col["floe_bodies"];
-  FLOESIM_REQUIRE(col.size() == 18, "internal: the results table has ", col.size(),
-                  " series; the recorder writes 18 (update simulate.cpp)");
-
   const size_t nb = model.bodies.size();  // at the start; the world's table grows as ice breaks
   const size_t frames = static_cast<size_t>(steps / every);
   r.frame_offset.push_back(0);
@@ -224,13 +241,7 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
     push_body_wrench(c_hydro, R, rep.hydro_load);
     push_body_wrench(c_wind, R, rep.wind_load);
     push_body_wrench(c_prop, R, rep.propulsion_load);
-    c_contacts.push_back(rep.contacts);
-    c_vcontacts.push_back(rep.vessel_contacts);
-    c_iter.push_back(rep.solve.iterations);
-    c_res.push_back(rep.solve.residual);
-    c_awake.push_back(rep.awake_floes);
-    c_fracture.push_back(rep.fracture_events);
-    c_floes.push_back(rep.floe_bodies);
+    for (const ScalarSeries& f : kScalarSeries) col[f.name]->push_back(f.get(rep));
     awake_sum += rep.awake_floes;
     contact_sum += rep.contacts;
     iter_sum += rep.solve.iterations;
@@ -307,6 +318,50 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
   return r;
 }
 
+namespace {
+
+// How well the contact solver did over the whole run (every step, not only the steady part: an unconverged step
+// during the start-up is as wrong as any other), for the solve and for the relax pass whose impulses are the
+// recorded loads.
+nlohmann::json solver_summary(const SolverOptions& o, const Results& r) {
+  auto pass = [&](const char* prefix) {
+    const std::string p = prefix;
+    const auto& sweeps = r.get(p + "_iterations");
+    const auto& resid = r.get(p + "_residual");
+    const auto& capped = r.get(p + "_capped");
+    const auto& viol = r.get(p + "_complementarity");
+    const size_t n = sweeps.size();
+    double sum = 0, most = 0, rmax = 0, ncap = 0, vmax = 0, vsum = 0;
+    for (size_t i = 0; i < n; ++i) {
+      sum += sweeps[i];
+      most = std::max(most, sweeps[i]);
+      rmax = std::max(rmax, resid[i]);
+      ncap += capped[i];
+      vmax = std::max(vmax, viol[i]);
+      vsum += viol[i];
+    }
+    const double d = std::max<double>(1, static_cast<double>(n));
+    return nlohmann::json{{"mean_sweeps", sum / d},
+                          {"max_sweeps", most},
+                          {"max_residual_mps", rmax},
+                          {"capped_step_fraction", ncap / d},
+                          {"max_complementarity_mps", vmax},
+                          {"mean_complementarity_mps", vsum / d}};
+  };
+  nlohmann::json j = pass("solver");
+  const auto& sub = r.get("solver_subspace_solves");
+  double subs = 0;
+  for (double x : sub) subs += x;
+  j["method"] = o.method;
+  j["sweep_cap"] = o.iterations;
+  j["tolerance_mps"] = o.tolerance_mps;
+  j["subspace_solves_per_step"] = subs / std::max<double>(1, static_cast<double>(sub.size()));
+  j["relax"] = pass("relax");
+  return j;
+}
+
+}  // namespace
+
 nlohmann::json summarize(const Model& model, const Results& r) {
   const SimulateOptions& o = model.options;
   const auto& t = r.get("time_s");
@@ -317,14 +372,12 @@ nlohmann::json summarize(const Model& model, const Results& r) {
   const auto& prop = r.get("propulsion_load");
   const auto& awake = r.get("awake_floes");
   const auto& contacts = r.get("contact_count");
-  const auto& iters = r.get("solver_iterations");
-  const auto& resid = r.get("solver_residual");
   const auto& vcont = r.get("vessel_contact_count");
   // Steady part: rows with t >= steady_start_s (within half a step).
   size_t first = 0;
   while (first < t.size() && t[first] < o.steady_start_s - 0.5 * o.time_step_s) ++first;
   std::vector<double> fx;
-  double speed = 0, thrust = 0, aw = 0, co = 0, it = 0, vc = 0, rmax = 0, fx_rigid = 0, fx_compliant = 0;
+  double speed = 0, thrust = 0, aw = 0, co = 0, vc = 0, fx_rigid = 0, fx_compliant = 0;
   for (size_t i = first; i < t.size(); ++i) {
     fx.push_back(ice[6 * i]);
     fx_rigid += ice_rigid[6 * i];
@@ -334,8 +387,6 @@ nlohmann::json summarize(const Model& model, const Results& r) {
     aw += awake[i];
     co += contacts[i];
     vc += vcont[i];
-    it += iters[i];
-    rmax = std::max(rmax, resid[i]);
   }
   const double n = static_cast<double>(fx.size());
   FLOESIM_REQUIRE(n > 0, "internal: no steady samples");
@@ -390,8 +441,7 @@ nlohmann::json summarize(const Model& model, const Results& r) {
   s["mean_awake_floes"] = aw / n;
   s["mean_contacts"] = co / n;
   s["mean_vessel_contacts"] = vc / n;
-  s["mean_solver_iterations"] = it / n;
-  s["max_solver_residual_mps"] = rmax;
+  s["solver"] = solver_summary(o.solver, r);
   s["steps"] = r.steps();
   s["frames"] = r.frames();
   s["floes"] = model.floe_count();

@@ -226,8 +226,21 @@ struct SolverOptions {
   double max_push_mps = 0.5;       // cap of the push-out velocity of rigid contacts
   double speculative_m = 0.02;     // manifold points up to this far apart are kept (speculative contacts)
   bool warm_start = true;          // start from the previous step's impulses (matched per contact)
+  // pgs_subspace: Gauss-Seidel with a subspace minimisation (an exact sparse solve of the settled rows) every
+  // subspace_every sweeps while unconverged, for heavy-on-light chains; pgs: sweeps alone (for comparison).
+  std::string method = "pgs_subspace";
+  int subspace_every = 8;
+  bool reverse_order = false;      // sweep the rows last to first (to check that results do not hang on the order)
   template <class V>
   void visit(V& v) {
+    v.field("method", method, "-",
+            "pgs_subspace (Gauss-Seidel + exact sparse solve of the settled rows, converges on heavy-on-light "
+            "chains) or pgs (sweeps only)",
+            one_of({"pgs_subspace", "pgs"}));
+    v.field("subspace_every", subspace_every, "-",
+            "sweeps between two subspace minimisations while the tolerance is unmet (pgs_subspace)",
+            int_in_range(1, 10000));
+    v.field("reverse_order", reverse_order, "-", "sweep the contact rows in reverse order (an order-dependence check)");
     v.field("iterations", iterations, "-", "largest number of Gauss-Seidel sweeps per step", int_in_range(1, 10000));
     v.field("relax_iterations", relax_iterations, "-",
             "sweeps without push-out bias after the position update, so that push-out leaves no velocity",

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
 namespace floesim::sim {
 
 namespace {
@@ -140,55 +143,251 @@ void prepare_contacts(const Model& model, const SolverBodies& sb, State& state, 
   }
 }
 
+namespace {
+
+// The new normal impulse of one contact's normal row from its current normal velocity vn: the local law.
+inline double normal_update(const Contact& c, double vn, double dt, bool use_bias) {
+  if (c.type == ContactType::crushing) return crushing_impulse(c, vn, dt);
+  const double target = use_bias ? c.bias : (c.gap > 0 ? -c.gap / dt : 0.0);
+  return std::clamp(c.pn + c.mass_n * (target - vn), 0.0, c.max_normal_impulse);
+}
+
+// The new friction impulses from the current tangential velocities, projected together onto the Coulomb disk of
+// radius mu p_n (the exact cone section, no polyhedral anisotropy).
+inline void friction_update(const Contact& c, double v1, double v2, double& p1, double& p2) {
+  const double lim = c.mu * c.pn;
+  p1 = c.pt1 - c.mass_t1 * v1;
+  p2 = c.pt2 - c.mass_t2 * v2;
+  const double pt = std::sqrt(p1 * p1 + p2 * p2);
+  if (pt > lim) {
+    const double s = pt > 0 ? lim / pt : 0.0;
+    p1 *= s;
+    p2 *= s;
+  }
+}
+
+// One Gauss-Seidel update of a contact (normal row, then the two friction rows on the new normal impulse).
+// Returns the largest row velocity change it made (m/s).
+double sweep_contact(State& state, const SolverBodies& sb, Contact& c, double dt, bool use_bias) {
+  double change = 0;
+  const double pn = normal_update(c, rel_velocity(state, c, c.normal), dt, use_bias);
+  const double dpn = pn - c.pn;
+  if (dpn != 0) {
+    apply(state, sb, c, c.normal, c.ia_n, c.ib_n, dpn);
+    c.pn = pn;
+    change = std::abs(dpn) * c.inv_mass_n;
+  }
+  double p1, p2;
+  friction_update(c, rel_velocity(state, c, c.t1), rel_velocity(state, c, c.t2), p1, p2);
+  const double d1 = p1 - c.pt1, d2 = p2 - c.pt2;
+  if (d1 != 0) {
+    apply(state, sb, c, c.t1, c.ia_t1, c.ib_t1, d1);
+    change = std::max(change, std::abs(d1) / std::max(c.mass_t1, 1e-300));
+  }
+  if (d2 != 0) {
+    apply(state, sb, c, c.t2, c.ia_t2, c.ib_t2, d2);
+    change = std::max(change, std::abs(d2) / std::max(c.mass_t2, 1e-300));
+  }
+  c.pt1 = p1;
+  c.pt2 = p2;
+  return change;
+}
+
+// How far one exact local update would move each row's velocity (m/s), nothing applied: the violation of the
+// contact law (complementarity, crushing law, Coulomb disk) at the current impulses. Returns the largest over all
+// rows; `sum_sq` gets the sum of squares (the merit the subspace step must lower).
+double law_violation(const State& state, const std::vector<Contact>& contacts, double dt, bool use_bias,
+                     double* sum_sq = nullptr) {
+  double worst = 0, sq = 0;
+  for (const Contact& c : contacts) {
+    const double pn = normal_update(c, rel_velocity(state, c, c.normal), dt, use_bias);
+    double p1, p2;
+    friction_update(c, rel_velocity(state, c, c.t1), rel_velocity(state, c, c.t2), p1, p2);
+    const double e[3] = {std::abs(pn - c.pn) * c.inv_mass_n, std::abs(p1 - c.pt1) / std::max(c.mass_t1, 1e-300),
+                         std::abs(p2 - c.pt2) / std::max(c.mass_t2, 1e-300)};
+    for (double x : e) {
+      worst = std::max(worst, x);
+      sq += x * x;
+    }
+  }
+  if (sum_sq) *sum_sq = sq;
+  return worst;
+}
+
+// A row of the subspace: which contact and which of its rows (0 normal, 1 and 2 friction), and its equation
+// v + soft p = target (soft = 0: an equality on the velocity; soft > 0: the crushing law's hardening branch,
+// p = dt (F - k v) <=> v + p / (dt k) = F / k).
+struct SubspaceRow {
+  int contact;
+  int k;
+  double soft, target;
+};
+
+// One row's block on one body: the Jacobian J (linear, angular) and M^-1 J^T.
+struct SubspaceEntry {
+  int body, row;
+  Vec3 lin, ang, mlin, mang;
+};
+
+// The subspace minimisation of PGS-SM (Silcowitz, Niebe & Erleben 2010). The rows whose state the sweeps have
+// settled are solved exactly, the others held: normal rows that press (rigid rows: v_n = target; crushing rows by
+// their branch: rigid v_n = 0 below dt F_0, or the hardening/capped law above it) and friction rows that stick
+// (v_t = 0). Their Delassus matrix W = J M^-1 J^T (sparse: rows share a body only through that body's block) is
+// factorised by a sparse LDL^T with a fill-reducing ordering; W may be singular (four manifold points on one face,
+// friction rows of a wall), so its diagonal gets a relative 1e-10 (the regularised variant of PHYSICS.md §1.5, far
+// below any physical compliance). The new impulses are projected on their bounds and applied; the next sweeps
+// correct rows that changed state. Returns the number of rows solved (0: nothing settled, the factorisation
+// failed, or the step did not lower the violation and was undone).
+int subspace_step(const SolverBodies& sb, State& state, std::vector<Contact>& contacts, double dt, bool use_bias) {
+  std::vector<SubspaceRow> rows;
+  for (int ci = 0; ci < static_cast<int>(contacts.size()); ++ci) {
+    const Contact& c = contacts[ci];
+    if (c.mass_n <= 0 || c.pn <= 0) continue;  // between two fixed bodies, or not pressing: held (at zero)
+    if (c.type == ContactType::rigid) {
+      rows.push_back({ci, 0, 0.0, use_bias ? c.bias : (c.gap > 0 ? -c.gap / dt : 0.0)});
+    } else if (c.pn < dt * c.crush_force_n) {
+      rows.push_back({ci, 0, 0.0, 0.0});  // below the crushing force: rigid, no push-out
+    } else {
+      // Crushing: the branch crushing_impulse takes at the current velocity.
+      const double W = c.inv_mass_n;
+      const double v0 = rel_velocity(state, c, c.normal) - W * c.pn;
+      const double k = dt * c.crush_stiffness_npm + c.crush_damping_nspm, cn = c.crush_damping_nspm;
+      const double hardening = dt * (c.crush_force_n - k * v0) / (1 + dt * k * W);
+      const double capped = dt * (c.crush_force_end_n - cn * v0) / (1 + dt * cn * W);
+      if (hardening <= capped) {
+        if (k > 0) rows.push_back({ci, 0, 1 / (dt * k), c.crush_force_n / k});
+      } else if (cn > 0) {
+        rows.push_back({ci, 0, 1 / (dt * cn), c.crush_force_end_n / cn});
+      }
+      // Otherwise the impulse is a constant of the branch (dt F_0 or dt F_end): held.
+    }
+    const double pt = std::sqrt(c.pt1 * c.pt1 + c.pt2 * c.pt2);
+    if (c.mu > 0 && pt < c.mu * c.pn * (1 - 1e-9)) {
+      rows.push_back({ci, 1, 0.0, 0.0});  // sticking
+      rows.push_back({ci, 2, 0.0, 0.0});
+    }
+  }
+  const int m = static_cast<int>(rows.size());
+  if (m == 0) return 0;
+
+  // Jacobian blocks per body (a fixed body has M^-1 = 0 and couples nothing), grouped by body.
+  std::vector<SubspaceEntry> entries;
+  entries.reserve(2 * rows.size());
+  auto fixed = [&](int b) { return sb.inv_mass[b].isZero(0) && sb.inv_inertia_world[b].isZero(0); };
+  for (int r = 0; r < m; ++r) {
+    const Contact& c = contacts[rows[r].contact];
+    const int k = rows[r].k;
+    const Vec3& d = k == 0 ? c.normal : k == 1 ? c.t1 : c.t2;
+    const Vec3& ia = k == 0 ? c.ia_n : k == 1 ? c.ia_t1 : c.ia_t2;
+    const Vec3& ib = k == 0 ? c.ib_n : k == 1 ? c.ib_t1 : c.ib_t2;
+    if (!fixed(c.body_a))
+      entries.push_back({c.body_a, r, -d, -c.ra.cross(d), -(sb.inv_mass[c.body_a] * d), -ia});
+    if (!fixed(c.body_b))
+      entries.push_back({c.body_b, r, d, c.rb.cross(d), sb.inv_mass[c.body_b] * d, ib});
+  }
+  std::sort(entries.begin(), entries.end(), [](const SubspaceEntry& x, const SubspaceEntry& y) {
+    return x.body != y.body ? x.body < y.body : x.row < y.row;
+  });
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (size_t g = 0; g < entries.size();) {
+    size_t e = g;
+    while (e < entries.size() && entries[e].body == entries[g].body) ++e;
+    for (size_t i = g; i < e; ++i)
+      for (size_t j = g; j <= i; ++j)  // lower triangle: row i >= row j (sorted by row within the body)
+        triplets.emplace_back(entries[i].row, entries[j].row,
+                              entries[i].lin.dot(entries[j].mlin) + entries[i].ang.dot(entries[j].mang));
+    g = e;
+  }
+  Eigen::SparseMatrix<double> W(m, m);
+  W.setFromTriplets(triplets.begin(), triplets.end());
+  Eigen::VectorXd rhs(m);
+  for (int r = 0; r < m; ++r) {
+    Contact& c = contacts[rows[r].contact];
+    const int k = rows[r].k;
+    const Vec3& d = k == 0 ? c.normal : k == 1 ? c.t1 : c.t2;
+    const double p = k == 0 ? c.pn : k == 1 ? c.pt1 : c.pt2;
+    const double w = W.coeff(r, r);
+    W.coeffRef(r, r) = w * (1 + 1e-10) + rows[r].soft;
+    rhs[r] = rows[r].target - rel_velocity(state, c, d) - rows[r].soft * p;
+  }
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower> ldlt(W);
+  if (ldlt.info() != Eigen::Success) return 0;
+  const Eigen::VectorXd dp = ldlt.solve(rhs);
+  if (ldlt.info() != Eigen::Success || !dp.allFinite()) return 0;
+
+  // New impulses, projected (normal >= 0, friction in the disk of the new normal impulse), applied per contact.
+  // The step is kept only if it lowers the violation of the contact law: when the settled set was wrong (a row
+  // that must slide or separate), the projection can leave the impulses worse than the sweeps had them (PGS-SM
+  // has no convergence guarantee of its own); then the step is undone exactly and the sweeps go on.
+  double before = 0, after = 0;
+  law_violation(state, contacts, dt, use_bias, &before);
+  std::vector<Vec3> old(contacts.size());  // (pn, pt1, pt2) of each contact the step touches
+  for (const SubspaceRow& row : rows) {
+    const Contact& c = contacts[row.contact];
+    old[row.contact] = Vec3(c.pn, c.pt1, c.pt2);
+  }
+  auto set_impulses = [&](Contact& c, double pn, double p1, double p2) {
+    apply(state, sb, c, c.normal, c.ia_n, c.ib_n, pn - c.pn);
+    apply(state, sb, c, c.t1, c.ia_t1, c.ib_t1, p1 - c.pt1);
+    apply(state, sb, c, c.t2, c.ia_t2, c.ib_t2, p2 - c.pt2);
+    c.pn = pn;
+    c.pt1 = p1;
+    c.pt2 = p2;
+  };
+  for (int r = 0; r < m;) {
+    Contact& c = contacts[rows[r].contact];
+    double pn = c.pn, p1 = c.pt1, p2 = c.pt2;
+    for (; r < m && &contacts[rows[r].contact] == &c; ++r) {
+      if (rows[r].k == 0) pn += dp[r];
+      else if (rows[r].k == 1) p1 += dp[r];
+      else p2 += dp[r];
+    }
+    // Rigid rows keep their bound; a crushing row's bound is its law, which the next sweep applies.
+    pn = c.type == ContactType::rigid ? std::clamp(pn, 0.0, c.max_normal_impulse) : std::max(pn, 0.0);
+    const double lim = c.mu * pn, pt = std::sqrt(p1 * p1 + p2 * p2);
+    if (pt > lim) {
+      const double s = pt > 0 ? lim / pt : 0.0;
+      p1 *= s;
+      p2 *= s;
+    }
+    set_impulses(c, pn, p1, p2);
+  }
+  law_violation(state, contacts, dt, use_bias, &after);
+  if (after < before) return m;
+  for (int r = m - 1; r >= 0; --r) {  // undo, contact by contact (each once: rows of a contact are adjacent)
+    if (r + 1 < m && rows[r + 1].contact == rows[r].contact) continue;
+    const Vec3& p = old[rows[r].contact];
+    set_impulses(contacts[rows[r].contact], p.x(), p.y(), p.z());
+  }
+  return 0;
+}
+
+}  // namespace
+
 SolverReport solve_contacts(const Model& model, const SolverBodies& sb, State& state, std::vector<Contact>& contacts,
                             double dt, bool use_bias, int iterations, double tolerance) {
   SolverReport rep;
   if (contacts.empty()) return rep;
-  // 3. Sweeps. Normal row first (accumulated impulse clamped to [0, bound]), then the two friction rows projected
-  // together onto the Coulomb disk of radius mu p_n (the exact cone section, no polyhedral anisotropy).
+  const SolverOptions& o = model.options.solver;
+  const bool subspace = o.method == "pgs_subspace";
+  const int n = static_cast<int>(contacts.size());
+  // 3. Sweeps: each contact's normal row, then its two friction rows on the new normal impulse; every
+  // subspace_every unconverged sweeps, the subspace minimisation.
   for (int it = 0; it < iterations; ++it) {
     double change = 0;
-    for (Contact& c : contacts) {
-      const double vn = rel_velocity(state, c, c.normal);
-      double pn;
-      if (c.type == ContactType::crushing) {
-        pn = crushing_impulse(c, vn, dt);
-      } else {
-        const double target = use_bias ? c.bias : (c.gap > 0 ? -c.gap / dt : 0.0);
-        pn = std::clamp(c.pn + c.mass_n * (target - vn), 0.0, c.max_normal_impulse);
-      }
-      const double dpn = pn - c.pn;
-      if (dpn != 0) {
-        apply(state, sb, c, c.normal, c.ia_n, c.ib_n, dpn);
-        c.pn = pn;
-        change = std::max(change, std::abs(dpn) * c.inv_mass_n);
-      }
-      const double lim = c.mu * c.pn;
-      const double v1 = rel_velocity(state, c, c.t1), v2 = rel_velocity(state, c, c.t2);
-      double p1 = c.pt1 - c.mass_t1 * v1, p2 = c.pt2 - c.mass_t2 * v2;
-      const double pt = std::sqrt(p1 * p1 + p2 * p2);
-      if (pt > lim) {
-        const double s = pt > 0 ? lim / pt : 0.0;
-        p1 *= s;
-        p2 *= s;
-      }
-      const double d1 = p1 - c.pt1, d2 = p2 - c.pt2;
-      if (d1 != 0) {
-        apply(state, sb, c, c.t1, c.ia_t1, c.ib_t1, d1);
-        change = std::max(change, std::abs(d1) / std::max(c.mass_t1, 1e-300));
-      }
-      if (d2 != 0) {
-        apply(state, sb, c, c.t2, c.ia_t2, c.ib_t2, d2);
-        change = std::max(change, std::abs(d2) / std::max(c.mass_t2, 1e-300));
-      }
-      c.pt1 = p1;
-      c.pt2 = p2;
-    }
+    if (o.reverse_order)
+      for (int i = n - 1; i >= 0; --i) change = std::max(change, sweep_contact(state, sb, contacts[i], dt, use_bias));
+    else
+      for (int i = 0; i < n; ++i) change = std::max(change, sweep_contact(state, sb, contacts[i], dt, use_bias));
     // 4. Residual and iteration count.
     rep.iterations = it + 1;
     rep.residual = change;
     if (!(change > tolerance)) break;  // also stops on NaN: the caller's health check reports it
+    if (subspace && (it + 1) % o.subspace_every == 0 && it + 1 < iterations)
+      rep.subspace_solves += subspace_step(sb, state, contacts, dt, use_bias) > 0;
   }
+  rep.capped = rep.residual > tolerance;
+  rep.complementarity = law_violation(state, contacts, dt, use_bias);
   return rep;
 }
 

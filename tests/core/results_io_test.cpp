@@ -192,7 +192,7 @@ TEST(ResultsIo, FractureEventsAndLineageRoundTrip) {
   const Results r = fractured_results();
   write_results(p, r);
   const Results b = read_results(p);
-  EXPECT_EQ(b.attributes["layout"], "floesim-results/2");
+  EXPECT_EQ(b.attributes["layout"], "floesim-results/3");
   EXPECT_EQ(b.floe_id, r.floe_id);
   EXPECT_EQ(b.floe_vertices_m, r.floe_vertices_m);
   EXPECT_EQ(b.floe_parent_id, r.floe_parent_id);
@@ -273,6 +273,33 @@ TEST(ResultsIo, InconsistentFractureTablesAreRefusedOnWriteAndOnReadNamingTheDat
   fs::remove(good);
 }
 
+TEST(ResultsIo, LayoutTwoFilesReadWithTheSolverSeriesNotRecorded) {
+  // A floesim-results/2 file: today's writer, then the series /3 added removed and the layout set back. What it did
+  // not record reads as NaN (unknown), never as a made-up zero; the rest is read as written.
+  const fs::path p = fs::temp_directory_path() / "floesim_results_layout2.h5";
+  const Results w = small_results(4);
+  write_results(p, w);
+  std::vector<std::string> added;
+  for (const auto& f : series_fields())
+    if (f.since == 3) added.push_back(f.name);
+  ASSERT_FALSE(added.empty());
+  {
+    const hid_t f = H5Fopen(p.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(f, 0);
+    for (const std::string& name : added) ASSERT_GE(H5Ldelete(f, ("/series/" + name).c_str(), H5P_DEFAULT), 0) << name;
+    H5Fclose(f);
+  }
+  replace_attributes(p, {{"layout", "floesim-results/2"}, {"time_step_s", 0.01}});
+  const Results r = read_results(p);
+  for (const std::string& name : added) {
+    ASSERT_EQ(r.get(name).size(), 4u) << name;
+    for (double x : r.get(name)) EXPECT_TRUE(std::isnan(x)) << name;
+  }
+  EXPECT_EQ(r.get("solver_iterations"), w.get("solver_iterations"));
+  EXPECT_EQ(r.get("fracture_events"), w.get("fracture_events"));
+  fs::remove(p);
+}
+
 TEST(ResultsIo, LayoutOneFilesFromBeforeFractureReadWithDefaults) {
   // A floesim-results/1 file: today's writer, then what /1 did not have removed and the layout set back.
   const fs::path p = fs::temp_directory_path() / "floesim_results_layout1.h5";
@@ -301,10 +328,10 @@ TEST(ResultsIo, LayoutOneFilesFromBeforeFractureReadWithDefaults) {
   EXPECT_EQ(r.get("fracture_events"), std::vector<double>(4, 0.0));
   EXPECT_EQ(r.get("floe_bodies"), std::vector<double>(4, 1.0)) << "every floe was a body for the whole run";
   EXPECT_EQ(r.get("ice_load").size(), 4u * 6u);
-  // Rewritten, it becomes a /2 file with the same content.
+  // Rewritten, it becomes a file of the current layout with the same content.
   const fs::path q = fs::temp_directory_path() / "floesim_results_layout1_rewritten.h5";
   write_results(q, r);
-  EXPECT_EQ(read_results(q).attributes["layout"], "floesim-results/2");
+  EXPECT_EQ(read_results(q).attributes["layout"], "floesim-results/3");
   fs::remove(q);
 
   // A layout from the future is refused, naming it.

@@ -53,7 +53,7 @@ TEST(SimTransit, VesselPushesFloesAndLayoutIsExact) {
   std::printf("[measured] mean surge ice load %.1f kN, mean speed %.3f m/s, mean vessel contacts %.2f, "
               "mean sweeps %.1f, %.3f ms/step\n",
               mean_fx / 1e3, s["mean_vessel_speed_mps"].get<double>(), s["mean_vessel_contacts"].get<double>(),
-              s["mean_solver_iterations"].get<double>(), 1e3 * stats.wall_s / stats.steps);
+              s["solver"]["mean_sweeps"].get<double>(), 1e3 * stats.wall_s / stats.steps);
   EXPECT_LT(mean_fx, 0);  // ice resists the vessel
   EXPECT_GT(s["mean_vessel_contacts"].get<double>(), 0.5);
   EXPECT_NEAR(s["mean_vessel_speed_mps"].get<double>(), 2.0, 0.1);  // the speed controller holds 2 m/s

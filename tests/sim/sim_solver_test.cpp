@@ -1,0 +1,160 @@
+// The contact solver on heavy-on-light chains (issue #8 §1): a 13,000 t hull pushing light ice against heavy ice
+// or a fixed wall is where projected Gauss-Seidel leaves its error on the vessel. The answers are closed forms
+// (momentum of a perfectly inelastic chain; statics of a jam), independent of the solver.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "sim/solver.h"
+#include "sim_fixtures.h"
+
+namespace floesim::sim {
+namespace {
+
+using testing::rect_floe;
+
+// Three bodies on the x axis, a < b < c, touching: a rigid (or rigid-branch crushing) row between each neighbour
+// pair, the contact points on the axis (no lever arms), normals +x. Cold start (no cache).
+struct Chain {
+  Model model;
+  State state;
+  SolverBodies bodies;
+  std::vector<Contact> contacts;
+};
+
+Chain make_chain(const std::vector<double>& mass, double v0, ContactType type, const std::string& method) {
+  Chain ch;
+  ch.model.options.solver.method = method;
+  const int n = static_cast<int>(mass.size());
+  ch.state.position.resize(n);
+  ch.state.orientation.assign(n, Quat::Identity());
+  ch.state.velocity.assign(n, Vec3::Zero());
+  ch.state.angular_velocity.assign(n, Vec3::Zero());
+  ch.state.velocity[0] = Vec3(v0, 0, 0);
+  for (int i = 0; i < n; ++i) {
+    ch.state.position[i] = Vec3(10.0 * i, 0, 0);
+    ch.bodies.inv_mass.push_back(Mat3::Identity() / mass[i]);
+    // A 10 m cube's inertia: any finite inertia will do, the rows have no lever arm.
+    ch.bodies.inv_inertia_world.push_back(Mat3::Identity() * 6 / (mass[i] * 100));
+  }
+  for (int i = 0; i + 1 < n; ++i) {
+    Contact c;
+    c.body_a = i;
+    c.body_b = i + 1;
+    c.part_a = c.part_b = 0;
+    c.point = Vec3(10.0 * i + 5, 0, 0);
+    c.normal = Vec3::UnitX();
+    c.gap = 0;
+    c.mu = 0.1;
+    c.type = type;
+    if (type == ContactType::crushing) {
+      // A large contact face: dt sigma_c A far above the impulses of the chain, so the rows stay rigid.
+      c.area_m2 = c.area_end_m2 = 1000;
+      c.area_step_m = 0.01;
+    }
+    ch.contacts.push_back(c);
+  }
+  return ch;
+}
+
+// Vessel 13,000 t at 2 m/s hits a 10 t floe resting against a 7,000 t floe. The converged (perfectly inelastic)
+// answer: all three move at v_f = m_v v0 / (m_v + m_1 + m_2); the row between the floes carries m_2 v_f, the bow's
+// row (m_1 + m_2) v_f.
+class SolverChain : public ::testing::TestWithParam<ContactType> {};
+
+TEST_P(SolverChain, HeavyOnLightChainGetsTheInelasticImpulse) {
+  const std::vector<double> mass = {13e6, 1e4, 7e6};
+  const double v0 = 2.0;
+  const double vf = mass[0] * v0 / (mass[0] + mass[1] + mass[2]);
+  const double p_bow = (mass[1] + mass[2]) * vf, p_floes = mass[2] * vf;
+  double reached[2] = {0, 0};
+  for (const char* method : {"pgs", "pgs_subspace"}) {
+    Chain ch = make_chain(mass, v0, GetParam(), method);
+    const double dt = ch.model.options.time_step_s;
+    prepare_contacts(ch.model, ch.bodies, ch.state, ch.contacts, dt);
+    const SolverOptions& o = ch.model.options.solver;
+    const SolverReport rep =
+        solve_contacts(ch.model, ch.bodies, ch.state, ch.contacts, dt, true, o.iterations, o.tolerance_mps);
+    const bool sm = std::string(method) == "pgs_subspace";
+    reached[sm] = ch.contacts[1].pn / p_floes;
+    std::printf("[measured] %s, %s: bow row %.4f, floe row %.4f of the inelastic impulse after %d sweeps "
+                "(%d subspace solves), residual %.2g m/s, law violation %.2g m/s\n",
+                GetParam() == ContactType::rigid ? "rigid" : "crushing", method, ch.contacts[0].pn / p_bow,
+                ch.contacts[1].pn / p_floes, rep.iterations, rep.subspace_solves, rep.residual, rep.complementarity);
+    if (sm) {
+      // 1 %: the issue's bound; the subspace solve is exact to round-off and the regularisation (1e-10 of the
+      // diagonal), so this is met by orders of magnitude.
+      EXPECT_NEAR(ch.contacts[0].pn / p_bow, 1.0, 0.01);
+      EXPECT_NEAR(ch.contacts[1].pn / p_floes, 1.0, 0.01);
+      EXPECT_NEAR(ch.state.velocity[2].x(), vf, 0.01 * vf);
+      EXPECT_FALSE(rep.capped);
+      EXPECT_LT(rep.complementarity, o.tolerance_mps);
+    }
+  }
+  // The sweeps alone are the finding this solver fixes: at 60 sweeps they pass on a fraction of the impulse.
+  EXPECT_LT(reached[0], 0.5) << "plain Gauss-Seidel converged: the chain no longer tests the subspace solve";
+}
+
+INSTANTIATE_TEST_SUITE_P(Laws, SolverChain, ::testing::Values(ContactType::rigid, ContactType::crushing));
+
+// A closed box as the vessel's one convex part: a vertical flat bow, so the jam is planar.
+HullModel box_hull(double length, double beam, double depth) {
+  HullModel h;
+  TriMesh m;
+  const double x = length / 2, y = beam / 2, z = depth / 2;
+  m.vertices = {Vec3(-x, -y, -z), Vec3(x, -y, -z), Vec3(x, y, -z), Vec3(-x, y, -z),
+                Vec3(-x, -y, z),  Vec3(x, -y, z),  Vec3(x, y, z),  Vec3(-x, y, z)};
+  m.triangles = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                 {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+  h.parts = {m};
+  h.surface = m;
+  return h;
+}
+
+// Ten 5 m x 10 m x 1 m floes (45 t) afloat in a row between the flat bow of a 13,000 t box (100 x 25.4 m, draught
+// 5 m) and a fixed wall; the vessel pushed by a constant thrust F well below the crushing force (sigma_c x 10 m^2 =
+// 20 MN) and below what the jam carries without buckling (F h = 0.5 MN m against each floe's pitch restoring
+// rho_w g I_wp = 1.0 MN m/rad: a jam of thin floes under a larger thrust rafts, which is physics, not this test).
+// Once the gaps have closed and the jam is at rest, statics: every contact of the row carries F, and the ice load
+// on the vessel is -F in surge (at rest there is no water resistance).
+TEST(SolverJam, TenFloesBetweenBowAndWallCarryTheThrust) {
+  const double F = 5e5;
+  FloeField field;
+  field.width_m = 200;
+  field.height_m = 100;
+  for (int k = 0; k < 10; ++k) field.floes.push_back(rect_floe(k + 1, 50.001 + 5.001 * k, -5, 5, 10, 1.0));
+  SimulateOptions o = testing::floe_options();
+  o.fracture.enabled = false;
+  o.vessel.initial_speed_mps = 0;
+  o.vessel.x_m = 0;
+  o.vessel.y_m = 0;
+  o.vessel.propulsion.mode = "constant_thrust";
+  o.vessel.propulsion.thrust_n = F;
+  o.domain.walls = {"east"};
+  o.domain.extent_m = {-100, -50, 100.011, 50};
+  const HullModel hull = box_hull(100, 25.4, 10);
+  for (const char* method : {"pgs", "pgs_subspace"}) {
+    o.solver.method = method;
+    const Model m = build_model(field, &hull, o);
+    ASSERT_EQ(m.floe_count(), 10);
+    World w(m);
+    const int steps = 600, tail = 200;  // the gaps close and the floes' heave settles within ~3 s
+    double fx = 0, capped = 0;
+    for (int i = 0; i < steps; ++i) {
+      w.step();
+      if (i < steps - tail) continue;
+      fx += w.report().ice_load.force.x() / tail;
+      capped += w.report().solve.capped;
+    }
+    std::printf("[measured] jam of ten floes, %s: mean surge ice load %.1f kN over the last %d steps (thrust %.1f "
+                "kN), %.0f capped steps; vessel speed %.2g m/s\n",
+                method, fx / 1e3, tail, F / 1e3, capped, w.state().velocity[m.vessel].x());
+    // 1 %: the issue's bound. The statics is exact; what is left is the solver's error and the floes' residual
+    // bobbing (their contact forces scatter by ~10 % step to step, averaged over 200 steps).
+    if (std::string(method) == "pgs_subspace") EXPECT_NEAR(-fx, F, 0.01 * F);
+  }
+}
+
+}  // namespace
+}  // namespace floesim::sim
+
