@@ -43,6 +43,8 @@ const std::vector<FieldSpec>& series_fields() {
       {"relax_residual", 1, "m/s", "largest velocity change of the relax pass's last sweep", 3},
       {"relax_capped", 1, "-", "1 if the relax pass stopped at its sweep cap with the tolerance unmet, else 0", 3},
       {"relax_complementarity", 1, "m/s", "largest contact-law violation left by the relax pass", 3},
+      {"solver_surge_load_error", 1, "N",
+       "surge ice load minus the same with the relax pass converged (simulate.solver.reference_sweeps; NaN if off)", 3},
   };
   return k;
 }

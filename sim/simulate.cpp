@@ -182,6 +182,7 @@ constexpr ScalarSeries kScalarSeries[] = {
     {"relax_residual", [](const StepReport& r) { return r.relax.residual; }},
     {"relax_capped", [](const StepReport& r) { return r.relax.capped ? 1.0 : 0.0; }},
     {"relax_complementarity", [](const StepReport& r) { return r.relax.complementarity; }},
+    {"solver_surge_load_error", [](const StepReport& r) { return r.surge_load_error_n; }},
 };
 
 }  // namespace
@@ -442,6 +443,22 @@ nlohmann::json summarize(const Model& model, const Results& r) {
   s["mean_contacts"] = co / n;
   s["mean_vessel_contacts"] = vc / n;
   s["solver"] = solver_summary(o.solver, r);
+  // The solver's error on the mean load (solver.reference_sweeps > 0): recorded minus converged, over the steady
+  // part, against the mean surge ice load.
+  const auto& err = r.get("solver_surge_load_error");
+  if (o.solver.reference_sweeps > 0 && err.size() == t.size()) {
+    double e = 0, ea = 0, emax = 0;
+    for (size_t i = first; i < t.size(); ++i) {
+      e += err[i];
+      ea += std::abs(err[i]);
+      emax = std::max(emax, std::abs(err[i]));
+    }
+    s["solver"]["surge_load_error"] = {{"reference_sweeps", o.solver.reference_sweeps},
+                                       {"mean_N", e / n},
+                                       {"mean_abs_N", ea / n},
+                                       {"max_abs_N", emax},
+                                       {"mean_over_mean_load", mean != 0 ? (e / n) / mean : 0.0}};
+  }
   s["steps"] = r.steps();
   s["frames"] = r.frames();
   s["floes"] = model.floe_count();

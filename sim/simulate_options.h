@@ -230,6 +230,8 @@ struct SolverOptions {
   // subspace_every sweeps while unconverged, for heavy-on-light chains; pgs: sweeps alone (for comparison).
   std::string method = "pgs_subspace";
   int subspace_every = 8;
+  double subspace_above_mps = 1e-3;  // ... and only while a sweep still changes a velocity by more than this
+  int reference_sweeps = 0;        // diagnostic: the relax pass also continued this far, to measure the load error
   bool reverse_order = false;      // sweep the rows last to first (to check that results do not hang on the order)
   template <class V>
   void visit(V& v) {
@@ -240,6 +242,14 @@ struct SolverOptions {
     v.field("subspace_every", subspace_every, "-",
             "sweeps between two subspace minimisations while the tolerance is unmet (pgs_subspace)",
             int_in_range(1, 10000));
+    v.field("subspace_above_mps", subspace_above_mps, "m/s",
+            "subspace minimisations only while the last sweep changed a contact velocity by more than this (the "
+            "signature of a heavy-on-light chain)",
+            non_negative());
+    v.field("reference_sweeps", reference_sweeps, "-",
+            "diagnostic (costly): each step the relax pass is also continued on a copy for up to this many sweeps, "
+            "and the difference in the vessel's surge ice load is recorded (solver_surge_load_error); 0 = off",
+            int_in_range(0, 1000000));
     v.field("reverse_order", reverse_order, "-", "sweep the contact rows in reverse order (an order-dependence check)");
     v.field("iterations", iterations, "-", "largest number of Gauss-Seidel sweeps per step", int_in_range(1, 10000));
     v.field("relax_iterations", relax_iterations, "-",

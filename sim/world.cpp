@@ -232,20 +232,40 @@ void World::stage_relax() {
     report_.relax = solve_contacts(model_, solver_bodies_, state_, contacts_, dt, false, o.relax_iterations,
                                    o.tolerance_mps);
   store_impulses(model_, state_, contacts_);
+  report_.contacts = static_cast<int>(contacts_.size());
+  report_.vessel_contacts = vessel_ice_load(contacts_, &report_.ice_load_rigid, &report_.ice_load_compliant);
+  report_.ice_load = report_.ice_load_rigid;
+  report_.ice_load += report_.ice_load_compliant;
+  // The solver's error on the recorded load (solver.reference_sweeps, a diagnostic): the relax pass continued on
+  // copies until converged; the difference in the vessel's surge load is what the sweep cap left.
+  report_.surge_load_error_n = std::numeric_limits<double>::quiet_NaN();
+  if (o.reference_sweeps > 0 && model_.vessel >= 0) {
+    State s = state_;
+    std::vector<Contact> c = contacts_;
+    solve_contacts(model_, solver_bodies_, s, c, dt, false, o.reference_sweeps, o.tolerance_mps * 1e-3);
+    Wrench rigid, compliant;
+    vessel_ice_load(c, &rigid, &compliant);
+    const Vec3 surge = state_.orientation[model_.vessel] * Vec3::UnitX();
+    report_.surge_load_error_n = surge.dot(report_.ice_load.force - rigid.force - compliant.force);
+  }
+}
+
+int World::vessel_ice_load(const std::vector<Contact>& contacts, Wrench* rigid, Wrench* compliant) const {
   // Contact loads on the vessel: impulse / dt, about its centre of mass (lever arms of the solve), split by contact
   // law (the seed filters compliant loads over 0.5 s and rigid ones over 20 s, PHYSICS.md §5).
-  report_.contacts = static_cast<int>(contacts_.size());
   const int vessel = model_.vessel;
-  for (const Contact& c : contacts_) {
+  const double dt = model_.options.time_step_s;
+  int n = 0;
+  for (const Contact& c : contacts) {
     if (c.body_a != vessel && c.body_b != vessel) continue;
-    ++report_.vessel_contacts;
+    ++n;
     const Vec3 p = (c.pn * c.normal + c.pt1 * c.t1 + c.pt2 * c.t2) / dt;  // on body b
     Wrench w;
     if (c.body_b == vessel) w.add_at(p, c.rb);
     else w.add_at(-p, c.ra);
-    report_.ice_load += w;
-    (c.type == ContactType::rigid ? report_.ice_load_rigid : report_.ice_load_compliant) += w;
+    *(c.type == ContactType::rigid ? rigid : compliant) += w;
   }
+  return n;
 }
 
 void World::stage_fracture() {

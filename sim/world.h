@@ -43,6 +43,9 @@ struct StepReport {
   int fracture_events = 0;   // floes broken in this step
   int floe_bodies = 0;       // floe bodies alive at the end of the step
   SolverReport solve, relax;
+  // Vessel surge ice load minus the same with the relax pass converged (solver.reference_sweeps > 0), N; NaN when
+  // not measured. The solver's error on the recorded load.
+  double surge_load_error_n = 0;
   Wrench ice_load, ice_load_rigid, ice_load_compliant;
   Wrench hydro_load, wind_load, propulsion_load;
   double thrust_n = 0;
@@ -88,6 +91,9 @@ class World {
   void stage_relax();
   void stage_fracture();
   void stage_sleep();
+  // Sums the contact loads on the vessel (world frame, about its centre of mass) by contact law; returns how many
+  // contacts touch it.
+  int vessel_ice_load(const std::vector<Contact>& contacts, Wrench* rigid, Wrench* compliant) const;
   // Replaces the floe of `cut` by its pieces (bodies appended at the floe's pose and velocity field) and records
   // the event.
   void apply_fracture(FractureCut& cut);

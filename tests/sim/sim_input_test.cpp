@@ -40,6 +40,10 @@ TEST(SimInput, OptionErrorsNameTheKey) {
                {"vessel.propulsion.mode", "speed"});
   expect_error([] { options_from({{"vessel", {{"propulsion", {{"mode", "thrust_series"}}}}}}); },
                {"vessel.propulsion.thrust_file"});
+  expect_error([] { options_from({{"solver", {{"method", "jacobi"}}}}); }, {"solver.method", "pgs_subspace"});
+  expect_error([] { options_from({{"solver", {{"subspace_every", 0}}}}); }, {"solver.subspace_every"});
+  expect_error([] { options_from({{"solver", {{"subspace_above_mps", -1}}}}); }, {"solver.subspace_above_mps"});
+  expect_error([] { options_from({{"solver", {{"reference_sweeps", -5}}}}); }, {"solver.reference_sweeps"});
   const SimulateOptions ok = options_from({{"duration_s", 30}});
   EXPECT_EQ(ok.steps(), 3000);
   EXPECT_EQ(ok.output_every(), 20);

