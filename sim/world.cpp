@@ -179,6 +179,9 @@ void World::stage_forces() {
     report_.propulsion_load = vessel_propulsion(model_, k, state_.time_s, dt, state_.speed_error_integral,
                                                 report_.thrust_n);
     report_.propulsion_load += vessel_autopilot(model_, body, k, state_.heading_ref_rad);
+    // The jets from the pose and thrust at the start of the step, for every floe's drag below. The vessel's own
+    // jets leave its hull astern; their effect on the hull (thrust deduction) is in the resistance and thrust.
+    propeller_jets(model_, k, report_.thrust_n, jets_);
     total += report_.hydro_load;
     total += report_.wind_load;
     total += report_.propulsion_load;
@@ -197,7 +200,7 @@ void World::stage_forces() {
       if (water) {
         w += buoyancy_force(model_, body, k, s);
         w += hydrostatic_damping(model_, body, k);
-        w += floe_water_drag(model_, body, k, s);
+        w += floe_water_drag(model_, body, k, s, jets_);
       }
       w += floe_wind_drag(model_, body, k, s);
       advance(b, k, w);
