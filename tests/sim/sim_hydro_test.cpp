@@ -353,3 +353,49 @@ TEST(SimHydro, ClosedFormDragMatchesClipping) {
 
 }  // namespace
 }  // namespace floesim::sim
+
+namespace floesim::sim {
+namespace {
+
+// What the floes' linear heave/roll/pitch damping (zeta = 0.2 of critical, a stand-in for radiation damping) governs
+// when the bow forces a floe down: the vessel (coarse hull, 2 m/s held) meets a 10 m and a 4 m floe on its track
+// (fracture off: the encounter is pure submersion and push), once with the damping and once without. The surge ice
+// impulse over 60 s changes by less than 6 % (measured 0.3 % and 4 %): the damping does not govern the resistance.
+// It does slow the floe's descent: the vertical impulse and the depth reached differ more (printed), and the peak
+// damping force (40 kN for the 10 m floe) is of the order of the vertical contact load, as a radiation force of
+// zeta ~ 0.1-0.2 would be.
+TEST(SimHydro, HeaveDampingDoesNotGovernBowResistance) {
+  const HullModel hull = testing::coarse_hull(8);
+  for (double size : {10.0, 4.0}) {
+    double surge[2];
+    for (int on = 0; on < 2; ++on) {
+      SimulateOptions o;
+      o.sleep.enabled = false;
+      o.fracture.enabled = false;
+      o.vessel.initial_speed_mps = 2;
+      o.vessel.propulsion.speed_mps = 2;
+      o.water.floe_heave_damping_ratio = on ? 0.2 : 0.0;
+      o.water.floe_roll_pitch_damping_ratio = on ? 0.2 : 0.0;
+      FloeField field;
+      field.floes = {rect_floe(1, 60, -size / 2, size, size, 1.0)};
+      const Model m = build_model(field, &hull, o);
+      World w(m);
+      double ix = 0, iz = 0, zmin = 0, damp_max = 0;
+      for (int i = 0; i < 6000; ++i) {
+        w.step();
+        ix += -w.report().ice_load.force.x() * o.time_step_s;
+        iz += w.report().ice_load.force.z() * o.time_step_s;
+        zmin = std::min(zmin, w.state().position[1].z());
+        damp_max = std::max(damp_max, std::abs(m.bodies[1].heave_damping * w.state().velocity[1].z()));
+      }
+      surge[on] = ix;
+      std::printf("[measured] %2.0f m floe, damping %s: surge ice impulse %.4g N s, vertical %.4g N s, deepest floe "
+                  "centre %.2f m, peak heave damping force %.3g N\n", size, on ? "on " : "off", ix, iz, zmin, damp_max);
+    }
+    EXPECT_GT(surge[0], 1e5);  // a real encounter
+    EXPECT_NEAR(surge[1] / surge[0], 1.0, 0.06);
+  }
+}
+
+}  // namespace
+}  // namespace floesim::sim
