@@ -230,12 +230,14 @@ bool floe_drag_afloat(const Model& m, const Body& b, const BodyKinematics& k, do
 }
 }  // namespace
 
+bool floe_in_jets(const Body& b, const Vec3& x, const std::vector<PropellerJet>& jets) {
+  return !jets.empty() && jets_reach(jets, x, std::hypot(b.section_radius, 0.5 * b.thickness_m));
+}
+
 namespace {
-// The jets if any reaches the floe's bounding ball, else null (the drag then uses the uniform current alone).
+// The jets if any reaches the floe, else null (the drag then uses the uniform current alone).
 const std::vector<PropellerJet>* jets_on(const Body& b, const BodyKinematics& k, const std::vector<PropellerJet>& jets) {
-  if (jets.empty()) return nullptr;
-  const double radius = std::hypot(b.section_radius, 0.5 * b.thickness_m);
-  return jets_reach(jets, k.x, radius) ? &jets : nullptr;
+  return floe_in_jets(b, k.x, jets) ? &jets : nullptr;
 }
 }  // namespace
 

@@ -59,6 +59,8 @@ double jet_width(const PropellerJet& j, double x);
 Vec3 jet_velocity(const std::vector<PropellerJet>& jets, const Vec3& p);
 // False when no jet reaches the ball (centre, radius): the floe's drag then uses the uniform current alone.
 bool jets_reach(const std::vector<PropellerJet>& jets, const Vec3& centre, double radius);
+// Whether a jet reaches the floe b with its centre of mass at x (its bounding ball).
+bool floe_in_jets(const Body& b, const Vec3& x, const std::vector<PropellerJet>& jets);
 // The jets of the vessel's propellers (options.vessel.propellers) for its pose and the propulsion thrust T (each
 // propeller makes thrust_share x T along its axis; T < 0 reverses the jet). V_A: the vessel's velocity through the
 // water at the propeller along the thrust axis (no wake fraction), at least 0.

@@ -128,6 +128,12 @@ void World::stage_collide() {
     if (!state_.awake[c.body_a]) wake(c.body_a);
     if (!state_.awake[c.body_b]) wake(c.body_b);
   }
+  // A sleeping floe that a propeller jet reaches wakes: the water moves there (the jets of the last step).
+  if (!jets_.empty())
+    for (size_t b = 0; b < model_.bodies.size(); ++b)
+      if (!state_.awake[b] && state_.alive[b] && model_.bodies[b].kind == BodyKind::floe &&
+          floe_in_jets(model_.bodies[b], state_.position[b], jets_))
+        wake(static_cast<int>(b));
   awake_list_.clear();
   for (size_t b = 0; b < model_.bodies.size(); ++b)
     if (state_.awake[b]) awake_list_.push_back(static_cast<int>(b));
