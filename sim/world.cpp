@@ -152,7 +152,8 @@ void World::stage_forces() {
     return k;
   };
   // Per body: external wrench, world inverse mass matrices, then the predicted velocities v* = v + dt M^-1 f.
-  // M holds the added mass (PHYSICS.md §3.3: a33 of floes along their normal, surge/sway/yaw of the vessel), so it
+  // M holds the added mass (PHYSICS.md §3.3: floes' heave along their normal and roll/pitch, the vessel's surge, sway,
+  // heave, pitch and yaw), so it
   // acts against every force, the contact impulses of the solver included (the solver uses the same M^-1): the
   // added mass is implicit, not an explicit force. The added mass's Coriolis/Munk terms are neglected.
   auto advance = [&](int b, const BodyKinematics& k, const Wrench& w) {

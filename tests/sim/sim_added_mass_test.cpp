@@ -184,7 +184,7 @@ TEST(SimAddedMass, VesselInertiaGivenOutright) {
 // A 10 m disc floe, 1 m thick (64-gon): heave added mass of the floating disc (4/3) rho_w R^3, 2.4 x the floe's mass
 // (PHYSICS.md §3.3's figure), roll and pitch (8/45) rho_w R^5 (Lamb 1932 §108: (16/45) rho a^5 about a diameter in
 // unbounded fluid, half of it under a free surface), none in surge, sway and yaw. A 40 x 10 m floe of the same
-// thickness: heave added mass over its own mass grows with the size (the 10 m disc's 2.4 x becomes 4.3 x), and more
+// thickness: heave added mass over its own mass grows with the size (the 10 m disc's 2.4 x becomes 5.5 x), and more
 // pitch (about its short axis y) than roll. Within 0.5 %: the 64-gon's area is 0.16 % below pi R^2, its second
 // moment 0.3 % below pi R^4 / 4.
 TEST(SimAddedMass, FloeAddedMassOfFloatingDisc) {
@@ -207,7 +207,7 @@ TEST(SimAddedMass, FloeAddedMassOfFloatingDisc) {
   const Body& r = m.bodies[1];
   // Equivalent disc a = sqrt(400 / pi) = 11.28 m: (4/3) rho a^3 over 900 x 400 kg.
   EXPECT_NEAR(r.added_mass.z() / r.mass_kg, 4.0 / 3.0 * rho * std::pow(400 / kPi, 1.5) / (900 * 400), 1e-9);
-  EXPECT_GT(r.added_mass.z() / r.mass_kg, 4.0);
+  EXPECT_GT(r.added_mass.z() / r.mass_kg, 5.0);
   EXPECT_GT(r.added_inertia.y(), 10 * r.added_inertia.x());  // S_xx / S_yy = (40/10)^2 = 16
   std::printf("[measured] disc D = 10 m: A33 = %.3g kg (%.2f x mass), A44 = %.3g kg m^2; 40 x 10 m: A33 %.2f x mass\n",
               b.added_mass.z(), b.added_mass.z() / b.mass_kg, b.added_inertia.x(), r.added_mass.z() / r.mass_kg);
@@ -232,6 +232,11 @@ TEST(SimAddedMass, VesselHeavePitchByStripTheory) {
               b.added_inertia.y() / a55);
   EXPECT_NEAR(b.added_mass.z() / a33, 1.0, 1e-9);
   EXPECT_NEAR(b.added_inertia.y() / a55, 1.0, 5e-3);
+  // The default Oden-like hull, for the record (no closed form to compare with).
+  const HullModel oden = coarse_hull(30);
+  const Model mo = build_model(FloeField{}, &oden, o);
+  std::printf("[measured] Oden-like hull: A33 = %.2f x mass, A55 = %.2f x I_yy\n",
+              mo.bodies[0].added_mass.z() / mo.bodies[0].mass_kg, mo.bodies[0].added_inertia.y() / mo.bodies[0].inertia(1, 1));
   o.vessel.heave_pitch_added_mass_scale = 0;
   const Model none = build_model(FloeField{}, &hull, o);
   EXPECT_EQ(none.bodies[0].added_mass.z(), 0.0);
