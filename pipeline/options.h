@@ -81,6 +81,31 @@ class OptionReader {
     r.check_unknown();
   }
 
+  // A list of options structs under `key` (a JSON array of objects; absent: the default list). Problems name the
+  // item: "vessel.propellers[1].diameter_m must be > 0".
+  template <class S>
+  void list(const char* key, std::vector<S>& items, const char* doc) {
+    (void)doc;
+    seen_.push_back(key);
+    if (!j_.is_object() || !j_.contains(key)) return;
+    const Json& a = j_.at(key);
+    if (!a.is_array()) {
+      problems_->push_back(where(key) + " must be an array of objects, got " + a.dump());
+      return;
+    }
+    items.assign(a.size(), S{});
+    for (size_t i = 0; i < a.size(); ++i) {
+      const std::string path = where(key) + "[" + std::to_string(i) + "]";
+      if (!a[i].is_object()) {
+        problems_->push_back(path + " must be an object, got " + a[i].dump());
+        continue;
+      }
+      OptionReader r(a[i], file_, path, problems_);
+      items[i].visit(r);
+      r.check_unknown();
+    }
+  }
+
   // Records a cross-field problem found by the struct's own validation.
   void problem(const std::string& key, const std::string& what) { problems_->push_back(where(key) + " " + what); }
 
@@ -125,6 +150,16 @@ class OptionWriter {
     sub.visit(w);
     out[key] = w.out;
   }
+  template <class S>
+  void list(const char* key, std::vector<S>& items, const char*) {
+    Json a = Json::array();
+    for (S& item : items) {
+      OptionWriter w;
+      item.visit(w);
+      a.push_back(w.out);
+    }
+    out[key] = a;
+  }
   void problem(const std::string&, const std::string&) {}
   Json out = Json::object();
 };
@@ -141,6 +176,17 @@ class OptionDocWriter {
   void section(const char* key, S& sub, const char*) {
     OptionDocWriter w(prefix_ + key + ".");
     sub.visit(w);
+    rows += w.rows;
+  }
+  // A list: its default, then the fields of one item (`key[].field`) with an item's defaults.
+  template <class S>
+  void list(const char* key, std::vector<S>& items, const char* doc) {
+    OptionWriter def;
+    def.list(key, items, doc);
+    rows += "| `" + prefix_ + key + "` | `" + def.out[key].dump() + "` | - | " + doc + " |\n";
+    S item;
+    OptionDocWriter w(prefix_ + key + "[].");
+    item.visit(w);
     rows += w.rows;
   }
   void problem(const std::string&, const std::string&) {}

@@ -8,10 +8,65 @@
 
 namespace floesim::sim {
 
+double heading_of(const Mat3& R) { return std::atan2(R(1, 0), R(0, 0)); }
+
 namespace {
+constexpr double kJetCore = 6.2;       // far-field constant of u_c = 6.2 V_0 D_0 / x; also the near field's length
+constexpr double kJetSpread = 0.1;     // sigma = 0.1 x in the far field
+constexpr double kJetCutSigmas = 4.0;  // the Gaussian is cut at 4 sigma (exp(-8) = 3e-4 of u_c)
+}  // namespace
+
+double jet_centreline_speed(const PropellerJet& j, double x) {
+  if (x <= 0) return 0.0;
+  const double xe = kJetCore * j.d0_m;
+  return x < xe ? j.excess_mps : j.excess_mps * xe / x;
 }
 
-double heading_of(const Mat3& R) { return std::atan2(R(1, 0), R(0, 0)); }
+double jet_width(const PropellerJet& j, double x) { return kJetSpread * std::max(x, kJetCore * j.d0_m); }
+
+Vec3 jet_velocity(const std::vector<PropellerJet>& jets, const Vec3& p) {
+  Vec3 u = Vec3::Zero();
+  for (const PropellerJet& j : jets) {
+    const Vec3 d = p - j.origin;
+    const double x = d.dot(j.dir);
+    if (x <= 0) continue;
+    const double r2 = (d - x * j.dir).squaredNorm(), sigma = jet_width(j, x);
+    if (r2 >= kJetCutSigmas * kJetCutSigmas * sigma * sigma) continue;
+    u += jet_centreline_speed(j, x) * std::exp(-r2 / (2 * sigma * sigma)) * j.dir;
+  }
+  return u;
+}
+
+bool jets_reach(const std::vector<PropellerJet>& jets, const Vec3& c, double radius) {
+  for (const PropellerJet& j : jets) {
+    const Vec3 d = c - j.origin;
+    const double x = d.dot(j.dir);
+    if (x + radius <= 0) continue;  // wholly ahead of the propeller
+    // The jet's reach grows with x: at most kJetCutSigmas sigma(x + radius) from the axis anywhere in the ball.
+    const double reach = kJetCutSigmas * jet_width(j, x + radius) + radius;
+    if ((d - x * j.dir).squaredNorm() < reach * reach) return true;
+  }
+  return false;
+}
+
+void propeller_jets(const Model& m, const BodyKinematics& k, double thrust_n, std::vector<PropellerJet>& out) {
+  out.clear();
+  const double rho = m.options.water.density_kg_m3;
+  for (const Propeller& p : m.propellers) {
+    const double t = p.thrust_share * thrust_n;
+    if (t == 0) continue;
+    PropellerJet j;
+    j.origin = k.x + k.R * p.position;
+    const Vec3 thrust_dir = k.R * p.axis;
+    j.dir = t > 0 ? Vec3(-thrust_dir) : thrust_dir;  // the jet flows against the thrust it makes
+    const Vec3 vp = k.v + k.w.cross(j.origin - k.x) - m.current;  // the propeller through the water
+    const double va = std::max(0.0, -vp.dot(j.dir));                // inflow speed along the jet's axis
+    j.efflux_mps = std::sqrt(va * va + 8 * std::abs(t) / (kPi * rho * p.diameter_m * p.diameter_m));
+    j.excess_mps = j.efflux_mps - va;
+    j.d0_m = 0.71 * p.diameter_m;
+    out.push_back(j);
+  }
+}
 
 Wrench gravity_force(const Model& m, const Body& b) {
   Wrench w;
@@ -74,18 +129,40 @@ Wrench hydrostatic_damping(const Model& m, const Body& b, const BodyKinematics& 
 }
 
 namespace {
-// Form drag and skin friction on one submerged face (world normal n, area, centroid c), PHYSICS.md §3.2.
-inline Wrench face_drag(const Model& m, const BodyKinematics& k, const Vec3& n, double area, const Vec3& c, double cd,
-                        double cf, double half_rho) {
+// Form drag and skin friction on one submerged face of a floe slab (outward normal n, area, relative velocity vrel
+// of the face through the water), PHYSICS.md §3.2. Form drag is the lumped ½ rho_w C_d A_proj |v| v of the seed
+// (SAMS Table 1) face by face: a face advancing into the flow u contributes its projected area A (u.n) / |u|, and
+// the force is along -u, so the faces of a convex floe sum to ½ rho_w C_d A_proj |u| u, A_proj the floe's area
+// projected across the flow, at any heading. (Forcing each face along its own normal with (u.n)^2 gave 0.5-1.0 of
+// that: 2/3 for a disc, 1/2 for a square at 45 degrees.) The flow that matters is the one the face sees edge on:
+// for the side walls the relative velocity in the floe's plane (`plane_normal`: the floe's z axis; a heave velocity
+// does not make an edge advance), for the top and bottom faces the velocity along their normal (the lumped form for
+// flow normal to the plate: heave, roll and pitch). Skin friction takes the tangential relative velocity.
+inline Vec3 face_force(const Vec3& vrel, const Vec3& n, double area, bool side_wall, const Vec3& plane_normal,
+                       double cd, double cf, double half_rho) {
+  const double vn = vrel.dot(n);
+  Vec3 f = Vec3::Zero();
+  if (side_wall) {
+    const Vec3 u = vrel - vrel.dot(plane_normal) * plane_normal;
+    const double un = u.dot(n);
+    if (un > 0) f -= half_rho * cd * area * un * u;
+  } else if (vn > 0) {
+    f -= half_rho * cd * area * vn * vn * n;
+  }
+  const Vec3 vt = vrel - vn * n;
+  f -= half_rho * cf * area * vt.norm() * vt;
+  return f;
+}
+
+// face_force on a face given in the world (normal n, area, centroid c), with the moment about the centre of mass;
+// the water moves with the current and, if given, the jets at c.
+inline Wrench face_drag(const Model& m, const BodyKinematics& k, const Vec3& n, double area, const Vec3& c,
+                        bool side_wall, double cd, double cf, double half_rho, const std::vector<PropellerJet>* jets) {
   Wrench w;
   const Vec3 r = c - k.x;
-  const Vec3 vrel = k.v + k.w.cross(r) - m.current;
-  const double vn = vrel.dot(n);
-  Vec3 force = Vec3::Zero();
-  if (vn > 0) force -= half_rho * cd * area * vn * vn * n;  // face advancing into the water
-  const Vec3 vt = vrel - vn * n;
-  force -= half_rho * cf * area * vt.norm() * vt;
-  w.add_at(force, r);
+  Vec3 vrel = k.v + k.w.cross(r) - m.current;
+  if (jets) vrel -= jet_velocity(*jets, c);
+  w.add_at(face_force(vrel, n, area, side_wall, k.R.col(2), cd, cf, half_rho), r);
   return w;
 }
 }  // namespace
@@ -98,7 +175,7 @@ namespace {
 // wall instead of transforming and clipping the slab's vertices. Returns false when the plane may cut the top or
 // bottom face (then the general path clips).
 bool floe_drag_afloat(const Model& m, const Body& b, const BodyKinematics& k, double cd, double cf, double half_rho,
-                      Wrench& out) {
+                      const std::vector<PropellerJet>* jets, Wrench& out) {
   if (b.section_area <= 0 || b.top_face < 0) return false;
   const Vec3 mv = k.R.row(2).transpose();  // world z in the body frame
   if (mv.z() < 0.5) return false;
@@ -109,20 +186,28 @@ bool floe_drag_afloat(const Model& m, const Body& b, const BodyKinematics& k, do
   if (l0 - spread < 0 || l0 + spread > h) return false;
   const Vec3 vb = k.R.transpose() * (k.v - m.current), wb = k.R.transpose() * k.w;
   Vec3 F = Vec3::Zero(), T = Vec3::Zero();
-  auto face = [&](const Vec3& n, double area, const Vec3& c) {
-    const Vec3 vrel = vb + wb.cross(c);
-    const double vn = vrel.dot(n);
-    Vec3 f = Vec3::Zero();
-    if (vn > 0) f -= half_rho * cd * area * vn * vn * n;
-    const Vec3 vt = vrel - vn * n;
-    f -= half_rho * cf * area * vt.norm() * vt;
+  auto face = [&](const Vec3& n, double area, const Vec3& c, bool side_wall) {
+    Vec3 vrel = vb + wb.cross(c);
+    if (jets) vrel -= k.R.transpose() * jet_velocity(*jets, k.x + k.R * c);  // the jets where the face is
+    const Vec3 f = face_force(vrel, n, area, side_wall, Vec3::UnitZ(), cd, cf, half_rho);
     F += f;
     T += c.cross(f);
   };
-  // Bottom: whole and wet (faces 0 = bottom, top_face = top, then the side walls).
+  // Bottom: whole and wet (faces 0 = bottom, top_face = top, then the side walls). In a jet, per triangle of the fan
+  // from the centroid (the body origin), with signed areas so that a non-convex outline still sums to the face.
   const DragFace& bottom = b.drag_faces[0];
-  face(bottom.normal, bottom.area, bottom.centroid);
   const int n = static_cast<int>(b.outline.size());
+  if (!jets) {
+    face(bottom.normal, bottom.area, bottom.centroid, false);
+  } else {
+    for (int i = 0; i < n; ++i) {
+      const Vec2& p = b.outline[i];
+      const Vec2& q = b.outline[i + 1 == n ? 0 : i + 1];
+      const double area = 0.5 * (p.x() * q.y() - p.y() * q.x());
+      const Vec2 c = (p + q) / 3;
+      face(bottom.normal, area, Vec3(c.x(), c.y(), bottom.centroid.z()), false);
+    }
+  }
   for (const DragFace& f : b.drag_faces) {
     if (f.side < 0) continue;
     const int i = f.side, j = i + 1 == n ? 0 : i + 1;
@@ -137,7 +222,7 @@ bool floe_drag_afloat(const Model& m, const Body& b, const BodyKinematics& k, do
     const double t = (li + 2 * lj) / (3 * sum);
     const double zc = -h / 2 + (li * li + li * lj + lj * lj) / (3 * sum);
     const Vec2 cxy = pi + t * (pj - pi);
-    face(f.normal, area, Vec3(cxy.x(), cxy.y(), zc));
+    face(f.normal, area, Vec3(cxy.x(), cxy.y(), zc), true);
   }
   out.force = k.R * F;
   out.torque = k.R * T;
@@ -145,11 +230,32 @@ bool floe_drag_afloat(const Model& m, const Body& b, const BodyKinematics& k, do
 }
 }  // namespace
 
-Wrench floe_water_drag(const Model& m, const Body& b, const BodyKinematics& k, ForceScratch& s) {
+bool floe_in_jets(const Body& b, const Vec3& x, const std::vector<PropellerJet>& jets) {
+  return !jets.empty() && jets_reach(jets, x, std::hypot(b.section_radius, 0.5 * b.thickness_m));
+}
+
+namespace {
+// The jets if any reaches the floe, else null (the drag then uses the uniform current alone).
+const std::vector<PropellerJet>* jets_on(const Body& b, const BodyKinematics& k, const std::vector<PropellerJet>& jets) {
+  return floe_in_jets(b, k.x, jets) ? &jets : nullptr;
+}
+}  // namespace
+
+Wrench floe_water_drag(const Model& m, const Body& b, const BodyKinematics& k, ForceScratch& s,
+                       const std::vector<PropellerJet>& jets) {
   Wrench w;
   const double cd = m.options.water.form_drag_cd, cf = m.options.water.skin_friction_cf;
   const double half_rho = 0.5 * m.options.water.density_kg_m3;
-  if (floe_drag_afloat(m, b, k, cd, cf, half_rho, w)) return w;
+  if (floe_drag_afloat(m, b, k, cd, cf, half_rho, jets_on(b, k, jets), w)) return w;
+  return floe_water_drag_clipped(m, b, k, s, jets);
+}
+
+Wrench floe_water_drag_clipped(const Model& m, const Body& b, const BodyKinematics& k, ForceScratch& s,
+                               const std::vector<PropellerJet>& all_jets) {
+  Wrench w;
+  const double cd = m.options.water.form_drag_cd, cf = m.options.water.skin_friction_cf;
+  const double half_rho = 0.5 * m.options.water.density_kg_m3;
+  const std::vector<PropellerJet>* jets = jets_on(b, k, all_jets);
   s.vertices.resize(b.drag_vertices.size());
   for (size_t i = 0; i < b.drag_vertices.size(); ++i) s.vertices[i] = k.x + k.R * b.drag_vertices[i];
   // Waterline points of the vertical edges (bottom ring vertex i, top ring vertex n + i) that cross the water
@@ -176,7 +282,7 @@ Wrench floe_water_drag(const Model& m, const Body& b, const BodyKinematics& k, F
         const double area = a1 + a2;
         if (area <= 0) continue;
         const Vec3 c = (a1 * (bi + bj + wj) + a2 * (bi + wj + wi)) / (3 * area);
-        w += face_drag(m, k, nw, area, c, cd, cf, half_rho);
+        w += face_drag(m, k, nw, area, c, true, cd, cf, half_rho, jets);
         continue;
       }
     }
@@ -207,7 +313,7 @@ Wrench floe_water_drag(const Model& m, const Body& b, const BodyKinematics& k, F
       ac = polygon_area_centroid(s.big_cut.data(), static_cast<int>(s.big_cut.size()));
     }
     if (ac.area <= 0) continue;
-    w += face_drag(m, k, k.R * f.normal, ac.area, ac.centroid, cd, cf, half_rho);
+    w += face_drag(m, k, k.R * f.normal, ac.area, ac.centroid, f.side >= 0, cd, cf, half_rho, jets);
   }
   return w;
 }
@@ -281,7 +387,7 @@ Wrench vessel_propulsion(const Model& m, const BodyKinematics& k, double time_s,
   const PropulsionOptions& p = m.options.vessel.propulsion;
   const Vec3 ex = k.R.col(0);
   double thrust = 0;
-  if (p.mode == "constant_thrust") {
+  if (p.mode == "constant_thrust" || p.mode == "bollard_pull") {
     thrust = p.thrust_n;
   } else if (p.mode == "thrust_series") {
     const auto& t = m.thrust_time_s;
@@ -307,7 +413,7 @@ Wrench vessel_propulsion(const Model& m, const BodyKinematics& k, double time_s,
   }
   thrust_n = thrust;
   Wrench w;
-  w.force = thrust * ex;
+  if (p.mode != "bollard_pull") w.force = thrust * ex;
   return w;
 }
 

@@ -137,9 +137,31 @@ void waterline_particulars(const TriMesh& m, VesselParticulars& p) {
   p.beam_wl_m = ymax - ymin;
   p.draught_m = -zmin;
   p.strip_x_m.clear();
+  p.strip_beam_m.clear();
   const int strips = 20;
   p.strip_length_m = p.length_wl_m / strips;
   for (int i = 0; i < strips; ++i) p.strip_x_m.push_back(lx0 + (i + 0.5) * p.strip_length_m);
+  // Waterline beam at each station: the y extent of the waterline segments (where the triangles cross z = 0) that
+  // span the station's x.
+  std::vector<double> ylo(strips, 1e300), yhi(strips, -1e300);
+  for (const auto& t : m.triangles) {
+    Vec3 q[2];
+    int nq = 0;
+    for (int e = 0; e < 3 && nq < 2; ++e) {
+      const Vec3& a = m.vertices[t[e]];
+      const Vec3& b = m.vertices[t[(e + 1) % 3]];
+      if ((a.z() <= 0) != (b.z() <= 0)) q[nq++] = a + (0 - a.z()) / (b.z() - a.z()) * (b - a);
+    }
+    if (nq < 2) continue;
+    for (int i = 0; i < strips; ++i) {
+      const double x = p.strip_x_m[i];
+      if ((q[0].x() - x) * (q[1].x() - x) > 0 || q[0].x() == q[1].x()) continue;
+      const double y = q[0].y() + (x - q[0].x()) / (q[1].x() - q[0].x()) * (q[1].y() - q[0].y());
+      ylo[i] = std::min(ylo[i], y);
+      yhi[i] = std::max(yhi[i], y);
+    }
+  }
+  for (int i = 0; i < strips; ++i) p.strip_beam_m.push_back(yhi[i] > ylo[i] ? yhi[i] - ylo[i] : 0.0);
 }
 
 TriMesh shifted(const TriMesh& m, const Vec3& d) {
@@ -188,9 +210,24 @@ Body make_floe_body(const Polygon& outline, double h, int id, int body_index, co
   b.inv_mass = 1 / b.mass_kg;
   b.inertia = rho_i * mp.inertia;
   b.inv_inertia = b.inertia.inverse();
-  // Heave added mass along the floe's normal (body z), C_a33 x mass, only with water (PHYSICS.md §3.3).
-  set_added_mass(b, Vec3(0, 0, o.water.enabled ? o.water.floe_heave_added_mass_ratio * b.mass_kg : 0.0),
-                 Vec3::Zero());
+  // Added mass of the floating thin plate (PHYSICS.md §3.3), only with water: heave along the floe's normal (body z),
+  // roll and pitch about the body x and y axes; surge, sway and yaw none (a thin plate moving in its own plane).
+  // High-frequency limit (phi = 0 on the free surface): half of the plate's added mass in unbounded fluid, where a
+  // disc of radius a has (8/3) rho a^3 broadside and (16/45) rho a^5 about a diameter (Lamb 1932, Hydrodynamics
+  // §108; Newman 1977, Marine Hydrodynamics, §4.13). A floe is the disc of its area A (a = sqrt(A/pi)): heave
+  // (4/3) rho_w a^3 = (4/(3 pi)) rho_w a A, which grows with D/h against the floe's mass (2.4 x for D = 10 m,
+  // h = 1 m); roll and pitch (8/45) rho_w a^5 scaled by the floe's second moment of area about the axis over the
+  // disc's pi a^4 / 4, i.e. (32/(45 pi)) rho_w a S_yy (roll) and S_xx (pitch): exact for a disc, longer floes get
+  // more about their short axis. The product moment S_xy is left out (diagonal added inertia in body axes).
+  if (o.water.enabled) {
+    const double rho_w = o.water.density_kg_m3, s = o.water.floe_added_mass_scale;
+    const double a = std::sqrt(b.section_area / kPi);
+    const double c_rot = s * 32 / (45 * kPi) * rho_w * a;
+    set_added_mass(b, Vec3(0, 0, s * 4 / (3 * kPi) * rho_w * a * b.section_area),
+                   Vec3(c_rot * b.section_syy, c_rot * b.section_sxx, 0));
+  } else {
+    set_added_mass(b, Vec3::Zero(), Vec3::Zero());
+  }
   b.initial_position = Vec3(centre.x(), centre.y(), h / 2 - draught_ratio * h);
   b.initial_orientation = Quat::Identity();
   const std::vector<Polygon> pieces = convex_decompose(b.outline);
@@ -513,13 +550,34 @@ Model build_model(const FloeField& field, const HullModel* hull, const SimulateO
       vp.radii_of_gyration_m = (b.inertia.diagonal() / mass).cwiseSqrt();
     }
     b.inv_inertia = b.inertia.inverse();
-    // Added mass in surge and sway and added inertia in yaw (PHYSICS.md §3.3), only with water. Heave, roll and
-    // pitch keep none: the vessel's hydrostatic periods are not what the ice loads depend on.
-    if (o.water.enabled)
-      set_added_mass(b, Vec3(o.vessel.surge_added_mass_ratio * mass, o.vessel.sway_added_mass_ratio * mass, 0),
-                     Vec3(0, 0, o.vessel.yaw_added_inertia_ratio * b.inertia(2, 2)));
-    else
+    // Added mass (PHYSICS.md §3.3), only with water: surge, sway and yaw as fractions of the mass and I_zz; heave and
+    // pitch by strip theory, each waterline strip a semicircular section of beam B(x) with the high-frequency 2-D
+    // heave added mass (pi/8) rho_w B^2 per metre (half the circle's rho pi (B/2)^2, also the flat plate's; Lewis
+    // 1929 forms of a full section of B/T ~ 3 carry a coefficient C of about 1-1.2 on it: the scale option), so
+    // A33 = (pi/8) rho_w sum B^2 dx and A55 = (pi/8) rho_w sum B^2 x^2 dx about the centre of mass. Roll keeps none
+    // (the roll period is not what the ice loads depend on).
+    if (o.water.enabled) {
+      double a33 = 0, a55 = 0;
+      for (size_t i = 0; i < vp.strip_x_m.size(); ++i) {
+        const double x = vp.strip_x_m[i], beam = vp.strip_beam_m[i];
+        const double strip = kPi / 8 * rho_w * beam * beam * vp.strip_length_m;
+        a33 += strip;
+        a55 += strip * x * x;
+      }
+      const double s = o.vessel.heave_pitch_added_mass_scale;
+      set_added_mass(b, Vec3(o.vessel.surge_added_mass_ratio * mass, o.vessel.sway_added_mass_ratio * mass, s * a33),
+                     Vec3(0, s * a55, o.vessel.yaw_added_inertia_ratio * b.inertia(2, 2)));
+    } else {
       set_added_mass(b, Vec3::Zero(), Vec3::Zero());
+    }
+    for (const PropellerOptions& po : o.vessel.propellers) {
+      Propeller p;
+      p.position = Vec3(po.position_m[0], po.position_m[1], po.position_m[2]) - com;  // hull frame to body frame
+      p.axis = Vec3(po.axis[0], po.axis[1], po.axis[2]).normalized();
+      p.diameter_m = po.diameter_m;
+      p.thrust_share = po.thrust_share;
+      model.propellers.push_back(p);
+    }
     b.buoyancy_mesh = shifted(surf, -com);
     const double heading = o.vessel.heading_deg * kPi / 180;
     b.initial_orientation = Quat(Eigen::AngleAxisd(heading, Vec3::UnitZ()));

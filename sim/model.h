@@ -92,7 +92,16 @@ struct VesselParticulars {
   Vec3 radii_of_gyration_m = Vec3::Zero();
   double gm_transverse_m = 0, gm_longitudinal_m = 0;  // metacentric heights from the clipped hull
   std::vector<double> strip_x_m;      // stations of the cross-flow (sway/yaw) damping strips, body frame
+  std::vector<double> strip_beam_m;   // waterline beam at each station (heave/pitch added mass)
   double strip_length_m = 0;          // length of one strip
+};
+
+// A propeller of the vessel (options.vessel.propellers) in the vessel's body frame.
+struct Propeller {
+  Vec3 position = Vec3::Zero();  // centre of the disc, body frame (about the centre of mass)
+  Vec3 axis = Vec3::UnitX();     // unit, the direction of the thrust it gives
+  double diameter_m = 0;
+  double thrust_share = 0;
 };
 
 struct Model {
@@ -107,6 +116,7 @@ struct Model {
   Vec3 current = Vec3::Zero();        // water velocity, world
   Vec3 wind = Vec3::Zero();           // air velocity, world
   std::vector<double> thrust_time_s, thrust_n;  // thrust_series mode
+  std::vector<Propeller> propellers;            // their jets wash the floes (forces.h, PropellerJet)
 
   int wall_count = 0;                 // domain walls, the last bodies
   // Floe bodies in the table: the input floes of a built model; in a world's grown table, every piece too (dead or

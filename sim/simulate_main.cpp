@@ -20,7 +20,8 @@ int main(int argc, char** argv) {
   app.add_flag("--help-config", help_config, "print the simulate options as a Markdown table and exit");
   return floesim::run_stage(app, argc, argv, [&] {
     if (help_config) {
-      std::cout << floesim::options_doc(floesim::sim::SimulateOptions{});
+      const floesim::sim::SimulateOptions defaults;  // named: GCC 12 misreads a temporary's strings as uninitialised
+      std::cout << floesim::options_doc(defaults);
       return;
     }
     if (floes.empty() || hull.empty() || config.empty() || out.empty())

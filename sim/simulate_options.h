@@ -51,7 +51,7 @@ struct WaterOptions {
   double vessel_roll_damping_ratio = 0.08;
   double vessel_pitch_damping_ratio = 0.2;
   double kinematic_viscosity_m2ps = 1.83e-6;  // sea water at 0 degC (ITTC-57 Reynolds number)
-  double floe_heave_added_mass_ratio = 1.0;   // C_a33: floe heave added mass / floe mass (PHYSICS.md §3.3)
+  double floe_added_mass_scale = 1.0;         // x the floating thin-disc heave/roll/pitch added mass (§3.3)
   bool floes_start_with_current = false;      // floes start drifting with the current (else at rest)
   template <class V>
   void visit(V& v) {
@@ -77,9 +77,9 @@ struct WaterOptions {
             in_range(0, 2));
     v.field("kinematic_viscosity_m2ps", kinematic_viscosity_m2ps, "m^2/s", "water kinematic viscosity (ITTC-57)",
             positive());
-    v.field("floe_heave_added_mass_ratio", floe_heave_added_mass_ratio, "-",
-            "C_a33: floe heave added mass as a fraction of the floe mass, along the floe's normal, in the mass matrix "
-            "(implicit; PHYSICS.md 3.3 suggests 0.5-2)",
+    v.field("floe_added_mass_scale", floe_added_mass_scale, "-",
+            "factor on the floes' heave added mass (4/3) rho_w a^3 and roll/pitch added inertia of the floating thin "
+            "disc of the same area (a = sqrt(A/pi)), in the mass matrix (implicit); 0 = none",
             in_range(0, 10));
     v.field("floes_start_with_current", floes_start_with_current, "-",
             "floes start drifting with the current (an established drift) instead of at rest");
@@ -88,7 +88,7 @@ struct WaterOptions {
 
 // How the vessel is driven.
 struct PropulsionOptions {
-  std::string mode = "speed";        // constant_thrust | thrust_series | speed
+  std::string mode = "speed";        // constant_thrust | thrust_series | speed | bollard_pull
   double thrust_n = 0.0;             // constant_thrust: thrust along the body x axis
   std::string thrust_file;           // thrust_series: CSV "time_s,thrust_N" (relative to the config file)
   double speed_mps = 2.0;            // speed: prescribed forward speed through the water
@@ -98,9 +98,11 @@ struct PropulsionOptions {
   double max_thrust_n = 4e6;
   template <class V>
   void visit(V& v) {
-    v.field("mode", mode, "-", "constant_thrust | thrust_series | speed (PI controller on thrust)",
-            one_of({"constant_thrust", "thrust_series", "speed"}));
-    v.field("thrust_n", thrust_n, "N", "constant_thrust: thrust along the vessel's x axis");
+    v.field("mode", mode, "-",
+            "constant_thrust | thrust_series | speed (PI controller on thrust) | bollard_pull (thrust_n made by the "
+            "propellers, held by a line to a fixed bollard: no net force on the vessel)",
+            one_of({"constant_thrust", "thrust_series", "speed", "bollard_pull"}));
+    v.field("thrust_n", thrust_n, "N", "constant_thrust and bollard_pull: thrust along the vessel's x axis");
     v.field("thrust_file", thrust_file, "-",
             "thrust_series: CSV with header time_s,thrust_N (path relative to the config file); linear "
             "interpolation, held constant outside");
@@ -112,6 +114,39 @@ struct PropulsionOptions {
     v.field("max_thrust_n", max_thrust_n, "N", "speed: largest thrust", positive());
     if (min_thrust_n > max_thrust_n) v.problem("min_thrust_n", "must be <= max_thrust_n");
     if (mode == "thrust_series" && thrust_file.empty()) v.problem("thrust_file", "must be set for mode thrust_series");
+  }
+};
+
+// One propeller of the vessel: its share of the propulsion thrust makes a jet (PHYSICS.md §3.5) that the floes' drag
+// sees. Positions in the hull file's frame (x forward, y to port, z up, waterline z = 0, the hull's own origin).
+struct PropellerOptions {
+  std::vector<double> position_m;         // [x, y, z] of the propeller disc's centre, hull frame
+  std::vector<double> axis = {1, 0, 0};   // direction of the thrust it gives (body axes); the jet flows opposite
+  double diameter_m = 4.0;                // D_p
+  double thrust_share = 0.5;              // fraction of the propulsion thrust this propeller makes
+  template <class V>
+  void visit(V& v) {
+    v.field("position_m", position_m, "m",
+            "[x, y, z] of the propeller disc's centre in the hull file's frame (waterline z = 0); must be under water",
+            Check<std::vector<double>>([](const std::vector<double>& p) -> std::string {
+              if (p.size() != 3) return "must be [x, y, z] (3 numbers)";
+              for (double x : p)
+                if (!std::isfinite(x)) return "must be finite numbers";
+              if (!(p[2] < 0)) return "z must be below the waterline (z < 0)";
+              return "";
+            }));
+    v.field("axis", axis, "-",
+            "direction of the thrust the propeller gives, body axes ([1, 0, 0] ahead); the jet flows the other way",
+            Check<std::vector<double>>([](const std::vector<double>& a) -> std::string {
+              if (a.size() != 3) return "must be [x, y, z] (3 numbers)";
+              const double n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+              if (!std::isfinite(n2) || n2 < 1e-12) return "must be a non-zero vector";
+              return "";
+            }));
+    v.field("diameter_m", diameter_m, "m", "propeller diameter D_p", positive());
+    v.field("thrust_share", thrust_share, "-",
+            "fraction of the propulsion thrust this propeller makes (the shares of all propellers add up to <= 1)",
+            in_range(0, 1));
   }
 };
 
@@ -147,8 +182,10 @@ struct VesselOptions {
   double surge_added_mass_ratio = 0.05;  // A11 / m (PHYSICS.md §3.3: 0.05-0.1)
   double sway_added_mass_ratio = 0.5;    // A22 / m (0.5-1.0)
   double yaw_added_inertia_ratio = 0.5;  // A66 / I_zz (0.5-1.0)
+  double heave_pitch_added_mass_scale = 1.0;  // x strip theory (pi/8) rho_w B(x)^2 per metre (heave and pitch)
   PropulsionOptions propulsion;
   AutopilotOptions autopilot;
+  std::vector<PropellerOptions> propellers;  // none: no propeller wash on the floes
   template <class V>
   void visit(V& v) {
     v.field("x_m", x_m, "m", "initial centre of mass, world x");
@@ -189,8 +226,20 @@ struct VesselOptions {
             "sway added mass A22 as a fraction of the vessel mass, in the mass matrix", in_range(0, 5));
     v.field("yaw_added_inertia_ratio", yaw_added_inertia_ratio, "-",
             "yaw added moment of inertia A66 as a fraction of the vessel's I_zz, in the mass matrix", in_range(0, 5));
+    v.field("heave_pitch_added_mass_scale", heave_pitch_added_mass_scale, "-",
+            "factor on the heave added mass A33 = (pi/8) rho_w integral B(x)^2 dx and pitch added inertia "
+            "A55 = (pi/8) rho_w integral B(x)^2 x^2 dx (strip theory, semicircular sections of the waterline beam "
+            "B(x)); 0 = none",
+            in_range(0, 5));
     v.section("propulsion", propulsion, "how the vessel is driven");
     v.section("autopilot", autopilot, "heading hold");
+    v.list("propellers", propellers,
+           "the vessel's propellers, whose jets (PHYSICS.md 3.5) wash the floes; [] = no propeller wash");
+    double shares = 0;
+    for (const PropellerOptions& p : propellers) shares += p.thrust_share;
+    if (shares > 1 + 1e-9)
+      v.problem("propellers", "thrust_share adds up to " + Json(shares).dump() + " (must be <= 1: the shares split "
+                "the propulsion thrust)");
   }
 };
 

@@ -128,6 +128,12 @@ void World::stage_collide() {
     if (!state_.awake[c.body_a]) wake(c.body_a);
     if (!state_.awake[c.body_b]) wake(c.body_b);
   }
+  // A sleeping floe that a propeller jet reaches wakes: the water moves there (the jets of the last step).
+  if (!jets_.empty())
+    for (size_t b = 0; b < model_.bodies.size(); ++b)
+      if (!state_.awake[b] && state_.alive[b] && model_.bodies[b].kind == BodyKind::floe &&
+          floe_in_jets(model_.bodies[b], state_.position[b], jets_))
+        wake(static_cast<int>(b));
   awake_list_.clear();
   for (size_t b = 0; b < model_.bodies.size(); ++b)
     if (state_.awake[b]) awake_list_.push_back(static_cast<int>(b));
@@ -146,7 +152,8 @@ void World::stage_forces() {
     return k;
   };
   // Per body: external wrench, world inverse mass matrices, then the predicted velocities v* = v + dt M^-1 f.
-  // M holds the added mass (PHYSICS.md §3.3: a33 of floes along their normal, surge/sway/yaw of the vessel), so it
+  // M holds the added mass (PHYSICS.md §3.3: floes' heave along their normal and roll/pitch, the vessel's surge, sway,
+  // heave, pitch and yaw), so it
   // acts against every force, the contact impulses of the solver included (the solver uses the same M^-1): the
   // added mass is implicit, not an explicit force. The added mass's Coriolis/Munk terms are neglected.
   auto advance = [&](int b, const BodyKinematics& k, const Wrench& w) {
@@ -179,6 +186,9 @@ void World::stage_forces() {
     report_.propulsion_load = vessel_propulsion(model_, k, state_.time_s, dt, state_.speed_error_integral,
                                                 report_.thrust_n);
     report_.propulsion_load += vessel_autopilot(model_, body, k, state_.heading_ref_rad);
+    // The jets from the pose and thrust at the start of the step, for every floe's drag below. The vessel's own
+    // jets leave its hull astern; their effect on the hull (thrust deduction) is in the resistance and thrust.
+    propeller_jets(model_, k, report_.thrust_n, jets_);
     total += report_.hydro_load;
     total += report_.wind_load;
     total += report_.propulsion_load;
@@ -197,7 +207,7 @@ void World::stage_forces() {
       if (water) {
         w += buoyancy_force(model_, body, k, s);
         w += hydrostatic_damping(model_, body, k);
-        w += floe_water_drag(model_, body, k, s);
+        w += floe_water_drag(model_, body, k, s, jets_);
       }
       w += floe_wind_drag(model_, body, k, s);
       advance(b, k, w);

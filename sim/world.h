@@ -69,6 +69,8 @@ class World {
 
   const StepReport& report() const { return report_; }
   const std::vector<Contact>& contacts() const { return contacts_; }
+  // The propeller jets of the last step's forces stage (from the vessel's pose and thrust at its start).
+  const std::vector<PropellerJet>& jets() const { return jets_; }
   // Every fracture event so far, in time order (children ids are floe ids of bodies in model()).
   const std::vector<FractureEvent>& fracture_events() const { return events_; }
   // When each body left the world (broken up or removed), s; +inf while alive. Indexed like model().bodies.
@@ -111,6 +113,7 @@ class World {
   std::vector<int> moved_;          // bodies integrated in the previous step (broad phase refresh)
   std::vector<int> island_;         // sleep stage: union-find parent of each awake body (contact islands)
   std::vector<uint8_t> island_ok_;  // sleep stage: per island root, every member has been still long enough
+  std::vector<PropellerJet> jets_;  // this step's propeller jets (forces stage, before the floes)
   std::vector<Wrench> external_;    // per body, this step
   std::vector<ForceScratch> scratch_;
   SolverBodies solver_bodies_;

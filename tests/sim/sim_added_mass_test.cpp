@@ -7,6 +7,7 @@
 
 #include "pipeline/error.h"
 #include "sim/forces.h"
+#include "sim/mesh.h"
 #include "sim/world.h"
 #include "sim_fixtures.h"
 #include "pipeline/geometry2d.h"
@@ -178,6 +179,68 @@ TEST(SimAddedMass, VesselInertiaGivenOutright) {
   EXPECT_NE(msg({{"vessel", {{"inertia_kg_m2", {1, 1, 1, 2, 0, 0}}}}}).find("positive definite"), std::string::npos);
   EXPECT_NE(msg({{"vessel", {{"sway_added_mass_ratio", -0.5}}}}).find("vessel.sway_added_mass_ratio"),
             std::string::npos);
+}
+
+// A 10 m disc floe, 1 m thick (64-gon): heave added mass of the floating disc (4/3) rho_w R^3, 2.4 x the floe's mass
+// (PHYSICS.md §3.3's figure), roll and pitch (8/45) rho_w R^5 (Lamb 1932 §108: (16/45) rho a^5 about a diameter in
+// unbounded fluid, half of it under a free surface), none in surge, sway and yaw. A 40 x 10 m floe of the same
+// thickness: heave added mass over its own mass grows with the size (the 10 m disc's 2.4 x becomes 5.5 x), and more
+// pitch (about its short axis y) than roll. Within 0.5 %: the 64-gon's area is 0.16 % below pi R^2, its second
+// moment 0.3 % below pi R^4 / 4.
+TEST(SimAddedMass, FloeAddedMassOfFloatingDisc) {
+  SimulateOptions o;
+  const double rho = o.water.density_kg_m3, R = 5;
+  FloeField field;
+  Floe disc;
+  disc.id = 1;
+  disc.thickness_m = 1.0;
+  for (int i = 0; i < 64; ++i)
+    disc.outline.push_back(Vec2(R * std::cos(2 * kPi * i / 64), R * std::sin(2 * kPi * i / 64)));
+  field.floes = {disc, rect_floe(2, 20, -5, 40, 10, 1.0)};
+  const Model m = build_model(field, nullptr, o);
+  const Body& b = m.bodies[0];
+  EXPECT_NEAR(b.added_mass.z() / (4.0 / 3.0 * rho * R * R * R), 1.0, 5e-3);
+  EXPECT_NEAR(b.added_mass.z() / b.mass_kg, 2.4, 0.05);
+  EXPECT_NEAR(b.added_inertia.x() / (8.0 / 45.0 * rho * std::pow(R, 5)), 1.0, 5e-3);
+  EXPECT_NEAR(b.added_inertia.y() / (8.0 / 45.0 * rho * std::pow(R, 5)), 1.0, 5e-3);
+  EXPECT_EQ(b.added_mass.head<2>().norm() + b.added_inertia.z(), 0.0);
+  const Body& r = m.bodies[1];
+  // Equivalent disc a = sqrt(400 / pi) = 11.28 m: (4/3) rho a^3 over 900 x 400 kg.
+  EXPECT_NEAR(r.added_mass.z() / r.mass_kg, 4.0 / 3.0 * rho * std::pow(400 / kPi, 1.5) / (900 * 400), 1e-9);
+  EXPECT_GT(r.added_mass.z() / r.mass_kg, 5.0);
+  EXPECT_GT(r.added_inertia.y(), 10 * r.added_inertia.x());  // S_xx / S_yy = (40/10)^2 = 16
+  std::printf("[measured] disc D = 10 m: A33 = %.3g kg (%.2f x mass), A44 = %.3g kg m^2; 40 x 10 m: A33 %.2f x mass\n",
+              b.added_mass.z(), b.added_mass.z() / b.mass_kg, b.added_inertia.x(), r.added_mass.z() / r.mass_kg);
+}
+
+// A box hull (L = 100 m, B = 20 m, draught 5 m): the strip-theory heave added mass is (pi/8) rho_w B^2 L and the pitch
+// added inertia (pi/8) rho_w B^2 L^3 / 12 about midship (the box's centre of mass). Heave exact to round-off; pitch
+// by the midpoint rule over 20 strips, which gives L^3/12 (1 - 1/20^2): within 0.5 %.
+TEST(SimAddedMass, VesselHeavePitchByStripTheory) {
+  const double L = 100, B = 20, T = 5;
+  HullModel hull;
+  hull.parts = {extrude_polygon({Vec2(-L / 2, -B / 2), Vec2(L / 2, -B / 2), Vec2(L / 2, B / 2), Vec2(-L / 2, B / 2)},
+                                -T, 2 * T)};
+  hull.surface = hull.parts[0];
+  SimulateOptions o = still_vessel();
+  const double rho = o.water.density_kg_m3;
+  const Model m = build_model(FloeField{}, &hull, o);
+  const Body& b = m.bodies[0];
+  const double a33 = kPi / 8 * rho * B * B * L, a55 = kPi / 8 * rho * B * B * L * L * L / 12;
+  std::printf("[measured] box hull: A33 = %.4g kg (%.3f of theory, %.2f x mass), A55 = %.4g kg m^2 (%.4f)\n",
+              b.added_mass.z(), b.added_mass.z() / a33, b.added_mass.z() / b.mass_kg, b.added_inertia.y(),
+              b.added_inertia.y() / a55);
+  EXPECT_NEAR(b.added_mass.z() / a33, 1.0, 1e-9);
+  EXPECT_NEAR(b.added_inertia.y() / a55, 1.0, 5e-3);
+  // The default Oden-like hull, for the record (no closed form to compare with).
+  const HullModel oden = coarse_hull(30);
+  const Model mo = build_model(FloeField{}, &oden, o);
+  std::printf("[measured] Oden-like hull: A33 = %.2f x mass, A55 = %.2f x I_yy\n",
+              mo.bodies[0].added_mass.z() / mo.bodies[0].mass_kg, mo.bodies[0].added_inertia.y() / mo.bodies[0].inertia(1, 1));
+  o.vessel.heave_pitch_added_mass_scale = 0;
+  const Model none = build_model(FloeField{}, &hull, o);
+  EXPECT_EQ(none.bodies[0].added_mass.z(), 0.0);
+  EXPECT_EQ(none.bodies[0].added_inertia.y(), 0.0);
 }
 
 // No water, no added mass: the vacuum tests' momentum stays the plain m v.

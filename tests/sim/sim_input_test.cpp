@@ -44,6 +44,38 @@ TEST(SimInput, OptionErrorsNameTheKey) {
   expect_error([] { options_from({{"solver", {{"subspace_every", 0}}}}); }, {"solver.subspace_every"});
   expect_error([] { options_from({{"solver", {{"subspace_above_mps", -1}}}}); }, {"solver.subspace_above_mps"});
   expect_error([] { options_from({{"solver", {{"reference_sweeps", -5}}}}); }, {"solver.reference_sweeps"});
+  // The added-mass factors and the propellers (a list: errors name the item).
+  expect_error([] { options_from({{"water", {{"floe_added_mass_scale", -1}}}}); }, {"water.floe_added_mass_scale"});
+  expect_error([] { options_from({{"water", {{"floe_heave_added_mass_ratio", 1}}}}); },
+               {"water.floe_heave_added_mass_ratio"});  // the old key is unknown now
+  expect_error([] { options_from({{"vessel", {{"heave_pitch_added_mass_scale", 9}}}}); },
+               {"vessel.heave_pitch_added_mass_scale"});
+  expect_error([] { options_from({{"vessel", {{"propellers", {{{"position_m", {1, 2}}}}}}}}); },
+               {"vessel.propellers[0].position_m", "[x, y, z]"});
+  expect_error([] { options_from({{"vessel", {{"propellers", {{{"position_m", {-40, 0, 2}}}}}}}}); },
+               {"vessel.propellers[0].position_m", "below the waterline"});
+  expect_error(
+      [] {
+        options_from({{"vessel",
+                       {{"propellers", {{{"position_m", {-40, 5, -5}}, {"diameter_m", 4}},
+                                        {{"position_m", {-40, -5, -5}}, {"diametr_m", 4}}}}}}});
+      },
+      {"vessel.propellers[1].diametr_m"});
+  expect_error(
+      [] {
+        options_from({{"vessel",
+                       {{"propellers", {{{"position_m", {-40, 5, -5}}, {"thrust_share", 0.7}},
+                                        {{"position_m", {-40, -5, -5}}, {"thrust_share", 0.7}}}}}}});
+      },
+      {"vessel.propellers", "adds up to 1.4"});
+  expect_error([] { options_from({{"vessel", {{"propellers", {{{"position_m", {-40, 0, -5}}, {"axis", {0, 0, 0}}}}}}}}); },
+               {"vessel.propellers[0].axis", "non-zero"});
+  expect_error([] { options_from({{"vessel", {{"propellers", 3}}}}); }, {"vessel.propellers", "array of objects"});
+  const SimulateOptions two = options_from(
+      {{"vessel", {{"propellers", {{{"position_m", {-47, 6, -5.5}}}, {{"position_m", {-47, -6, -5.5}}}}}}}});
+  ASSERT_EQ(two.vessel.propellers.size(), 2u);
+  EXPECT_EQ(two.vessel.propellers[1].position_m[1], -6.0);
+  EXPECT_EQ(two.vessel.propellers[1].diameter_m, 4.0);  // the item's default
   const SimulateOptions ok = options_from({{"duration_s", 30}});
   EXPECT_EQ(ok.steps(), 3000);
   EXPECT_EQ(ok.output_every(), 20);
