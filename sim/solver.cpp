@@ -145,11 +145,16 @@ void prepare_contacts(const Model& model, const SolverBodies& sb, State& state, 
 
 namespace {
 
+// The normal velocity a rigid row aims at: the bias (push-out, speculative gap) in the solve; in the relax pass
+// only non-penetration (or the speculative gap).
+inline double rigid_target(const Contact& c, double dt, bool use_bias) {
+  return use_bias ? c.bias : (c.gap > 0 ? -c.gap / dt : 0.0);
+}
+
 // The new normal impulse of one contact's normal row from its current normal velocity vn: the local law.
 inline double normal_update(const Contact& c, double vn, double dt, bool use_bias) {
   if (c.type == ContactType::crushing) return crushing_impulse(c, vn, dt);
-  const double target = use_bias ? c.bias : (c.gap > 0 ? -c.gap / dt : 0.0);
-  return std::clamp(c.pn + c.mass_n * (target - vn), 0.0, c.max_normal_impulse);
+  return std::clamp(c.pn + c.mass_n * (rigid_target(c, dt, use_bias) - vn), 0.0, c.max_normal_impulse);
 }
 
 // The new friction impulses from the current tangential velocities, projected together onto the Coulomb disk of
@@ -233,10 +238,10 @@ struct SubspaceEntry {
 // settled are solved exactly, the others held: normal rows that press (rigid rows: v_n = target; crushing rows by
 // their branch: rigid v_n = 0 below dt F_0, or the hardening/capped law above it) and friction rows that stick
 // (v_t = 0). Their Delassus matrix W = J M^-1 J^T (sparse: rows share a body only through that body's block) is
-// factorised by a sparse LDL^T with a fill-reducing ordering; W may be singular (four manifold points on one face,
-// friction rows of a wall), so its diagonal gets a relative 1e-10 (the regularised variant of PHYSICS.md §1.5, far
-// below any physical compliance). The new impulses are projected on their bounds and applied; the next sweeps
-// correct rows that changed state. Returns the number of rows solved (0: nothing settled, the factorisation
+// factorised by a sparse LDL^T with a fill-reducing ordering; W may be singular or nearly so (four manifold points
+// on one face, many crushing rows between the parts of two floes), so its diagonal is regularised (the regularised
+// variant of PHYSICS.md §1.5; how much, below). The new impulses are projected on their bounds and applied; the
+// next sweeps correct rows that changed state. Returns the number of rows solved (0: nothing settled, the factorisation
 // failed, or the step did not lower the violation and was undone).
 int subspace_step(const SolverBodies& sb, State& state, std::vector<Contact>& contacts, double dt, bool use_bias) {
   std::vector<SubspaceRow> rows;
@@ -244,7 +249,7 @@ int subspace_step(const SolverBodies& sb, State& state, std::vector<Contact>& co
     const Contact& c = contacts[ci];
     if (c.mass_n <= 0 || c.pn <= 0) continue;  // between two fixed bodies, or not pressing: held (at zero)
     if (c.type == ContactType::rigid) {
-      rows.push_back({ci, 0, 0.0, use_bias ? c.bias : (c.gap > 0 ? -c.gap / dt : 0.0)});
+      rows.push_back({ci, 0, 0.0, rigid_target(c, dt, use_bias)});
     } else if (c.pn < dt * c.crush_force_n) {
       rows.push_back({ci, 0, 0.0, 0.0});  // below the crushing force: rigid, no push-out
     } else {
