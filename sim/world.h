@@ -66,6 +66,8 @@ class World {
 
   const StepReport& report() const { return report_; }
   const std::vector<Contact>& contacts() const { return contacts_; }
+  // The external wrench on each awake body this step (forces stage: gravity, water, wind, propulsion), world.
+  const std::vector<Wrench>& external_wrenches() const { return external_; }
   // Every fracture event so far, in time order (children ids are floe ids of bodies in model()).
   const std::vector<FractureEvent>& fracture_events() const { return events_; }
   // When each body left the world (broken up or removed), s; +inf while alive. Indexed like model().bodies.
