@@ -201,10 +201,12 @@ struct PatchScratch {
 };
 
 // step_of(point, normal) gives the penetration step of the area's secant (see ContactPatch::area_step_m). b is
-// measured translated by shift_b (a crushed pair: moved back to its crushed depth).
+// measured translated by shift_b (a crushed pair: moved back to its crushed depth). probe: only whether the parts
+// overlap, the area, normal and point (no span, rows or secant).
 template <class StepFn>
 ContactPatch overlap_patch(const ConvexPart& A, const PartWorld& wa, const ConvexPart& B, const PartWorld& wb,
-                           const Vec3& shift_b, PatchSide side, StepFn step_of, PatchScratch& ps) {
+                           const Vec3& shift_b, PatchSide side, StepFn step_of, PatchScratch& ps,
+                           bool probe = false) {
   ContactPatch r;
   // Local origin: the centre of the intersection of the two boxes.
   const Vec3 origin = 0.5 * (wa.lo.cwiseMax(wb.lo + shift_b) + wa.hi.cwiseMin(wb.hi + shift_b));
@@ -242,6 +244,7 @@ ContactPatch overlap_patch(const ConvexPart& A, const PartWorld& wa, const Conve
   }
   const Vec3 centre = r.point;  // local origin
   r.point += origin;
+  if (probe) return r;
   // Horizontal extent of the contact surface across the normal (the contact width of PHYSICS.md §2.1). A normal
   // close to vertical (a floe under a flat bottom) has no horizontal tangent: the span is then taken along x.
   Vec3 u1 = Vec3::UnitZ().cross(r.normal);
@@ -386,8 +389,9 @@ struct CollisionWorld::Impl {
   // normal (held in a's frame); a pair that has backed off from it by g is measured at that depth (b moved back by
   // g along the normal: the crushed face, not a fresh overlap) and its rows let it approach over g without force.
   // A pair that presses at or beyond its crushed depth is measured as it is and remembers the new depth along its
-  // current normal. The state lives as long as the parts overlap (in the cache, like the warm start): a pair that
-  // backs off beyond its crushed depth separates and forgets it.
+  // current normal. The state lives as long as the parts overlap and the contact keeps its direction (in the cache,
+  // like the warm start): a pair that backs off beyond its crushed depth separates and forgets it.
+  static constexpr double kSameDirection = 0.985;  // cos 10 deg
   bool crushing_contact(const PairCandidate& pc, Scratch& sc, std::vector<Contact>& out) {
     const bool structure = is_structure_pair(pc);
     // The area's secant spans the penetration this step is about to add at the current approach speed (at least
@@ -404,21 +408,29 @@ struct CollisionWorld::Impl {
       return std::max(eps, dt * std::max(0.0, -n.dot(vb - va)));
     };
     const Quat& qa = s.orientation[pc.body_a];
-    double gap = 0, crushed_depth = 0;
-    Vec3 crushed_normal = Vec3::Zero();
-    if (const CachedContact* mem = crushed_state(pc)) {
-      crushed_normal = qa * mem->crush_normal_a;
-      crushed_depth = mem->crush_depth_m;
-      gap = std::max(0.0, crushed_depth - depth_along(pc, crushed_normal));
-    }
     const PatchSide side = structure ? PatchSide::a_is_structure : PatchSide::symmetric;
-    const ContactPatch patch = overlap_patch(model.parts[pc.part_a], world[pc.part_a], model.parts[pc.part_b],
-                                             world[pc.part_b], -gap * crushed_normal, side, step_of, sc.patch);
-    if (!patch.valid || patch.row_count == 0) return false;
-    if (gap == 0) {  // pressing at or beyond the crushed depth: the new depth along the current normal
-      crushed_normal = patch.normal;
-      crushed_depth = depth_along(pc, patch.normal);
+    auto patch_at = [&](const Vec3& shift_b, bool probe) {
+      return overlap_patch(model.parts[pc.part_a], world[pc.part_a], model.parts[pc.part_b], world[pc.part_b],
+                           shift_b, side, step_of, sc.patch, probe);
+    };
+    const CachedContact* mem = crushed_state(pc);
+    // The overlap as it is: no overlap, no contact (and the crushed state is forgotten).
+    ContactPatch patch = patch_at(Vec3::Zero(), mem != nullptr);
+    if (!patch.valid) return false;
+    double gap = 0;
+    // The crushed state holds while the contact keeps its direction (within kSameDirection of the remembered
+    // normal); a contact that has turned further (a floe sliding round the bow) starts afresh.
+    Vec3 n = patch.normal;
+    if (mem && (qa * mem->crush_normal_a).dot(patch.normal) >= kSameDirection) {
+      n = qa * mem->crush_normal_a;
+      gap = std::max(0.0, mem->crush_depth_m - depth_along(pc, n));
     }
+    // With a gap: the crushed face (b moved back to the crushed depth); else the overlap as it is, in full.
+    if (gap > 0 || mem) patch = patch_at(-gap * n, false);
+    if (!patch.valid || patch.row_count == 0) return false;
+    const Vec3 crushed_normal = gap > 0 ? n : patch.normal;
+    // At or beyond the crushed depth: the new depth along the current normal.
+    const double crushed_depth = gap > 0 ? mem->crush_depth_m : depth_along(pc, patch.normal);
     const Vec3 normal_a = qa.conjugate() * crushed_normal;
     for (int k = 0; k < patch.row_count; ++k) {
       const PatchRow& pr = patch.rows[k];

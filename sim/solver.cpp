@@ -81,7 +81,7 @@ inline double rel_velocity(const State& s, const Contact& c, const Vec3& d) {
 }
 
 // The normal impulse of a crushing row given its current normal velocity vn (PHYSICS.md §1.8(c)), the local
-// three-branch update of a Gauss-Seidel sweep. With W = 1/m_eff and v0 = vn - W p the velocity without this row's
+// three-branch update of a Gauss-Seidel sweep (velocities counted from the bias, see below). With W = 1/m_eff and v0 = vn - W p the velocity without this row's
 // impulse, the end-of-step velocity is v = v0 + W p and
 //   v0 >= 0                        -> p = 0                  separating: no tension, no spring-back
 //   -v0 <= W dt F_0                -> p = -v0 / W            below the crushing force: rigid (v = 0), no push-out
@@ -133,7 +133,8 @@ void prepare_contacts(const Model& model, const SolverBodies& sb, State& state, 
     c.mass_t1 = row(c.t1, c.ia_t1, c.ib_t1);
     c.mass_t2 = row(c.t2, c.ia_t2, c.ib_t2);
     // Bias = smallest allowed normal velocity. Rigid: push out the overlap beyond the slop at ERP per step (capped);
-    // a speculative gap allows approaching by gap/dt. Crushing rows never push out (PHYSICS.md §1.8(c)).
+    // a speculative gap allows approaching by gap/dt. Crushing rows never push out (PHYSICS.md §1.8(c)); a pair
+    // backed off from its crushed depth approaches over the gap freely.
     if (c.type == ContactType::crushing) {
       c.bias = -c.crush_gap_m / dt;  // free approach back to the crushed depth; never a push-out
       // Optional damping c_n = 2 zeta sqrt(m K_t) of the body pair (m its translational reduced mass along the

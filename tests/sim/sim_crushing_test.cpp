@@ -89,6 +89,12 @@ TEST(SimCrushingGeometry, FlatEdgeAreaIsThicknessTimesWidth) {
     ASSERT_TRUE(p.valid);
     EXPECT_NEAR(p.area_m2, h * w, kGeomTol);
     EXPECT_NEAR(p.area_slope_m, 0.0, kGeomTol);
+    // Two rows, each half the edge, at the quarter points of the width.
+    ASSERT_EQ(p.row_count, 2);
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_NEAR(p.rows[k].area_m2, h * w / 2, kGeomTol);
+      EXPECT_NEAR(std::abs(p.rows[k].point.y() - 1), w / 4, kGeomTol);
+    }
     EXPECT_NEAR(p.volume_m3, h * w * delta, kGeomTol);
   }
   // Apart by a millimetre: no patch.
@@ -116,6 +122,12 @@ TEST(SimCrushingGeometry, SymmetricPatchOfTwoFloes) {
   EXPECT_NEAR(p.volume_m3, delta * (4 - dy), kGeomTol);
   EXPECT_LT((p.normal - S.normalized()).norm(), 1e-8);
   EXPECT_LT((p.point - Vec3(2 - delta / 2, dy / 2, 0)).norm(), kGeomTol);
+  // The two rows: the halves of the contact surface either side of the centroid across the horizontal tangent
+  // z x n. Their areas add up to the patch's, and their area-weighted points to its point.
+  ASSERT_EQ(p.row_count, 2);
+  EXPECT_NEAR(p.rows[0].area_m2 + p.rows[1].area_m2, p.area_m2, kGeomTol);
+  EXPECT_LT((p.rows[0].area_m2 * p.rows[0].point + p.rows[1].area_m2 * p.rows[1].point - p.area_m2 * p.point).norm(),
+            10 * kGeomTol);
   const ContactPatch q = convex_overlap(b, xb, Quat::Identity(), a, Vec3::Zero(), Quat::Identity(),
                                         PatchSide::symmetric, 0.005);
   EXPECT_NEAR(q.area_m2, p.area_m2, kGeomTol);
