@@ -382,8 +382,9 @@ struct CollisionWorld::Impl {
     return &*it;
   }
 
-  // The crushing contact of a compliant pair: two rows over the contact surface (its halves, see row_sums). Returns false if the parts do not overlap. The vessel is body 0, so in a vessel-floe pair it is always
-  // a (the structure side of the patch).
+  // The crushing contact of a compliant pair: two rows over the contact surface (its halves, see row_sums).
+  // Returns false if the parts do not overlap. The vessel is body 0, so in a vessel-floe pair it is always a (the
+  // structure side of the patch).
   //
   // Crushed state: the ice crushed so far is gone. The pair remembers the deepest overlap it reached along its
   // normal (held in a's frame); a pair that has backed off from it by g is measured at that depth (b moved back by

@@ -11,8 +11,8 @@
 //    faces of b inside a; their vector areas give the nominal contact area (the overlap projected on the contact
 //    plane), the normal and the centroid, all continuous functions of the poses (no chatter as contacts slide or
 //    faces change). The contact surface is cut in two halves across its width at that centroid, one row each (so
-//    the contact resists a floe turning into it), and the pair keeps its crushed depth from step to step (crushed ice does not come back).
-//    GJK is not needed: an empty overlap is the answer "apart".
+//    the contact resists a floe turning into it), and the pair keeps its crushed depth from step to step (crushed
+//    ice does not come back). GJK is not needed: an empty overlap is the answer "apart".
 #pragma once
 #include <array>
 #include <memory>

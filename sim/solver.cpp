@@ -81,8 +81,8 @@ inline double rel_velocity(const State& s, const Contact& c, const Vec3& d) {
 }
 
 // The normal impulse of a crushing row given its current normal velocity vn (PHYSICS.md §1.8(c)), the local
-// three-branch update of a Gauss-Seidel sweep (velocities counted from the bias, see below). With W = 1/m_eff and v0 = vn - W p the velocity without this row's
-// impulse, the end-of-step velocity is v = v0 + W p and
+// three-branch update of a Gauss-Seidel sweep (velocities counted from the bias, see below). With W = 1/m_eff and
+// v0 = vn - W p the velocity without this row's impulse, the end-of-step velocity is v = v0 + W p and
 //   v0 >= 0                        -> p = 0                  separating: no tension, no spring-back
 //   -v0 <= W dt F_0                -> p = -v0 / W            below the crushing force: rigid (v = 0), no push-out
 //   otherwise                      -> p = dt (F_0 - k v) with k = dt K_t + c_n, i.e.

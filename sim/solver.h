@@ -4,7 +4,8 @@
 // (separating -> 0; rigid below the crushing force dt F_0; crushing above it, hardening with K_t implicitly in the
 // end-of-step velocity), never a push-out bias, so crushed overlap stays and nothing springs back (a pair backed off
 // from its crushed depth only gets the free approach over the gap); the pressure of the pressure-area law is that of
-// the body pair's whole contact area. Friction on the same row for both. Laid out like Chrono's ChSolverPSOR in numbered steps.
+// the body pair's whole contact area. Friction on the same row for both. Laid out like Chrono's ChSolverPSOR in
+// numbered steps.
 #pragma once
 #include <vector>
 
