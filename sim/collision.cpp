@@ -390,9 +390,10 @@ struct CollisionWorld::Impl {
   // normal (held in a's frame); a pair that has backed off from it by g is measured at that depth (b moved back by
   // g along the normal: the crushed face, not a fresh overlap) and its rows let it approach over g without force.
   // A pair that presses at or beyond its crushed depth is measured as it is and remembers the new depth along its
-  // current normal. The state lives as long as the parts overlap and the contact keeps its direction (in the cache,
-  // like the warm start): a pair that backs off beyond its crushed depth separates and forgets it.
-  static constexpr double kSameDirection = 0.985;  // cos 10 deg
+  // current normal. The state lives as long as the parts overlap and the contact keeps its place and direction (in
+  // the cache, like the warm start): a pair that backs off beyond its crushed depth separates and forgets it.
+  static constexpr double kSameDirection = 0.9994;  // cos 2 deg
+  static constexpr double kSameSpot = 0.1;          // m
   bool crushing_contact(const PairCandidate& pc, Scratch& sc, std::vector<Contact>& out) {
     const bool structure = is_structure_pair(pc);
     // The area's secant spans the penetration this step is about to add at the current approach speed (at least
@@ -419,10 +420,13 @@ struct CollisionWorld::Impl {
     ContactPatch patch = patch_at(Vec3::Zero(), mem != nullptr);
     if (!patch.valid) return false;
     double gap = 0;
-    // The crushed state holds while the contact keeps its direction (within kSameDirection of the remembered
-    // normal); a contact that has turned further (a floe sliding round the bow) starts afresh.
+    // The crushed state holds while the contact keeps its place and direction (within kSameSpot and kSameDirection
+    // of the remembered point and normal, in a's frame): a floe sliding along the hull meets fresh ice, and the
+    // depth along an old normal would then only measure how the hull curves away.
     Vec3 n = patch.normal;
-    if (mem && (qa * mem->crush_normal_a).dot(patch.normal) >= kSameDirection) {
+    const Vec3 xa = s.position[pc.body_a];
+    if (mem && (qa * mem->crush_normal_a).dot(patch.normal) >= kSameDirection &&
+        (qa * mem->crush_point_a + xa - patch.point).norm() <= kSameSpot) {
       n = qa * mem->crush_normal_a;
       gap = std::max(0.0, mem->crush_depth_m - depth_along(pc, n));
     }
@@ -433,6 +437,7 @@ struct CollisionWorld::Impl {
     // At or beyond the crushed depth: the new depth along the current normal.
     const double crushed_depth = gap > 0 ? mem->crush_depth_m : depth_along(pc, patch.normal);
     const Vec3 normal_a = qa.conjugate() * crushed_normal;
+    const Vec3 point_a = gap > 0 ? mem->crush_point_a : Vec3(qa.conjugate() * (patch.point - xa));
     for (int k = 0; k < patch.row_count; ++k) {
       const PatchRow& pr = patch.rows[k];
       Contact c;
@@ -452,6 +457,7 @@ struct CollisionWorld::Impl {
       c.area_step_m = patch.area_step_m;
       c.area_slope_m = (pr.area_end_m2 - pr.area_m2) / patch.area_step_m;
       c.crush_normal_a = normal_a;
+      c.crush_point_a = point_a;
       c.crush_depth_m = crushed_depth;
       c.crush_gap_m = gap;
       c.span_lo = patch.span_lo;

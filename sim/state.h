@@ -37,11 +37,13 @@ struct Contact {
   double area_end_m2 = 0;      // A(delta + step) >= A
   double area_step_m = 0;      // the step, m
   double area_slope_m = 0;     // (area_end - area) / step, m^2/m
-  // Crushed state of the part pair (collide; kept in the cache): the normal in a's frame along which the pair
-  // crushed, the deepest overlap reached along it (the extent of the two parts' overlap along that normal, m), and
-  // how far the pair has backed off from it now (>= 0). The crushed ice is gone: the row is measured at the
-  // crushed depth and lets the pair approach freely over the gap (bias -gap/dt) before it crushes again.
+  // Crushed state of the part pair (collide; kept in the cache): the normal and the contact point in a's frame
+  // where the pair crushed, the deepest overlap reached along that normal (the extent of the two parts' overlap
+  // along it, m), and how far the pair has backed off from it now (>= 0). The crushed ice is gone: the row is
+  // measured at the crushed depth and lets the pair approach freely over the gap (bias -gap/dt) before it crushes
+  // again.
   Vec3 crush_normal_a = Vec3::UnitZ();
+  Vec3 crush_point_a = Vec3::Zero();
   double crush_depth_m = 0;
   double crush_gap_m = 0;
   // Horizontal extent of the contact (collide): the two extreme points of the contact surface (crushing) or the
@@ -74,7 +76,7 @@ struct CachedContact {
   Vec3 local_a;
   Vec3 impulse;  // world: pn n + pt1 t1 + pt2 t2
   ContactType type;
-  Vec3 crush_normal_a;
+  Vec3 crush_normal_a, crush_point_a;
   double crush_depth_m;
 };
 
