@@ -361,15 +361,6 @@ struct CollisionWorld::Impl {
     return is_structure_pair(pc) ? compliant_structure : compliant_ice;
   }
 
-  // Extent of the overlap of the two parts along the unit n (from a to b): max over a of n.x - min over b of n.x,
-  // the depth a translation of b along -n deepens one for one (the separating-axis overlap along n).
-  double depth_along(const PairCandidate& pc, const Vec3& n) const {
-    double amax = -1e300, bmin = 1e300;
-    for (const Vec3& v : world[pc.part_a].v) amax = std::max(amax, n.dot(v));
-    for (const Vec3& v : world[pc.part_b].v) bmin = std::min(bmin, n.dot(v));
-    return amax - bmin;
-  }
-
   // The crushed state of a part pair kept from the previous step (any of its cached crushing rows), or null.
   const CachedContact* crushed_state(const PairCandidate& pc) const {
     const std::vector<CachedContact>& cache = state->contact_cache;
@@ -386,12 +377,15 @@ struct CollisionWorld::Impl {
   // Returns false if the parts do not overlap. The vessel is body 0, so in a vessel-floe pair it is always a (the
   // structure side of the patch).
   //
-  // Crushed state: the ice crushed so far is gone. The pair remembers the deepest overlap it reached along its
-  // normal (held in a's frame); a pair that has backed off from it by g is measured at that depth (b moved back by
-  // g along the normal: the crushed face, not a fresh overlap) and its rows let it approach over g without force.
-  // A pair that presses at or beyond its crushed depth is measured as it is and remembers the new depth along its
-  // current normal. The state lives as long as the parts overlap and the contact keeps its place and direction (in
-  // the cache, like the warm start): a pair that backs off beyond its crushed depth separates and forgets it.
+  // Crushed state: the ice crushed so far is gone. The pair remembers where it crushed last: the contact point as a
+  // material point of a and of b (where the crushed face of b met a) and the normal, in a's frame. How far b's
+  // point has moved away from a's along that normal is how far the pair has backed off from its crushed depth, g
+  // (local to the contact: a floe tilting about it does not back off). A pair with g > 0 is measured at the crushed
+  // depth (b moved back by g along the normal: the crushed face, not a fresh overlap), and its rows let it approach
+  // over g without force. A pair pressing at or beyond its crushed depth is measured as it is and remembers its
+  // current contact point and normal. The state lives as long as the parts overlap and the contact keeps its place
+  // and direction (in the cache, like the warm start): a pair that backs off beyond its crushed depth separates and
+  // forgets it.
   static constexpr double kSameDirection = 0.9994;  // cos 2 deg
   static constexpr double kSameSpot = 0.1;          // m
   bool crushing_contact(const PairCandidate& pc, Scratch& sc, std::vector<Contact>& out) {
@@ -419,26 +413,24 @@ struct CollisionWorld::Impl {
     // The overlap as it is: no overlap, no contact (and the crushed state is forgotten).
     ContactPatch patch = patch_at(Vec3::Zero(), mem != nullptr);
     if (!patch.valid) return false;
-    double gap = 0;
     // The crushed state holds while the contact keeps its place and direction (within kSameSpot and kSameDirection
-    // of the remembered point and normal, in a's frame): a floe that slides or turns meets fresh ice, and a depth
-    // along an old normal at another place no longer says how far it backed off (looser, 10 deg and no place check,
-    // cost a default-case start 28 % of its mean load in such free gaps).
+    // of the remembered point and normal, in a's frame): a floe that slides or turns meets fresh ice.
+    const Vec3 xa = s.position[pc.body_a], xb = s.position[pc.body_b];
+    const Quat& qb = s.orientation[pc.body_b];
+    double gap = 0;
     Vec3 n = patch.normal;
-    const Vec3 xa = s.position[pc.body_a];
     if (mem && (qa * mem->crush_normal_a).dot(patch.normal) >= kSameDirection &&
         (qa * mem->crush_point_a + xa - patch.point).norm() <= kSameSpot) {
       n = qa * mem->crush_normal_a;
-      gap = std::max(0.0, mem->crush_depth_m - depth_along(pc, n));
+      gap = std::max(0.0, n.dot((xb + qb * mem->crush_point_b) - (xa + qa * mem->crush_point_a)));
     }
     // With a gap: the crushed face (b moved back to the crushed depth); else the overlap as it is, in full.
     if (gap > 0 || mem) patch = patch_at(-gap * n, false);
     if (!patch.valid || patch.row_count == 0) return false;
-    const Vec3 crushed_normal = gap > 0 ? n : patch.normal;
-    // At or beyond the crushed depth: the new depth along the current normal.
-    const double crushed_depth = gap > 0 ? mem->crush_depth_m : depth_along(pc, patch.normal);
-    const Vec3 normal_a = qa.conjugate() * crushed_normal;
+    // At or beyond the crushed depth: the current contact point and normal are the new crushed state.
+    const Vec3 normal_a = gap > 0 ? mem->crush_normal_a : Vec3(qa.conjugate() * patch.normal);
     const Vec3 point_a = gap > 0 ? mem->crush_point_a : Vec3(qa.conjugate() * (patch.point - xa));
+    const Vec3 point_b = gap > 0 ? mem->crush_point_b : Vec3(qb.conjugate() * (patch.point - xb));
     for (int k = 0; k < patch.row_count; ++k) {
       const PatchRow& pr = patch.rows[k];
       Contact c;
@@ -459,7 +451,7 @@ struct CollisionWorld::Impl {
       c.area_slope_m = (pr.area_end_m2 - pr.area_m2) / patch.area_step_m;
       c.crush_normal_a = normal_a;
       c.crush_point_a = point_a;
-      c.crush_depth_m = crushed_depth;
+      c.crush_point_b = point_b;
       c.crush_gap_m = gap;
       c.span_lo = patch.span_lo;
       c.span_hi = patch.span_hi;

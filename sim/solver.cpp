@@ -238,7 +238,7 @@ void store_impulses(const Model& model, State& state, const std::vector<Contact>
   for (const Contact& c : contacts)
     state.contact_cache.push_back(CachedContact{c.body_a, c.part_a, c.body_b, c.part_b, c.row, c.local_a,
                                                 c.pn * c.normal + c.pt1 * c.t1 + c.pt2 * c.t2, c.type,
-                                                c.crush_normal_a, c.crush_point_a, c.crush_depth_m});
+                                                c.crush_normal_a, c.crush_point_a, c.crush_point_b});
 }
 
 }  // namespace floesim::sim

@@ -37,14 +37,12 @@ struct Contact {
   double area_end_m2 = 0;      // A(delta + step) >= A
   double area_step_m = 0;      // the step, m
   double area_slope_m = 0;     // (area_end - area) / step, m^2/m
-  // Crushed state of the part pair (collide; kept in the cache): the normal and the contact point in a's frame
-  // where the pair crushed, the deepest overlap reached along that normal (the extent of the two parts' overlap
-  // along it, m), and how far the pair has backed off from it now (>= 0). The crushed ice is gone: the row is
-  // measured at the crushed depth and lets the pair approach freely over the gap (bias -gap/dt) before it crushes
-  // again.
+  // Crushed state of the part pair (collide; kept in the cache): where it crushed last, as the contact point held
+  // as a material point of a and of b and the normal in a's frame, and how far b's point has moved away from a's
+  // along that normal since (>= 0: backed off from the crushed depth). The crushed ice is gone: the row is measured
+  // at the crushed depth and lets the pair approach freely over the gap (bias -gap/dt) before it crushes again.
   Vec3 crush_normal_a = Vec3::UnitZ();
-  Vec3 crush_point_a = Vec3::Zero();
-  double crush_depth_m = 0;
+  Vec3 crush_point_a = Vec3::Zero(), crush_point_b = Vec3::Zero();
   double crush_gap_m = 0;
   // Horizontal extent of the contact (collide): the two extreme points of the contact surface (crushing) or the
   // point itself (rigid manifold points) along the horizontal tangent z x normal. The fracture stage takes the
@@ -76,8 +74,7 @@ struct CachedContact {
   Vec3 local_a;
   Vec3 impulse;  // world: pn n + pt1 t1 + pt2 t2
   ContactType type;
-  Vec3 crush_normal_a, crush_point_a;
-  double crush_depth_m;
+  Vec3 crush_normal_a, crush_point_a, crush_point_b;
 };
 
 struct State {
