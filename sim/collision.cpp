@@ -1,6 +1,7 @@
 #include "sim/collision.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
@@ -8,6 +9,7 @@
 #include <fcl/narrowphase/collision.h>
 #include <fcl/narrowphase/collision_object.h>
 
+#include "sim/geometry.h"
 #include "sim/parallel.h"
 
 namespace floesim::sim {
@@ -53,6 +55,21 @@ void transform_part(const ConvexPart& cp, const Vec3& x, const Mat3& R, PartWorl
   w.hi = hi;
 }
 
+// The clipped contact-surface faces of a patch (local origin), one polygon after another, with their face normals and
+// sides: split into the patch's rows after the patch's centroid and normal are known.
+struct SurfacePolygons {
+  std::vector<Vec3> v;        // vertices
+  std::vector<int> end;       // end of each polygon in v
+  std::vector<Vec3> n;        // face normal of each polygon
+  std::vector<uint8_t> side;  // 0: a face of a, 1: a face of b
+  void clear() {
+    v.clear();
+    end.clear();
+    n.clear();
+    side.clear();
+  }
+};
+
 // Sums over the faces of one part clipped by the other part (one side of the overlap's boundary), in coordinates
 // relative to a local origin near the overlap (so that the volume does not cancel large world offsets).
 struct SideSums {
@@ -60,7 +77,8 @@ struct SideSums {
   Vec3 moment = Vec3::Zero();    // sum of area x centroid over contact-surface faces
   double area = 0;               // sum of the areas of contact-surface faces
   double volume = 0;             // divergence theorem over all faces: (1/3) sum of area x (n . centroid)
-  std::vector<Vec3>* points = nullptr;  // if set: the vertices of the clipped contact-surface faces (local origin)
+  SurfacePolygons* surface = nullptr;   // if set: the clipped contact-surface faces themselves (local origin)
+  uint8_t side = 0;                     // 0: faces of a, 1: faces of b (tag of the faces put into `surface`)
 };
 
 // Points up to this far outside a plane count as inside (1 nm): a face lying in the other part's face plane (the
@@ -118,7 +136,12 @@ void clip_faces(const ConvexPart& P, const PartWorld& pw, const Vec3& tp, const 
     const Vec3 centroid = c / (3 * a2);
     out.volume += area * nf.dot(centroid) / 3;
     if (P.face_internal[f]) continue;  // bounds the overlap, but is no surface of the body
-    if (out.points) out.points->insert(out.points->end(), poly.begin(), poly.end());
+    if (out.surface) {
+      out.surface->v.insert(out.surface->v.end(), poly.begin(), poly.end());
+      out.surface->end.push_back(static_cast<int>(out.surface->v.size()));
+      out.surface->n.push_back(nf);
+      out.surface->side.push_back(out.side);
+    }
     out.vec_area += area * nf;
     out.moment += area * centroid;
     out.area += area;
@@ -128,20 +151,72 @@ void clip_faces(const ConvexPart& P, const PartWorld& pw, const Vec3& tp, const 
 // Areas below this (1 mm^2; 2 N at 2 MPa) are no contact: the parts merely graze.
 constexpr double kMinPatchArea = 1e-6;
 
-// step_of(point, normal) gives the penetration step of the area's secant (see ContactPatch::area_step_m).
+// The rows of a crushing contact: the contact surface cut in two halves by the plane through its centroid normal
+// to the horizontal tangent u = z x n (x when n is vertical). Each half is a row at its own centroid carrying its
+// own share of the area, so that the contact resists a rotation about the vertical (a floe turning into the hull):
+// the half turning into the ice crushes and the half turning away unloads (one row at the centroid carries no
+// moment). No second cut across the thickness: on floes ~1 m thick its rows are a quarter metre apart on bodies
+// metres across, nearly redundant, and Gauss-Seidel does not converge on them within its sweeps (tried: residuals
+// of 5e-3 m/s at impacts and floes leaving a pushing face at 0.1 % of its speed). Sums per half (1: u.(x - c) >= 0);
+// side_weight is the weight of a's and b's faces in the vector area (as for the whole patch), and point_side which
+// sides' faces place the points.
+constexpr int kRows = 2;
+struct RowSums {
+  std::array<Vec3, kRows> vec_area, moment;
+  std::array<double, kRows> area;
+  RowSums() {
+    vec_area.fill(Vec3::Zero());
+    moment.fill(Vec3::Zero());
+    area.fill(0.0);
+  }
+};
+
+void row_sums(const SurfacePolygons& s, const Vec3& c, const Vec3& u, const double side_weight[2],
+              const bool point_side[2], std::vector<Vec3>& half, RowSums& out) {
+  int begin = 0;
+  for (size_t k = 0; k < s.end.size(); ++k) {
+    const Vec3* p = s.v.data() + begin;
+    const int n = s.end[k] - begin;
+    begin = s.end[k];
+    if (side_weight[s.side[k]] == 0 && !point_side[s.side[k]]) continue;  // a side the patch does not use
+    const Vec3& nf = s.n[k];
+    for (int h = 0; h < kRows; ++h) {
+      const double sg = h ? 1.0 : -1.0;  // h = 1: u.(x - c) >= 0
+      clip_polygon_plane(p, n, -sg * u, -sg * u.dot(c), half);
+      const AreaCentroid ac = polygon_area_centroid(half.data(), static_cast<int>(half.size()));
+      if (!(ac.area > 0)) continue;
+      out.vec_area[h] += side_weight[s.side[k]] * ac.area * nf;
+      if (point_side[s.side[k]]) {
+        out.moment[h] += ac.area * ac.centroid;
+        out.area[h] += ac.area;
+      }
+    }
+  }
+}
+
+// Scratch buffers of the patch computation.
+struct PatchScratch {
+  std::vector<Vec3> poly, tmp, half;
+  SurfacePolygons surface;
+};
+
+// step_of(point, normal) gives the penetration step of the area's secant (see ContactPatch::area_step_m). b is
+// measured translated by shift_b (a crushed pair: moved back to its crushed depth). probe: only whether the parts
+// overlap, the area, normal and point (no span, rows or secant).
 template <class StepFn>
 ContactPatch overlap_patch(const ConvexPart& A, const PartWorld& wa, const ConvexPart& B, const PartWorld& wb,
-                           PatchSide side, StepFn step_of, std::vector<Vec3>& poly, std::vector<Vec3>& tmp,
-                           std::vector<Vec3>& surface) {
+                           const Vec3& shift_b, PatchSide side, StepFn step_of, PatchScratch& ps,
+                           bool probe = false) {
   ContactPatch r;
   // Local origin: the centre of the intersection of the two boxes.
-  const Vec3 origin = 0.5 * (wa.lo.cwiseMax(wb.lo) + wa.hi.cwiseMin(wb.hi));
+  const Vec3 origin = 0.5 * (wa.lo.cwiseMax(wb.lo + shift_b) + wa.hi.cwiseMin(wb.hi + shift_b));
   const Vec3 zero = Vec3::Zero();
   SideSums sa, sb;
-  surface.clear();
-  sa.points = sb.points = &surface;
-  clip_faces(A, wa, zero, B, wb, zero, origin, false, poly, tmp, sa);
-  clip_faces(B, wb, zero, A, wa, zero, origin, true, poly, tmp, sb);
+  ps.surface.clear();
+  sa.surface = sb.surface = &ps.surface;
+  sb.side = 1;
+  clip_faces(A, wa, zero, B, wb, shift_b, origin, false, ps.poly, ps.tmp, sa);
+  clip_faces(B, wb, shift_b, A, wa, zero, origin, true, ps.poly, ps.tmp, sb);
   // The boundary of the overlap is closed, so sa.vec_area = -sb.vec_area up to the internal faces left out: the
   // vector area of one side is the overlap projected on the plane normal to it, which is the nominal contact area
   // (a wedge of half-angle phi pushed delta into a wall: 2 h delta tan(phi); a flat edge: h w).
@@ -167,34 +242,65 @@ ContactPatch overlap_patch(const ConvexPart& A, const PartWorld& wa, const Conve
   } else {
     r.point = from_b ? Vec3(sb.moment / sb.area) : Vec3(sa.moment / sa.area);
   }
+  const Vec3 centre = r.point;  // local origin
   r.point += origin;
+  if (probe) return r;
   // Horizontal extent of the contact surface across the normal (the contact width of PHYSICS.md §2.1). A normal
   // close to vertical (a floe under a flat bottom) has no horizontal tangent: the span is then taken along x.
+  Vec3 u1 = Vec3::UnitZ().cross(r.normal);
+  u1 = u1.norm() > 1e-6 ? Vec3(u1.normalized()) : Vec3::UnitX();
   {
-    Vec3 t = Vec3::UnitZ().cross(r.normal);
-    t = t.norm() > 1e-6 ? Vec3(t.normalized()) : Vec3::UnitX();
     double lo = 1e300, hi = -1e300;
-    for (const Vec3& p : surface) {
-      const double s = t.dot(p);
+    for (const Vec3& p : ps.surface.v) {
+      const double s = u1.dot(p);
       if (s < lo) lo = s, r.span_lo = p + origin;
       if (s > hi) hi = s, r.span_hi = p + origin;
     }
-    if (surface.empty()) r.span_lo = r.span_hi = r.point;
+    if (ps.surface.v.empty()) r.span_lo = r.span_hi = r.point;
   }
-  // dA/d(delta): b moved by the step towards a along the normal, the same sides re-clipped, projected on this normal.
+  // The rows: the same sides as the patch, cut in halves across u1 through its centroid.
+  double side_weight[2];
+  bool point_side[2];
+  if (side == PatchSide::symmetric) {
+    side_weight[0] = 0.5, side_weight[1] = -0.5;
+    point_side[0] = point_side[1] = true;
+  } else {
+    side_weight[0] = from_b ? 0.0 : 1.0, side_weight[1] = from_b ? -1.0 : 0.0;
+    point_side[0] = !from_b, point_side[1] = from_b;
+  }
+  RowSums rows;
+  row_sums(ps.surface, centre, u1, side_weight, point_side, ps.half, rows);
+  // dA/d(delta): b moved by the step towards a along the normal, the same sides re-clipped, projected on this normal
+  // (in total and per half, with the same cutting plane).
   const double eps = step_of(r.point, r.normal);
-  const Vec3 t = -eps * r.normal;
+  const Vec3 t = shift_b - eps * r.normal;
   SideSums fa, fb;
-  if (side == PatchSide::symmetric || !from_b) clip_faces(A, wa, zero, B, wb, t, origin, false, poly, tmp, fa);
-  if (side == PatchSide::symmetric || from_b) clip_faces(B, wb, t, A, wa, zero, origin, true, poly, tmp, fb);
+  ps.surface.clear();
+  fa.surface = fb.surface = &ps.surface;
+  fb.side = 1;
+  if (side == PatchSide::symmetric || !from_b) clip_faces(A, wa, zero, B, wb, t, origin, false, ps.poly, ps.tmp, fa);
+  if (side == PatchSide::symmetric || from_b) clip_faces(B, wb, t, A, wa, zero, origin, true, ps.poly, ps.tmp, fb);
   double area_eps;
   if (side == PatchSide::symmetric) area_eps = 0.5 * (fa.vec_area - fb.vec_area).dot(r.normal);
   else area_eps = from_b ? -fb.vec_area.dot(r.normal) : fa.vec_area.dot(r.normal);
+  RowSums rows_end;
+  row_sums(ps.surface, centre, u1, side_weight, point_side, ps.half, rows_end);
   // A shrinking area (a corner passing through a thin part) would soften the implicit row and could make it
   // unstable; the hardening is kept >= 0 (constant-force crushing in that case).
   r.area_step_m = eps;
   r.area_end_m2 = std::max(area, area_eps);
   r.area_slope_m = (r.area_end_m2 - area) / eps;
+  // Halves with a measurable area become rows (their areas add up to the patch's, to a dropped sliver below
+  // kMinPatchArea).
+  for (int q = 0; q < kRows; ++q) {
+    const double aq = rows.vec_area[q].dot(r.normal);
+    if (!(aq >= kMinPatchArea) || !(rows.area[q] > 0)) continue;
+    PatchRow& row = r.rows[r.row_count++];
+    row.half = q;
+    row.point = rows.moment[q] / rows.area[q] + origin;
+    row.area_m2 = aq;
+    row.area_end_m2 = std::max(aq, rows_end.vec_area[q].dot(r.normal));
+  }
   return r;
 }
 
@@ -210,7 +316,8 @@ struct PairCandidate {
 
 // Scratch of one worker.
 struct Scratch {
-  std::vector<Vec3> poly, tmp, surface;
+  std::vector<Vec3> poly, tmp;
+  PatchScratch patch;
   std::vector<Contact> contacts;      // contacts of this worker's pairs, in pair order
   long hits = 0, edges = 0, crushing = 0;
 };
@@ -254,8 +361,33 @@ struct CollisionWorld::Impl {
     return is_structure_pair(pc) ? compliant_structure : compliant_ice;
   }
 
-  // The crushing contact of a compliant pair: one row at the patch centroid. Returns false if the parts do not
-  // overlap. The vessel is body 0, so in a vessel-floe pair it is always a (the structure side of the patch).
+  // The crushed state of a part pair kept from the previous step (any of its cached crushing rows), or null.
+  const CachedContact* crushed_state(const PairCandidate& pc) const {
+    const std::vector<CachedContact>& cache = state->contact_cache;
+    auto it = std::lower_bound(cache.begin(), cache.end(), pc, [](const CachedContact& c, const PairCandidate& k) {
+      return PairCandidate{c.body_a, c.part_a, c.body_b, c.part_b} < k;
+    });
+    if (it == cache.end() || it->body_a != pc.body_a || it->part_a != pc.part_a || it->body_b != pc.body_b ||
+        it->part_b != pc.part_b || it->type != ContactType::crushing)
+      return nullptr;
+    return &*it;
+  }
+
+  // The crushing contact of a compliant pair: two rows over the contact surface (its halves, see row_sums).
+  // Returns false if the parts do not overlap. The vessel is body 0, so in a vessel-floe pair it is always a (the
+  // structure side of the patch).
+  //
+  // Crushed state: the ice crushed so far is gone. The pair remembers where it crushed last: the contact point as a
+  // material point of a and of b (where the crushed face of b met a) and the normal, in a's frame. How far b's
+  // point has moved away from a's along that normal is how far the pair has backed off from its crushed depth, g
+  // (local to the contact: a floe tilting about it does not back off). A pair with g > 0 is measured at the crushed
+  // depth (b moved back by g along the normal: the crushed face, not a fresh overlap), and its rows let it approach
+  // over g without force. A pair pressing at or beyond its crushed depth is measured as it is and remembers its
+  // current contact point and normal. The state lives as long as the parts overlap and the contact keeps its place
+  // and direction (in the cache, like the warm start): a pair that backs off beyond its crushed depth separates and
+  // forgets it.
+  static constexpr double kSameDirection = 0.9994;  // cos 2 deg
+  static constexpr double kSameSpot = 0.1;          // m
   bool crushing_contact(const PairCandidate& pc, Scratch& sc, std::vector<Contact>& out) {
     const bool structure = is_structure_pair(pc);
     // The area's secant spans the penetration this step is about to add at the current approach speed (at least
@@ -271,28 +403,60 @@ struct CollisionWorld::Impl {
       const Vec3 vb = s.velocity[b] + s.angular_velocity[b].cross(p - s.position[b]);
       return std::max(eps, dt * std::max(0.0, -n.dot(vb - va)));
     };
-    const ContactPatch patch =
-        overlap_patch(model.parts[pc.part_a], world[pc.part_a], model.parts[pc.part_b], world[pc.part_b],
-                      structure ? PatchSide::a_is_structure : PatchSide::symmetric, step_of, sc.poly, sc.tmp,
-                      sc.surface);
+    const Quat& qa = s.orientation[pc.body_a];
+    const PatchSide side = structure ? PatchSide::a_is_structure : PatchSide::symmetric;
+    auto patch_at = [&](const Vec3& shift_b, bool probe) {
+      return overlap_patch(model.parts[pc.part_a], world[pc.part_a], model.parts[pc.part_b], world[pc.part_b],
+                           shift_b, side, step_of, sc.patch, probe);
+    };
+    const CachedContact* mem = crushed_state(pc);
+    // The overlap as it is: no overlap, no contact (and the crushed state is forgotten).
+    ContactPatch patch = patch_at(Vec3::Zero(), mem != nullptr);
     if (!patch.valid) return false;
-    Contact c;
-    c.body_a = pc.body_a;
-    c.part_a = pc.part_a;
-    c.body_b = pc.body_b;
-    c.part_b = pc.part_b;
-    c.point = patch.point;
-    c.normal = patch.normal;
-    c.gap = -patch.volume_m3 / patch.area_m2;  // mean depth of the crushed overlap (diagnostics only: no bias)
-    c.type = ContactType::crushing;
-    c.mu = structure ? model.options.ice.mu_ice_structure : model.options.ice.mu_ice_ice;
-    c.area_m2 = patch.area_m2;
-    c.area_slope_m = patch.area_slope_m;
-    c.area_end_m2 = patch.area_end_m2;
-    c.area_step_m = patch.area_step_m;
-    c.span_lo = patch.span_lo;
-    c.span_hi = patch.span_hi;
-    out.push_back(c);
+    // The crushed state holds while the contact keeps its place and direction (within kSameSpot and kSameDirection
+    // of the remembered point and normal, in a's frame): a floe that slides or turns meets fresh ice.
+    const Vec3 xa = s.position[pc.body_a], xb = s.position[pc.body_b];
+    const Quat& qb = s.orientation[pc.body_b];
+    double gap = 0;
+    Vec3 n = patch.normal;
+    if (mem && (qa * mem->crush_normal_a).dot(patch.normal) >= kSameDirection &&
+        (qa * mem->crush_point_a + xa - patch.point).norm() <= kSameSpot) {
+      n = qa * mem->crush_normal_a;
+      gap = std::max(0.0, n.dot((xb + qb * mem->crush_point_b) - (xa + qa * mem->crush_point_a)));
+    }
+    // With a gap: the crushed face (b moved back to the crushed depth); else the overlap as it is, in full.
+    if (gap > 0 || mem) patch = patch_at(-gap * n, false);
+    if (!patch.valid || patch.row_count == 0) return false;
+    // At or beyond the crushed depth: the current contact point and normal are the new crushed state.
+    const Vec3 normal_a = gap > 0 ? mem->crush_normal_a : Vec3(qa.conjugate() * patch.normal);
+    const Vec3 point_a = gap > 0 ? mem->crush_point_a : Vec3(qa.conjugate() * (patch.point - xa));
+    const Vec3 point_b = gap > 0 ? mem->crush_point_b : Vec3(qb.conjugate() * (patch.point - xb));
+    for (int k = 0; k < patch.row_count; ++k) {
+      const PatchRow& pr = patch.rows[k];
+      Contact c;
+      c.body_a = pc.body_a;
+      c.part_a = pc.part_a;
+      c.body_b = pc.body_b;
+      c.part_b = pc.part_b;
+      c.row = pr.half;
+      c.point = pr.point;  // with a gap: on the crushed face (where the force acts once the gap is closed)
+      c.normal = patch.normal;
+      // Mean depth of the crushed overlap (diagnostics only: no bias), or the gap back to the crushed depth.
+      c.gap = gap > 0 ? gap : -patch.volume_m3 / patch.area_m2;
+      c.type = ContactType::crushing;
+      c.mu = structure ? model.options.ice.mu_ice_structure : model.options.ice.mu_ice_ice;
+      c.area_m2 = pr.area_m2;
+      c.area_end_m2 = pr.area_end_m2;
+      c.area_step_m = patch.area_step_m;
+      c.area_slope_m = (pr.area_end_m2 - pr.area_m2) / patch.area_step_m;
+      c.crush_normal_a = normal_a;
+      c.crush_point_a = point_a;
+      c.crush_point_b = point_b;
+      c.crush_gap_m = gap;
+      c.span_lo = patch.span_lo;
+      c.span_hi = patch.span_hi;
+      out.push_back(c);
+    }
     return true;
   }
 
@@ -665,8 +829,8 @@ ContactPatch convex_overlap(const ConvexPart& pa, const Vec3& xa, const Quat& qa
   PartWorld wa, wb;
   transform_part(pa, xa, qa.toRotationMatrix(), wa);
   transform_part(pb, xb, qb.toRotationMatrix(), wb);
-  std::vector<Vec3> poly, tmp, surface;
-  return overlap_patch(pa, wa, pb, wb, side, [eps](const Vec3&, const Vec3&) { return eps; }, poly, tmp, surface);
+  PatchScratch ps;
+  return overlap_patch(pa, wa, pb, wb, Vec3::Zero(), side, [eps](const Vec3&, const Vec3&) { return eps; }, ps);
 }
 
 }  // namespace floesim::sim

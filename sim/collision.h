@@ -10,9 +10,11 @@
 //    against the other's planes (convex_overlap below). Its boundary splits into the faces of a inside b and the
 //    faces of b inside a; their vector areas give the nominal contact area (the overlap projected on the contact
 //    plane), the normal and the centroid, all continuous functions of the poses (no chatter as contacts slide or
-//    faces change). One contact row per part pair, at that centroid. GJK is not needed: an empty overlap is the
-//    answer "apart".
+//    faces change). The contact surface is cut in two halves across its width at that centroid, one row each (so
+//    the contact resists a floe turning into it), and the pair keeps its crushed depth from step to step (crushed
+//    ice does not come back). GJK is not needed: an empty overlap is the answer "apart".
 #pragma once
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -21,6 +23,15 @@
 #include "sim/state.h"
 
 namespace floesim::sim {
+
+// One row of a crushing contact: a half of the contact surface (cut by the plane through the patch centroid normal
+// to the horizontal tangent z x n), at its centroid, with its share of the nominal area now and after the secant's
+// step. The rows' areas add up to the patch's.
+struct PatchRow {
+  int half = 0;                 // 0: (z x n).(x - centroid) < 0, 1: >= 0
+  Vec3 point = Vec3::Zero();
+  double area_m2 = 0, area_end_m2 = 0;
+};
 
 // The overlap of two convex parts and what a crushing contact needs of it.
 struct ContactPatch {
@@ -36,6 +47,8 @@ struct ContactPatch {
   double volume_m3 = 0;     // overlap volume (diagnostics; mean depth = volume / area)
   // The contact surface's extreme points along the horizontal tangent z x normal (its width, PHYSICS.md §2.1).
   Vec3 span_lo = Vec3::Zero(), span_hi = Vec3::Zero();
+  std::array<PatchRow, 2> rows;  // the non-empty halves (row_count of them)
+  int row_count = 0;
 };
 
 // Which side of the overlap carries the contact surface. A structure (the vessel) is hard: the crushing happens on

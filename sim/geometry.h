@@ -1,4 +1,4 @@
-// Small geometric kernels of the simulation core: planar polygons in 3D (area, clipping at a horizontal plane)
+// Small geometric kernels of the simulation core: planar polygons in 3D (area, clipping at a plane)
 // and convex polygons in 2D (hull, intersection). Header-only, allocation-free when given scratch buffers.
 #pragma once
 #include <algorithm>
@@ -68,6 +68,18 @@ inline int clip_polygon_z(const Vec3* p, int n, double z0, bool below, Vec3* out
     if (ia != ib) out[k++] = a + ((z0 - a.z()) / (b.z() - a.z())) * (b - a);
   }
   return k;
+}
+
+// Part of the polygon p[0..n) in the half-space u.x <= d, written to out (any plane; clip_polygon_z is z alone).
+inline void clip_polygon_plane(const Vec3* p, int n, const Vec3& u, double d, std::vector<Vec3>& out) {
+  out.clear();
+  for (int i = 0; i < n; ++i) {
+    const Vec3& a = p[i];
+    const Vec3& b = p[i + 1 == n ? 0 : i + 1];
+    const double sa = u.dot(a) - d, sb = u.dot(b) - d;
+    if (sa <= 0) out.push_back(a);
+    if ((sa <= 0) != (sb <= 0)) out.push_back(a + (sa / (sa - sb)) * (b - a));
+  }
 }
 
 // 2D cross product of (b - a) and (c - a).

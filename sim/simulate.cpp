@@ -532,7 +532,7 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
       << ", mean solver sweeps " << stats.mean_iterations << "\n";
   rep << "mean part pairs per step: " << stats.mean_pairs << " from the broad phase, " << stats.mean_touching
       << " touching (" << stats.mean_edge_pairs << " edge-on-edge, single point; " << stats.mean_crushing_pairs
-      << " crushing, one point)\n";
+      << " crushing, two rows)\n";
   rep << "stage times (ms/step):";
   for (int i = 0; i <= kStageCount; ++i)
     rep << " " << (i < kStageCount ? stage_name(i) : "record") << " " << std::setprecision(3)

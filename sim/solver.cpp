@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <utility>
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
@@ -28,6 +30,43 @@ bool same_key(const CachedContact& c, const Contact& k) {
   return c.body_a == k.body_a && c.part_a == k.part_a && c.body_b == k.body_b && c.part_b == k.part_b;
 }
 
+// The pressure-area law p_c(A) = sigma_c (A / 1 m^2)^e_x (PHYSICS.md §1.8(a)); A = 0 carries no pressure.
+double crushing_pressure(const SimulateOptions& o, double area) {
+  const double e = o.contact.pressure_area_exponent;
+  if (e == 0) return o.ice.crushing_strength_pa;
+  return area > 0 ? o.ice.crushing_strength_pa * std::pow(area, e) : 0.0;
+}
+
+// The crushing law of every crushing row (PHYSICS.md §1.8(a)): F = p_c(A_pair) A with A_pair the contact area of
+// the row's body pair (the sum over all its rows), so that the pressure acts on the whole contact: cutting a body
+// into convex parts must not change it (with e_x < 0 each part's own area would raise the pressure, up to sqrt(2)
+// for a contact halved by a seam at e_x = -0.5). F_0 at the current (crushed) overlap, F_end at the overlap
+// deepened by the step the collision stage measured, and the gradient K_t = dF/d(delta) as the secant between
+// them (for e_x = 0 and a wedge: exactly 2 sigma_c h tan(phi)). Returns each body pair's total K_t (the sum over
+// its rows), in contact order (deterministic sums).
+std::map<std::pair<int, int>, double> crushing_law(const SimulateOptions& o, std::vector<Contact>& contacts) {
+  struct PairArea {
+    double area = 0, area_end = 0;
+  };
+  std::map<std::pair<int, int>, PairArea> areas;
+  for (const Contact& c : contacts) {
+    if (c.type != ContactType::crushing) continue;
+    PairArea& p = areas[{c.body_a, c.body_b}];
+    p.area += c.area_m2;
+    p.area_end += c.area_end_m2;
+  }
+  std::map<std::pair<int, int>, double> stiffness;
+  for (Contact& c : contacts) {
+    if (c.type != ContactType::crushing) continue;
+    const PairArea& pa = areas.at({c.body_a, c.body_b});
+    c.crush_force_n = crushing_pressure(o, pa.area) * c.area_m2;
+    c.crush_force_end_n = std::max(c.crush_force_n, crushing_pressure(o, pa.area_end) * c.area_end_m2);
+    c.crush_stiffness_npm = c.area_step_m > 0 ? (c.crush_force_end_n - c.crush_force_n) / c.area_step_m : 0.0;
+    stiffness[{c.body_a, c.body_b}] += c.crush_stiffness_npm;
+  }
+  return stiffness;
+}
+
 // Applies an impulse p along the row (d, ia, ib) to the two bodies: a gets -p, b gets +p.
 inline void apply(State& s, const SolverBodies& sb, const Contact& c, const Vec3& d, const Vec3& ia, const Vec3& ib,
                   double p) {
@@ -45,8 +84,8 @@ inline double rel_velocity(const State& s, const Contact& c, const Vec3& d) {
 }
 
 // The normal impulse of a crushing row given its current normal velocity vn (PHYSICS.md §1.8(c)), the local
-// three-branch update of a Gauss-Seidel sweep. With W = 1/m_eff and v0 = vn - W p the velocity without this row's
-// impulse, the end-of-step velocity is v = v0 + W p and
+// three-branch update of a Gauss-Seidel sweep (velocities counted from the bias, see below). With W = 1/m_eff and
+// v0 = vn - W p the velocity without this row's impulse, the end-of-step velocity is v = v0 + W p and
 //   v0 >= 0                        -> p = 0                  separating: no tension, no spring-back
 //   -v0 <= W dt F_0                -> p = -v0 / W            below the crushing force: rigid (v = 0), no push-out
 //   otherwise                      -> p = dt (F_0 - k v) with k = dt K_t + c_n, i.e.
@@ -56,9 +95,12 @@ inline double rel_velocity(const State& s, const Contact& c, const Vec3& d) {
 // step's expected penetration: the secant K_t is exact up to there, and beyond it the area is unknown, so the force
 // stays at p_c A of a penetration that is certainly reached (A grows with the penetration): never above p_c A.
 // Written without dividing by W, so that two kinematic bodies (W = 0) crush at exactly F_0 + K_t dt (-v0).
+// A pair that backed off from its crushed depth by g (the crushed ice is gone) approaches over g freely: velocities
+// count from the bias -g/dt (v0 - bias is what crushes beyond the crushed depth in this step); without a gap the
+// bias is 0.
 double crushing_impulse(const Contact& c, double vn, double dt) {
   const double W = c.inv_mass_n;
-  const double v0 = vn - W * c.pn;
+  const double v0 = vn - W * c.pn - c.bias;
   if (v0 >= 0) return 0.0;
   if (-v0 <= W * dt * c.crush_force_n) return -v0 / W;
   const double k = dt * c.crush_stiffness_npm + c.crush_damping_nspm;
@@ -73,6 +115,7 @@ void prepare_contacts(const Model& model, const SolverBodies& sb, State& state, 
                       double dt) {
   const SolverOptions& o = model.options.solver;
   const double match_tol2 = 0.1 * 0.1;  // m^2: a cached point further than 10 cm is another point
+  const std::map<std::pair<int, int>, double> pair_stiffness = crushing_law(model.options, contacts);
   for (Contact& c : contacts) {
     // 1. Auxiliary data: lever arms, tangents, I^-1 (r x d) per row and body, effective masses 1/W.
     c.ra = c.point - state.position[c.body_a];
@@ -93,24 +136,17 @@ void prepare_contacts(const Model& model, const SolverBodies& sb, State& state, 
     c.mass_t1 = row(c.t1, c.ia_t1, c.ib_t1);
     c.mass_t2 = row(c.t2, c.ia_t2, c.ib_t2);
     // Bias = smallest allowed normal velocity. Rigid: push out the overlap beyond the slop at ERP per step (capped);
-    // a speculative gap allows approaching by gap/dt. Crushing rows never push out (PHYSICS.md §1.8(c)).
+    // a speculative gap allows approaching by gap/dt. Crushing rows never push out (PHYSICS.md §1.8(c)); a pair
+    // backed off from its crushed depth approaches over the gap freely.
     if (c.type == ContactType::crushing) {
-      c.bias = 0;
-      // Crushing law (PHYSICS.md §1.8(a)): F(A) = p_c(A) A with p_c = sigma_c (A / 1 m^2)^e_x. F_0 at the current
-      // overlap, F_end at the overlap deepened by the step the collision stage measured, and the gradient
-      // K_t = dF/d(delta) as the secant between them (for e_x = 0 and a wedge: exactly 2 sigma_c h tan(phi)).
-      const ContactOptions& co = model.options.contact;
-      const double sigma = model.options.ice.crushing_strength_pa;
-      auto force = [&](double area) {
-        return co.pressure_area_exponent == 0 ? sigma * area
-                                              : sigma * std::pow(area, 1 + co.pressure_area_exponent);
-      };
-      c.crush_force_n = force(c.area_m2);
-      c.crush_force_end_n = std::max(c.crush_force_n, force(c.area_end_m2));
-      c.crush_stiffness_npm = c.area_step_m > 0 ? (c.crush_force_end_n - c.crush_force_n) / c.area_step_m : 0.0;
-      // Optional damping c_n = 2 zeta sqrt(m_eff K_t) (none between two kinematic bodies: m_eff infinite).
-      c.crush_damping_nspm = c.mass_n > 0 ? 2 * co.crushing_damping_ratio * std::sqrt(c.mass_n * c.crush_stiffness_npm)
-                                          : 0.0;
+      c.bias = -c.crush_gap_m / dt;  // free approach back to the crushed depth; never a push-out
+      // Optional damping c_n = 2 zeta sqrt(m K_t) of the body pair (m its translational reduced mass along the
+      // normal, K_t the sum over its rows), shared among the rows by their K_t, so that cutting the contact into
+      // rows does not change it (none between two kinematic bodies: m infinite).
+      const double w_pair = c.normal.dot(im * c.normal), k_pair = pair_stiffness.at({c.body_a, c.body_b});
+      c.crush_damping_nspm = w_pair > 0 && k_pair > 0 ? 2 * model.options.contact.crushing_damping_ratio *
+                                                            std::sqrt(k_pair / w_pair) * c.crush_stiffness_npm / k_pair
+                                                      : 0.0;
       c.max_normal_impulse = dt * c.crush_force_n;  // the cap at the start-of-step penetration (warm start clamp)
     } else if (c.gap > 0) c.bias = -c.gap / dt;
     else c.bias = std::min(o.erp * std::max(0.0, -c.gap - o.slop_m) / dt, o.max_push_mps);
@@ -121,9 +157,14 @@ void prepare_contacts(const Model& model, const SolverBodies& sb, State& state, 
     if (!o.warm_start) continue;
     auto it = std::lower_bound(state.contact_cache.begin(), state.contact_cache.end(), c, key_less);
     const CachedContact* best = nullptr;
-    // A crushing pair has one row (at the patch centroid, which may slide): its cached impulse is the pair's.
-    double bd = c.type == ContactType::crushing ? std::numeric_limits<double>::infinity() : match_tol2;
+    // A crushing row carries a half of the pair's contact surface (its centroid may slide): the cached row of the
+    // same half is its predecessor. Rigid points: the nearest cached point within match_tol.
+    double bd = match_tol2;
     for (; it != state.contact_cache.end() && same_key(*it, c); ++it) {
+      if (c.type == ContactType::crushing) {
+        if (it->type == ContactType::crushing && it->row == c.row) best = &*it;
+        continue;
+      }
       const double d = (it->local_a - c.local_a).squaredNorm();
       if (d < bd) bd = d, best = &*it;
     }
@@ -251,18 +292,18 @@ int subspace_step(const SolverBodies& sb, State& state, std::vector<Contact>& co
     if (c.type == ContactType::rigid) {
       rows.push_back({ci, 0, 0.0, rigid_target(c, dt, use_bias)});
     } else if (c.pn < dt * c.crush_force_n) {
-      rows.push_back({ci, 0, 0.0, 0.0});  // below the crushing force: rigid, no push-out
+      rows.push_back({ci, 0, 0.0, c.bias});  // below the crushing force: rigid (from the bias), no push-out
     } else {
-      // Crushing: the branch crushing_impulse takes at the current velocity.
+      // Crushing: the branch crushing_impulse takes at the current velocity (counted from the bias, as there).
       const double W = c.inv_mass_n;
-      const double v0 = rel_velocity(state, c, c.normal) - W * c.pn;
+      const double v0 = rel_velocity(state, c, c.normal) - W * c.pn - c.bias;
       const double k = dt * c.crush_stiffness_npm + c.crush_damping_nspm, cn = c.crush_damping_nspm;
       const double hardening = dt * (c.crush_force_n - k * v0) / (1 + dt * k * W);
       const double capped = dt * (c.crush_force_end_n - cn * v0) / (1 + dt * cn * W);
       if (hardening <= capped) {
-        if (k > 0) rows.push_back({ci, 0, 1 / (dt * k), c.crush_force_n / k});
+        if (k > 0) rows.push_back({ci, 0, 1 / (dt * k), c.crush_force_n / k + c.bias});
       } else if (cn > 0) {
-        rows.push_back({ci, 0, 1 / (dt * cn), c.crush_force_end_n / cn});
+        rows.push_back({ci, 0, 1 / (dt * cn), c.crush_force_end_n / cn + c.bias});
       }
       // Otherwise the impulse is a constant of the branch (dt F_0 or dt F_end): held.
     }
@@ -418,8 +459,9 @@ SolverReport solve_contacts(const Model& model, const SolverBodies& sb, State& s
 void store_impulses(const Model& model, State& state, const std::vector<Contact>& contacts) {
   state.contact_cache.clear();
   for (const Contact& c : contacts)
-    state.contact_cache.push_back(CachedContact{c.body_a, c.part_a, c.body_b, c.part_b, c.local_a,
-                                                c.pn * c.normal + c.pt1 * c.t1 + c.pt2 * c.t2});
+    state.contact_cache.push_back(CachedContact{c.body_a, c.part_a, c.body_b, c.part_b, c.row, c.local_a,
+                                                c.pn * c.normal + c.pt1 * c.t1 + c.pt2 * c.t2, c.type,
+                                                c.crush_normal_a, c.crush_point_a, c.crush_point_b});
 }
 
 }  // namespace floesim::sim

@@ -2,8 +2,10 @@
 // (PHYSICS.md §1.4-1.6), one normal row and two friction rows per contact, with warm starting. Rigid rows: the ERP
 // push-out bias, normal impulse >= 0. Crushing rows (compliant contacts, §1.8(c)): the three-branch local law
 // (separating -> 0; rigid below the crushing force dt F_0; crushing above it, hardening with K_t implicitly in the
-// end-of-step velocity), zero bias, so crushed overlap is never pushed out and nothing springs back. Friction on
-// the same row for both. Laid out like Chrono's ChSolverPSOR in numbered steps.
+// end-of-step velocity), never a push-out bias, so crushed overlap stays and nothing springs back (a pair backed off
+// from its crushed depth only gets the free approach over the gap); the pressure of the pressure-area law is that of
+// the body pair's whole contact area. Friction on the same row for both. Laid out like Chrono's ChSolverPSOR in
+// numbered steps.
 //
 // Heavy-on-light chains (a 13,000 t hull pushing a 10 t piece against a 7,000 t floe) converge in thousands of
 // Gauss-Seidel sweeps, not tens: the light body passes on a tiny share of the momentum per sweep. So every few
@@ -42,9 +44,10 @@ void prepare_contacts(const Model& model, const SolverBodies& bodies, State& sta
                       double dt);
 
 // 3. Gauss-Seidel sweeps until the largest velocity change of a sweep is below `tolerance` or `iterations` sweeps,
-// with a subspace minimisation every solver.subspace_every sweeps while the tolerance is unmet (solver.method
+// with a subspace minimisation every solver.subspace_every sweeps while unconverged (solver.method
 // "pgs_subspace"). use_bias = false is the relax pass: rigid rows only keep non-penetration (and speculative
-// gaps), no push-out; crushing rows have no bias in either pass (the same local law).
+// gaps), no push-out; crushing rows have the same local law in both passes (their bias is only the free approach to
+// the crushed depth).
 SolverReport solve_contacts(const Model& model, const SolverBodies& bodies, State& state,
                             std::vector<Contact>& contacts, double dt, bool use_bias, int iterations,
                             double tolerance);

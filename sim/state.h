@@ -23,6 +23,7 @@ enum class ContactType : uint8_t { rigid, crushing };
 struct Contact {
   int body_a = -1, body_b = -1;
   int part_a = -1, part_b = -1;
+  int row = 0;                 // crushing pairs: which half of the contact surface this row carries (0, 1)
   Vec3 point = Vec3::Zero();   // world, midway between the surfaces
   Vec3 normal = Vec3::UnitZ(); // world, unit, from a to b
   double gap = 0;              // signed distance along the normal: < 0 overlap, > 0 speculative
@@ -36,13 +37,21 @@ struct Contact {
   double area_end_m2 = 0;      // A(delta + step) >= A
   double area_step_m = 0;      // the step, m
   double area_slope_m = 0;     // (area_end - area) / step, m^2/m
+  // Crushed state of the part pair (collide; kept in the cache): where it crushed last, as the contact point held
+  // as a material point of a and of b and the normal in a's frame, and how far b's point has moved away from a's
+  // along that normal since (>= 0: backed off from the crushed depth). The crushed ice is gone: the row is measured
+  // at the crushed depth and lets the pair approach freely over the gap (bias -gap/dt) before it crushes again.
+  Vec3 crush_normal_a = Vec3::UnitZ();
+  Vec3 crush_point_a = Vec3::Zero(), crush_point_b = Vec3::Zero();
+  double crush_gap_m = 0;
   // Horizontal extent of the contact (collide): the two extreme points of the contact surface (crushing) or the
   // point itself (rigid manifold points) along the horizontal tangent z x normal. The fracture stage takes the
   // contact width of a body pair from the spread of these over the pair's contacts (PHYSICS.md §2.1: the real
   // width from the overlap).
   Vec3 span_lo = Vec3::Zero(), span_hi = Vec3::Zero();
-  // Crushing law (solve): F_0 = p_c(A) A, its secant gradient K_t = dF/d(delta) over the step, the cap
-  // F_end = p_c(A_end) A_end, damping c_n, and W = 1/m_eff of the normal row.
+  // Crushing law (solve): F_0 = p_c(A_pair) A, its secant gradient K_t = dF/d(delta) over the step, the cap
+  // F_end = p_c(A_pair,end) A_end, damping c_n, and W = 1/m_eff of the normal row. A_pair is the contact area of
+  // the whole body pair (all its rows), so the pressure does not depend on how the bodies are cut into parts.
   double crush_force_n = 0, crush_force_end_n = 0, crush_stiffness_npm = 0, crush_damping_nspm = 0, inv_mass_n = 0;
   // Solver data (solve): lever arms, tangents, effective masses, bias and the accumulated impulses.
   Vec3 ra = Vec3::Zero(), rb = Vec3::Zero();
@@ -51,16 +60,21 @@ struct Contact {
   Vec3 ia_t1 = Vec3::Zero(), ib_t1 = Vec3::Zero();
   Vec3 ia_t2 = Vec3::Zero(), ib_t2 = Vec3::Zero();
   double mass_n = 0, mass_t1 = 0, mass_t2 = 0;       // effective masses 1/W of the rows
-  double bias = 0;                                    // smallest allowed normal velocity (m/s)
+  double bias = 0;                                    // smallest allowed normal velocity (m/s); crushing:
+                                                      // -crush_gap_m / dt (free approach to the crushed depth)
   double pn = 0, pt1 = 0, pt2 = 0;                    // accumulated impulses (N s)
   Vec3 local_a = Vec3::Zero();                        // point in a's body frame (warm-start matching)
 };
 
-// The impulses of one contact kept for warm starting the next step, keyed by body/part pair and local point.
+// The impulses of one contact kept for warm starting the next step, keyed by body/part pair and local point (rigid)
+// or row (crushing), and the pair's crushed state (crushing rows; the same in every row of the pair).
 struct CachedContact {
   int body_a, part_a, body_b, part_b;
+  int row;
   Vec3 local_a;
   Vec3 impulse;  // world: pn n + pt1 t1 + pt2 t2
+  ContactType type;
+  Vec3 crush_normal_a, crush_point_a, crush_point_b;
 };
 
 struct State {

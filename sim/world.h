@@ -8,7 +8,8 @@
 //              (PHYSICS.md §1.8(c): rigid below p_c(A) A, crushing above it, never pushed out)
 //   integrate  semi-implicit Euler: x += dt v, q += dt/2 [0, w] q (normalised)
 //   relax      PGS without push-out bias, so that resolving overlap leaves no velocity (crushing rows keep their
-//              law, which has no bias anyway); impulses stored for warm start; the vessel's loads by contact law
+//              law, which never pushes out); impulses and crushed depths stored for the next step; the vessel's
+//              loads by contact law
 //   fracture   the converged contact forces against the closed-form failure loads (PHYSICS.md §2): a floe that
 //              fails leaves the world and its pieces enter it as new bodies (sim/fracture.h)
 //   sleep      islands of floes joined by contacts fall asleep together at rest; health checks (NaN, blow-up)
@@ -71,6 +72,8 @@ class World {
   const std::vector<Contact>& contacts() const { return contacts_; }
   // The propeller jets of the last step's forces stage (from the vessel's pose and thrust at its start).
   const std::vector<PropellerJet>& jets() const { return jets_; }
+  // The external wrench on each awake body this step (forces stage: gravity, water, wind, propulsion), world.
+  const std::vector<Wrench>& external_wrenches() const { return external_; }
   // Every fracture event so far, in time order (children ids are floe ids of bodies in model()).
   const std::vector<FractureEvent>& fracture_events() const { return events_; }
   // When each body left the world (broken up or removed), s; +inf while alive. Indexed like model().bodies.

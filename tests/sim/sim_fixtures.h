@@ -44,6 +44,16 @@ inline HullModel coarse_hull(int sections = 8) {
   return h;
 }
 
+// A vertical wall (box lx x ly x hz, centred on the origin in x and y, z from z0) as a single-part hull.
+inline HullModel box_hull(double lx, double ly, double z0, double hz) {
+  const std::vector<Vec2> rect = {Vec2(-lx / 2, -ly / 2), Vec2(lx / 2, -ly / 2), Vec2(lx / 2, ly / 2),
+                                  Vec2(-lx / 2, ly / 2)};
+  HullModel h;
+  h.parts = {extrude_polygon(rect, z0, hz)};
+  h.surface = h.parts[0];
+  return h;
+}
+
 // A fresh temporary directory for one test.
 inline std::filesystem::path temp_dir(const std::string& name) {
   const auto d = std::filesystem::temp_directory_path() / ("floesim_sim_test_" + name);
