@@ -390,13 +390,13 @@ TEST(SimCrushing, ReloadingStartsAtTheCrushedDepth) {
   EXPECT_LT(work, sigma * volume + bound);
 }
 
-// A flat floe edge (width w, thickness h) pressed 2 cm into the wall, which then stops, and turning about the vertical line through
-// the centre of its face (omega = 0.01 rad/s; the floe ~1e11 kg keeps its motion): the half of the face turning
-// into the wall crushes at sigma_c, the half turning away unloads. The wall resists with the force sigma_c h w / 2
-// and the moment sigma_c h w^2 / 8 about that line (sigma_c h x the first moment of the half face, w^2 / 8). One
-// row at the centroid would see no approach and give neither. Over 0.5 s the face turns 5 mrad: the clipped face
-// changes by ~ theta delta / w ~ 3e-5 of its area, and the face centre drifts by omega^2 (L/2) t^2 / 2 ~ 4e-5 m,
-// hence 1e-3.
+// A flat floe edge (width w, thickness h) pressed 2 cm into the wall, which then stops, and turning about the
+// vertical line through the centre of its face (omega = 0.01 rad/s; the floe ~1e11 kg keeps its motion): the half
+// of the face turning into the wall crushes at sigma_c, the half turning away unloads. The wall resists with the
+// force sigma_c h w / 2 and the moment sigma_c h w^2 / 8 about that line (sigma_c h x the first moment of the half
+// face, w^2 / 8). One row at the centroid would see no approach and give neither. Over 0.5 s the face turns
+// 5 mrad: the clipped face changes by ~ theta delta / w ~ 3e-5 of its area, and the face centre drifts by
+// omega^2 (L/2) t^2 / 2 ~ 4e-5 m, hence 1e-3.
 TEST(SimCrushing, FaceTurningIntoTheWallIsResistedByAMoment) {
   const double h = 1.0, width = 4.0, length = 6.0, delta0 = 0.02, omega = 0.01;
   // The floe starts 1 mm clear; the wall pushes it 2 cm in at 0.1 m/s (21 steps), stops, and the floe turns.
