@@ -279,7 +279,7 @@ struct SolverOptions {
   // subspace_every sweeps while unconverged, for heavy-on-light chains; pgs: sweeps alone (for comparison).
   std::string method = "pgs_subspace";
   int subspace_every = 8;
-  double subspace_above_mps = 1e-3;  // ... and only while a sweep still changes a velocity by more than this
+  double subspace_above_mps = 0.0;  // ... and only while a sweep still changes a velocity by more than this
   int reference_sweeps = 0;        // diagnostic: the relax pass also continued this far, to measure the load error
   bool reverse_order = false;      // sweep the rows last to first (to check that results do not hang on the order)
   template <class V>

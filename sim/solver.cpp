@@ -440,12 +440,11 @@ SolverReport solve_contacts(const Model& model, const SolverBodies& sb, State& s
     rep.iterations = it + 1;
     rep.residual = change;
     if (!(change > tolerance)) break;  // also stops on NaN: the caller's health check reports it
-    // Only while the sweeps still change velocities by more than subspace_above_mps: the signature of a
-    // heavy-on-light chain (1.8 m/s after 8 sweeps in the 13,000 t - 10 t - 7,000 t chain). Below it the sweeps
-    // are slow for another reason (redundant crushing rows between the parts of two floes, branch switching of the
-    // crushing law), which the subspace step does not fix: in the default case it was undone 99 % of the time.
-    // A step that did not help (undone) will not help on the next try either, so the first failure ends the
-    // attempts of this solve.
+    // A step that did not help (undone) will not help on the next try either (the sweeps have not changed which
+    // rows are settled enough for it), so the first failure ends the attempts of this solve: in the default case
+    // most attempts are undone (redundant crushing rows between the parts of two floes, branch switching of the
+    // crushing law), and this keeps their cost at about one factorisation per unconverged solve.
+    // subspace_above_mps (default 0) can restrict the attempts to sweeps that still change velocities a lot.
     if (try_subspace && (it + 1) % o.subspace_every == 0 && it + 1 < iterations && change > o.subspace_above_mps) {
       try_subspace = subspace_step(sb, state, contacts, dt, use_bias) > 0;
       rep.subspace_solves += try_subspace;

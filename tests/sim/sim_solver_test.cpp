@@ -136,7 +136,6 @@ TEST(SolverJam, TenFloesBetweenBowAndWallCarryTheThrust) {
   const HullModel hull = box_hull(100, 25.4, 10);
   for (const char* method : {"pgs", "pgs_subspace"}) {
     o.solver.method = method;
-    if (getenv("SUBABOVE")) o.solver.subspace_above_mps = atof(getenv("SUBABOVE"));
     const Model m = build_model(field, &hull, o);
     ASSERT_EQ(m.floe_count(), 10);
     World w(m);
@@ -144,7 +143,6 @@ TEST(SolverJam, TenFloesBetweenBowAndWallCarryTheThrust) {
     double fx = 0, capped = 0;
     for (int i = 0; i < steps; ++i) {
       w.step();
-      if (getenv("JAMDBG") && i % 20 == 0) std::printf("%s %d fx %.1f vx %.2e x %.5f capped %d sweeps %d sub %d viol %.2g contacts %d\n", method, i, w.report().ice_load.force.x() / 1e3, w.state().velocity[m.vessel].x(), w.state().position[m.vessel].x(), (int)w.report().solve.capped, w.report().solve.iterations, w.report().solve.subspace_solves, w.report().solve.complementarity, w.report().contacts);
       if (i < steps - tail) continue;
       fx += w.report().ice_load.force.x() / tail;
       capped += w.report().solve.capped;
