@@ -284,7 +284,8 @@ struct SubspaceEntry {
 // variant of PHYSICS.md §1.5; how much, below). The new impulses are projected on their bounds and applied; the
 // next sweeps correct rows that changed state. Returns the number of rows solved (0: nothing settled, the factorisation
 // failed, or the step did not lower the violation and was undone).
-int subspace_step(const SolverBodies& sb, State& state, std::vector<Contact>& contacts, double dt, bool use_bias) {
+int subspace_step(const SolverBodies& sb, State& state, std::vector<Contact>& contacts, double dt, bool use_bias,
+                  int max_rows) {
   std::vector<SubspaceRow> rows;
   for (int ci = 0; ci < static_cast<int>(contacts.size()); ++ci) {
     const Contact& c = contacts[ci];
@@ -314,7 +315,7 @@ int subspace_step(const SolverBodies& sb, State& state, std::vector<Contact>& co
     }
   }
   const int m = static_cast<int>(rows.size());
-  if (m == 0) return 0;
+  if (m == 0 || m > max_rows) return 0;
 
   // Jacobian blocks per body (a fixed body has M^-1 = 0 and couples nothing), grouped by body.
   std::vector<SubspaceEntry> entries;
@@ -446,7 +447,7 @@ SolverReport solve_contacts(const Model& model, const SolverBodies& sb, State& s
     // crushing law), and this keeps their cost at about one factorisation per unconverged solve.
     // subspace_above_mps (default 0) can restrict the attempts to sweeps that still change velocities a lot.
     if (try_subspace && (it + 1) % o.subspace_every == 0 && it + 1 < iterations && change > o.subspace_above_mps) {
-      try_subspace = subspace_step(sb, state, contacts, dt, use_bias) > 0;
+      try_subspace = subspace_step(sb, state, contacts, dt, use_bias, o.subspace_max_rows) > 0;
       rep.subspace_solves += try_subspace;
     }
   }

@@ -43,6 +43,7 @@ TEST(SimInput, OptionErrorsNameTheKey) {
   expect_error([] { options_from({{"solver", {{"method", "jacobi"}}}}); }, {"solver.method", "pgs_subspace"});
   expect_error([] { options_from({{"solver", {{"subspace_every", 0}}}}); }, {"solver.subspace_every"});
   expect_error([] { options_from({{"solver", {{"subspace_above_mps", -1}}}}); }, {"solver.subspace_above_mps"});
+  expect_error([] { options_from({{"solver", {{"subspace_max_rows", 0}}}}); }, {"solver.subspace_max_rows"});
   expect_error([] { options_from({{"solver", {{"reference_sweeps", -5}}}}); }, {"solver.reference_sweeps"});
   // The added-mass factors and the propellers (a list: errors name the item).
   expect_error([] { options_from({{"water", {{"floe_added_mass_scale", -1}}}}); }, {"water.floe_added_mass_scale"});
