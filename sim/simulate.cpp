@@ -211,6 +211,8 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
   auto& c_hydro = *col["hydro_load"];
   auto& c_wind = *col["wind_load"];
   auto& c_prop = *col["propulsion_load"];
+  std::vector<std::vector<double>*> c_scalar;  // kScalarSeries' columns, looked up once
+  for (const ScalarSeries& f : kScalarSeries) c_scalar.push_back(col.at(f.name));
   const size_t nb = model.bodies.size();  // at the start; the world's table grows as ice breaks
   const size_t frames = static_cast<size_t>(steps / every);
   r.frame_offset.push_back(0);
@@ -242,7 +244,7 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
     push_body_wrench(c_hydro, R, rep.hydro_load);
     push_body_wrench(c_wind, R, rep.wind_load);
     push_body_wrench(c_prop, R, rep.propulsion_load);
-    for (const ScalarSeries& f : kScalarSeries) col[f.name]->push_back(f.get(rep));
+    for (size_t i = 0; i < c_scalar.size(); ++i) c_scalar[i]->push_back(kScalarSeries[i].get(rep));
     awake_sum += rep.awake_floes;
     contact_sum += rep.contacts;
     iter_sum += rep.solve.iterations;

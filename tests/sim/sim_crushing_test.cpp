@@ -266,6 +266,20 @@ TEST(SimCrushing, WedgeCornerForceGrowsWithPenetration) {
   }
 }
 
+// Steps a wall rig 50 steps; returns the largest |F_x / theory - 1| of the floe's contact force over the steps with
+// contacts, and how many there were.
+double worst_surge_force_error(World& w, double theory, int& steps) {
+  double worst = 0;
+  steps = 0;
+  for (int i = 0; i < 50; ++i) {
+    w.step();
+    if (w.contacts().empty()) continue;
+    ++steps;
+    worst = std::max(worst, std::abs(contact_force_on(w, 1).x() / theory - 1));
+  }
+  return worst;
+}
+
 // A flat floe edge (width w) driven into the wall: F = sigma_c h w from the first contact on, constant; with the
 // pressure-area law p_c = sigma_c (A / 1 m^2)^e_x, F = sigma_c (h w)^(1 + e_x).
 TEST(SimCrushing, FlatEdgeCrushesAtSigmaTimesArea) {
@@ -276,14 +290,8 @@ TEST(SimCrushing, FlatEdgeCrushesAtSigmaTimesArea) {
     World w(rig.model);
     const double sigma = rig.model.options.ice.crushing_strength_pa;
     const double theory = sigma * std::pow(h * width, 1 + ex);
-    double worst = 0;
     int steps = 0;
-    for (int i = 0; i < 50; ++i) {
-      w.step();
-      if (w.contacts().empty()) continue;
-      ++steps;
-      worst = std::max(worst, std::abs(contact_force_on(w, 1).x() / theory - 1));
-    }
+    const double worst = worst_surge_force_error(w, theory, steps);
     std::printf("[measured] flat edge, e_x = %.1f: %d crushing steps, largest |F / (sigma_c (h w)^(1 + e_x)) - 1| = "
                 "%.2e\n",
                 ex, steps, worst);
@@ -449,14 +457,8 @@ TEST(SimCrushing, PressureAreaLawActsOnTheWholeContactOfABodyPair) {
     WallRig rig = parts == 1 ? wall_rig(f, 1e7, v, ex) : wall_rig(f, 1e7, v, ex, 0.0, &cut);
     ASSERT_EQ(rig.model.options.ice.crushing_strength_pa, 2e6);
     World w(rig.model);
-    double worst = 0;
     int steps = 0;
-    for (int i = 0; i < 50; ++i) {
-      w.step();
-      if (w.contacts().empty()) continue;
-      ++steps;
-      worst = std::max(worst, std::abs(contact_force_on(w, 1).x() / theory - 1));
-    }
+    const double worst = worst_surge_force_error(w, theory, steps);
     std::printf("[measured] flat edge on a wall of %d part(s), e_x = -0.5: %d crushing steps, largest "
                 "|F / (sigma_c (h w)^0.5) - 1| = %.2e\n",
                 parts, steps, worst);

@@ -97,20 +97,6 @@ TEST_P(SolverChain, HeavyOnLightChainGetsTheInelasticImpulse) {
 
 INSTANTIATE_TEST_SUITE_P(Laws, SolverChain, ::testing::Values(ContactType::rigid, ContactType::crushing));
 
-// A closed box as the vessel's one convex part: a vertical flat bow, so the jam is planar.
-HullModel box_hull(double length, double beam, double depth) {
-  HullModel h;
-  TriMesh m;
-  const double x = length / 2, y = beam / 2, z = depth / 2;
-  m.vertices = {Vec3(-x, -y, -z), Vec3(x, -y, -z), Vec3(x, y, -z), Vec3(-x, y, -z),
-                Vec3(-x, -y, z),  Vec3(x, -y, z),  Vec3(x, y, z),  Vec3(-x, y, z)};
-  m.triangles = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
-                 {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
-  h.parts = {m};
-  h.surface = m;
-  return h;
-}
-
 // Ten 5 m x 10 m x 1 m floes (45 t) afloat in a row between the flat bow of a 13,000 t box (100 x 25.4 m, draught
 // 5 m) and a fixed wall; the vessel pushed by a constant thrust F well below the crushing force (sigma_c x 10 m^2 =
 // 20 MN) and well below what the jam carries without buckling (F h = 0.2 MN m against each floe's pitch restoring
@@ -133,7 +119,8 @@ TEST(SolverJam, TenFloesBetweenBowAndWallCarryTheThrust) {
   o.vessel.propulsion.thrust_n = F;
   o.domain.walls = {"east"};
   o.domain.extent_m = {-100, -50, 100.011, 50};
-  const HullModel hull = box_hull(100, 25.4, 10);
+  // A flat vertical bow: the jam stays planar (draught 5 m).
+  const HullModel hull = testing::box_hull(100, 25.4, -5, 10);
   for (const char* method : {"pgs", "pgs_subspace"}) {
     o.solver.method = method;
     const Model m = build_model(field, &hull, o);
