@@ -772,4 +772,17 @@ Polygon circular_sector(const Vec2& apex, const Vec2& axis, double half_angle_ra
   return s;
 }
 
+Polygon equal_area_wedge(const Vec2& apex, const Vec2& axis, double half_angle_rad, double radius_m) {
+  FLOESIM_REQUIRE(apex.allFinite() && axis.allFinite() && axis.norm() > 0,
+                  "equal_area_wedge: needs a finite apex and a non-zero axis");
+  FLOESIM_REQUIRE(half_angle_rad > 0 && half_angle_rad <= 1.57079632679489661923,
+                  "equal_area_wedge: half-angle must be in (0, pi/2], got ", half_angle_rad);
+  FLOESIM_REQUIRE(radius_m > 0 && std::isfinite(radius_m), "equal_area_wedge: radius must be > 0, got ", radius_m);
+  const Vec2 x = axis.normalized(), y(-x.y(), x.x());
+  // Two triangles (apex, side end, tip) of area r r' sin(half) / 2 each: equal to the sector's r^2 half.
+  const double side = radius_m * half_angle_rad / std::sin(half_angle_rad);
+  const double c = std::cos(half_angle_rad), s = std::sin(half_angle_rad);
+  return {apex, apex + side * (c * x - s * y), apex + radius_m * x, apex + side * (c * x + s * y)};
+}
+
 }  // namespace floesim

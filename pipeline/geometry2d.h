@@ -58,5 +58,11 @@ double chord_length(const Polygon& p, const Vec2& point, const Vec2& dir);
 // radius, and the arc as `segments` chords (vertices: the apex, then the arc from -half_angle to +half_angle). The
 // arc's vertices lie on the circle, so the polygon is inside the true sector.
 Polygon circular_sector(const Vec2& apex, const Vec2& axis, double half_angle_rad, double radius_m, int segments);
+// The circular sector's stand-in with the fewest vertices: a convex kite (apex, right end, tip, left end) whose tip
+// lies on the axis at `radius_m` and whose two sides of half-angle `half_angle_rad` (0, pi/2] are long enough,
+// r' = r half / sin(half), that its area is the sector's, r^2 half. A fracture's wedge cut as this kite reaches
+// as far and weighs as much as the sector; the floe it leaves has a notch of 3 reflex corners instead of an arc's
+// many, hence few convex parts (sim/fracture.cpp).
+Polygon equal_area_wedge(const Vec2& apex, const Vec2& axis, double half_angle_rad, double radius_m);
 
 }  // namespace floesim

@@ -444,5 +444,28 @@ TEST(CircularSector, ShapeAndArea) {
   EXPECT_THROW(circular_sector(apex, Vec2(1, 0), half, r, 0), Error);
 }
 
+TEST(EqualAreaWedge, ReachAreaAndShape) {
+  // For each half-angle: the tip on the axis at r, the area of the circular sector r^2 half (the closed form, not
+  // the polygon's own formula: against the 4096-chord sector's area), convex, CCW, symmetric about the axis.
+  const Vec2 apex(3, -2), axis(0, 2);  // axis +y, not unit
+  const double r = 5;
+  for (double half : {0.2, kPi / 8, kPi / 6, kPi / 4, 1.4, kPi / 2}) {
+    const Polygon k = equal_area_wedge(apex, axis, half, r);
+    ASSERT_EQ(k.size(), 4u);
+    EXPECT_EQ(k[0], apex);
+    EXPECT_NEAR(k[2].x() - apex.x(), 0.0, 1e-14);
+    EXPECT_NEAR(k[2].y() - apex.y(), r, 1e-14);
+    EXPECT_NEAR(signed_area(k), r * r * half, 1e-12 * r * r);
+    EXPECT_NEAR(signed_area(k), signed_area(circular_sector(apex, axis, half, r, 4096)), 1e-6 * r * r);
+    EXPECT_TRUE(is_convex(k, 1e-9)) << half;
+    EXPECT_NEAR(k[1].x() - apex.x(), -(k[3].x() - apex.x()), 1e-14);
+    EXPECT_NEAR(k[1].y(), k[3].y(), 1e-14);
+  }
+  EXPECT_THROW(equal_area_wedge(apex, axis, 0, r), Error);
+  EXPECT_THROW(equal_area_wedge(apex, axis, 1.6, r), Error);
+  EXPECT_THROW(equal_area_wedge(apex, Vec2(0, 0), 0.5, r), Error);
+  EXPECT_THROW(equal_area_wedge(apex, axis, 0.5, 0), Error);
+}
+
 }  // namespace
 }  // namespace floesim
