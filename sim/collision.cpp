@@ -94,7 +94,22 @@ void clip_faces(const ConvexPart& P, const PartWorld& pw, const Vec3& tp, const 
                 SideSums& out) {
   const size_t nq = Q.faces.size();
   const Vec3 shift_p = tp - origin, shift_q = tq - origin;
+  // Q's box, widened: a face of P entirely outside it is entirely outside Q and clips to nothing, so it is skipped
+  // before the clipping (most faces of two floes touching at a corner). The margin keeps every face the tolerance
+  // of the half-spaces could let in (1e-9 m, more at a sharp corner of Q: up to 1e-9 / sin(half its angle)).
+  constexpr double kBoxMargin = 1e-6;
+  const Vec3 qlo = qw.lo + shift_q - Vec3::Constant(kBoxMargin), qhi = qw.hi + shift_q + Vec3::Constant(kBoxMargin);
   for (size_t f = 0; f < P.faces.size(); ++f) {
+    {
+      Vec3 flo = Vec3::Constant(1e300), fhi = Vec3::Constant(-1e300);
+      for (int i : P.faces[f]) {
+        flo = flo.cwiseMin(pw.v[i]);
+        fhi = fhi.cwiseMax(pw.v[i]);
+      }
+      flo += shift_p;
+      fhi += shift_p;
+      if ((flo.array() > qhi.array()).any() || (fhi.array() < qlo.array()).any()) continue;
+    }
     if (second_side) {
       const double df = pw.d[f] + pw.n[f].dot(shift_p);
       bool coplanar = false;
@@ -194,29 +209,35 @@ void row_sums(const SurfacePolygons& s, const Vec3& c, const Vec3& u, const doub
   }
 }
 
-// Scratch buffers of the patch computation.
+// Scratch buffers of the patch computation, and the two sides of the last overlap clipped (with `surface`).
 struct PatchScratch {
   std::vector<Vec3> poly, tmp, half;
   SurfacePolygons surface;
+  SideSums sa, sb;
 };
 
 // step_of(point, normal) gives the penetration step of the area's secant (see ContactPatch::area_step_m). b is
 // measured translated by shift_b (a crushed pair: moved back to its crushed depth). probe: only whether the parts
-// overlap, the area, normal and point (no span, rows or secant).
+// overlap, the area, normal and point (no span, rows or secant). reuse_sides: the same parts at the same shift as
+// the last call (a probe): its clipped sides, still in `ps`, are taken as they are.
 template <class StepFn>
 ContactPatch overlap_patch(const ConvexPart& A, const PartWorld& wa, const ConvexPart& B, const PartWorld& wb,
                            const Vec3& shift_b, PatchSide side, StepFn step_of, PatchScratch& ps,
-                           bool probe = false) {
+                           bool probe = false, bool reuse_sides = false) {
   ContactPatch r;
   // Local origin: the centre of the intersection of the two boxes.
   const Vec3 origin = 0.5 * (wa.lo.cwiseMax(wb.lo + shift_b) + wa.hi.cwiseMin(wb.hi + shift_b));
   const Vec3 zero = Vec3::Zero();
-  SideSums sa, sb;
-  ps.surface.clear();
-  sa.surface = sb.surface = &ps.surface;
-  sb.side = 1;
-  clip_faces(A, wa, zero, B, wb, shift_b, origin, false, ps.poly, ps.tmp, sa);
-  clip_faces(B, wb, shift_b, A, wa, zero, origin, true, ps.poly, ps.tmp, sb);
+  if (!reuse_sides) {
+    ps.surface.clear();
+    ps.sa = ps.sb = SideSums{};
+    ps.sa.surface = ps.sb.surface = &ps.surface;
+    ps.sb.side = 1;
+    clip_faces(A, wa, zero, B, wb, shift_b, origin, false, ps.poly, ps.tmp, ps.sa);
+    clip_faces(B, wb, shift_b, A, wa, zero, origin, true, ps.poly, ps.tmp, ps.sb);
+  }
+  const SideSums& sa = ps.sa;
+  const SideSums& sb = ps.sb;
   // The boundary of the overlap is closed, so sa.vec_area = -sb.vec_area up to the internal faces left out: the
   // vector area of one side is the overlap projected on the plane normal to it, which is the nominal contact area
   // (a wedge of half-angle phi pushed delta into a wall: 2 h delta tan(phi); a flat edge: h w).
@@ -405,9 +426,9 @@ struct CollisionWorld::Impl {
     };
     const Quat& qa = s.orientation[pc.body_a];
     const PatchSide side = structure ? PatchSide::a_is_structure : PatchSide::symmetric;
-    auto patch_at = [&](const Vec3& shift_b, bool probe) {
+    auto patch_at = [&](const Vec3& shift_b, bool probe, bool reuse_sides = false) {
       return overlap_patch(model.parts[pc.part_a], world[pc.part_a], model.parts[pc.part_b], world[pc.part_b],
-                           shift_b, side, step_of, sc.patch, probe);
+                           shift_b, side, step_of, sc.patch, probe, reuse_sides);
     };
     const CachedContact* mem = crushed_state(pc);
     // The overlap as it is: no overlap, no contact (and the crushed state is forgotten).
@@ -424,8 +445,10 @@ struct CollisionWorld::Impl {
       n = qa * mem->crush_normal_a;
       gap = std::max(0.0, n.dot((xb + qb * mem->crush_point_b) - (xa + qa * mem->crush_point_a)));
     }
-    // With a gap: the crushed face (b moved back to the crushed depth); else the overlap as it is, in full.
-    if (gap > 0 || mem) patch = patch_at(-gap * n, false);
+    // With a gap: the crushed face (b moved back to the crushed depth); else the overlap as it is, in full (the
+    // probe's clipped sides are that overlap's).
+    if (gap > 0) patch = patch_at(-gap * n, false);
+    else if (mem) patch = patch_at(Vec3::Zero(), false, true);
     if (!patch.valid || patch.row_count == 0) return false;
     // At or beyond the crushed depth: the current contact point and normal are the new crushed state.
     const Vec3 normal_a = gap > 0 ? mem->crush_normal_a : Vec3(qa.conjugate() * patch.normal);

@@ -67,21 +67,30 @@ std::map<std::pair<int, int>, double> crushing_law(const SimulateOptions& o, std
   return stiffness;
 }
 
-// Applies an impulse p along the row (d, ia, ib) to the two bodies: a gets -p, b gets +p.
+// Applies an impulse p along the row (d, ia, ib) to the two bodies: a gets -p, b gets +p. A fixed body (a wall)
+// is not written: islands solved in parallel may share it.
 inline void apply(State& s, const SolverBodies& sb, const Contact& c, const Vec3& d, const Vec3& ia, const Vec3& ib,
                   double p) {
-  s.velocity[c.body_a] -= p * (sb.inv_mass[c.body_a] * d);
-  s.angular_velocity[c.body_a] -= p * ia;
-  s.velocity[c.body_b] += p * (sb.inv_mass[c.body_b] * d);
-  s.angular_velocity[c.body_b] += p * ib;
+  if (!c.fixed_a) {
+    s.velocity[c.body_a] -= p * (sb.inv_mass[c.body_a] * d);
+    s.angular_velocity[c.body_a] -= p * ia;
+  }
+  if (!c.fixed_b) {
+    s.velocity[c.body_b] += p * (sb.inv_mass[c.body_b] * d);
+    s.angular_velocity[c.body_b] += p * ib;
+  }
 }
 
-// Relative velocity of b with respect to a at the contact, along d.
-inline double rel_velocity(const State& s, const Contact& c, const Vec3& d) {
+// A body the contact impulses cannot move (zero inverse mass and inertia: a domain wall).
+bool is_fixed(const SolverBodies& sb, int b) { return sb.inv_mass[b].isZero(0) && sb.inv_inertia_world[b].isZero(0); }
+
+// Relative velocity of b with respect to a at the contact, and its component along d.
+inline Vec3 rel_velocity(const State& s, const Contact& c) {
   const Vec3 va = s.velocity[c.body_a] + s.angular_velocity[c.body_a].cross(c.ra);
   const Vec3 vb = s.velocity[c.body_b] + s.angular_velocity[c.body_b].cross(c.rb);
-  return d.dot(vb - va);
+  return vb - va;
 }
+inline double rel_velocity(const State& s, const Contact& c, const Vec3& d) { return d.dot(rel_velocity(s, c)); }
 
 // The normal impulse of a crushing row given its current normal velocity vn (PHYSICS.md §1.8(c)), the local
 // three-branch update of a Gauss-Seidel sweep (velocities counted from the bias, see below). With W = 1/m_eff and
@@ -120,6 +129,8 @@ void prepare_contacts(const Model& model, const SolverBodies& sb, State& state, 
     // 1. Auxiliary data: lever arms, tangents, I^-1 (r x d) per row and body, effective masses 1/W.
     c.ra = c.point - state.position[c.body_a];
     c.rb = c.point - state.position[c.body_b];
+    c.fixed_a = is_fixed(sb, c.body_a);
+    c.fixed_b = is_fixed(sb, c.body_b);
     tangents(c.normal, c.t1, c.t2);
     const Mat3& Ia = sb.inv_inertia_world[c.body_a];
     const Mat3& Ib = sb.inv_inertia_world[c.body_b];
@@ -212,6 +223,14 @@ inline void friction_update(const Contact& c, double v1, double v2, double& p1, 
   }
 }
 
+// The contacts of one island (joined by bodies that move), by index into the step's contact list, in its order.
+struct Island {
+  std::vector<Contact>* contacts;
+  const int* index;
+  int n;
+  Contact& operator[](int i) const { return (*contacts)[index[i]]; }
+};
+
 // One Gauss-Seidel update of a contact (normal row, then the two friction rows on the new normal impulse).
 // Returns the largest row velocity change it made (m/s).
 double sweep_contact(State& state, const SolverBodies& sb, Contact& c, double dt, bool use_bias) {
@@ -224,7 +243,8 @@ double sweep_contact(State& state, const SolverBodies& sb, Contact& c, double dt
     change = std::abs(dpn) * c.inv_mass_n;
   }
   double p1, p2;
-  friction_update(c, rel_velocity(state, c, c.t1), rel_velocity(state, c, c.t2), p1, p2);
+  const Vec3 dv = rel_velocity(state, c);  // once for both friction rows
+  friction_update(c, c.t1.dot(dv), c.t2.dot(dv), p1, p2);
   const double d1 = p1 - c.pt1, d2 = p2 - c.pt2;
   if (d1 != 0) {
     apply(state, sb, c, c.t1, c.ia_t1, c.ib_t1, d1);
@@ -242,10 +262,10 @@ double sweep_contact(State& state, const SolverBodies& sb, Contact& c, double dt
 // How far one exact local update would move each row's velocity (m/s), nothing applied: the violation of the
 // contact law (complementarity, crushing law, Coulomb disk) at the current impulses. Returns the largest over all
 // rows; `sum_sq` gets the sum of squares (the merit the subspace step must lower).
-double law_violation(const State& state, const std::vector<Contact>& contacts, double dt, bool use_bias,
-                     double* sum_sq = nullptr) {
+double law_violation(const State& state, const Island& island, double dt, bool use_bias, double* sum_sq = nullptr) {
   double worst = 0, sq = 0;
-  for (const Contact& c : contacts) {
+  for (int i = 0; i < island.n; ++i) {
+    const Contact& c = island[i];
     const double pn = normal_update(c, rel_velocity(state, c, c.normal), dt, use_bias);
     double p1, p2;
     friction_update(c, rel_velocity(state, c, c.t1), rel_velocity(state, c, c.t2), p1, p2);
@@ -284,10 +304,12 @@ struct SubspaceEntry {
 // variant of PHYSICS.md §1.5; how much, below). The new impulses are projected on their bounds and applied; the
 // next sweeps correct rows that changed state. Returns the number of rows solved (0: nothing settled, the factorisation
 // failed, or the step did not lower the violation and was undone).
-int subspace_step(const SolverBodies& sb, State& state, std::vector<Contact>& contacts, double dt, bool use_bias,
+int subspace_step(const SolverBodies& sb, State& state, const Island& island, double dt, bool use_bias,
                   int max_rows) {
+  std::vector<Contact>& contacts = *island.contacts;
   std::vector<SubspaceRow> rows;
-  for (int ci = 0; ci < static_cast<int>(contacts.size()); ++ci) {
+  for (int i = 0; i < island.n; ++i) {
+    const int ci = island.index[i];
     const Contact& c = contacts[ci];
     if (c.mass_n <= 0 || c.pn <= 0) continue;  // between two fixed bodies, or not pressing: held (at zero)
     if (c.type == ContactType::rigid) {
@@ -320,16 +342,15 @@ int subspace_step(const SolverBodies& sb, State& state, std::vector<Contact>& co
   // Jacobian blocks per body (a fixed body has M^-1 = 0 and couples nothing), grouped by body.
   std::vector<SubspaceEntry> entries;
   entries.reserve(2 * rows.size());
-  auto fixed = [&](int b) { return sb.inv_mass[b].isZero(0) && sb.inv_inertia_world[b].isZero(0); };
   for (int r = 0; r < m; ++r) {
     const Contact& c = contacts[rows[r].contact];
     const int k = rows[r].k;
     const Vec3& d = k == 0 ? c.normal : k == 1 ? c.t1 : c.t2;
     const Vec3& ia = k == 0 ? c.ia_n : k == 1 ? c.ia_t1 : c.ia_t2;
     const Vec3& ib = k == 0 ? c.ib_n : k == 1 ? c.ib_t1 : c.ib_t2;
-    if (!fixed(c.body_a))
+    if (!c.fixed_a)
       entries.push_back({c.body_a, r, -d, -c.ra.cross(d), -(sb.inv_mass[c.body_a] * d), -ia});
-    if (!fixed(c.body_b))
+    if (!c.fixed_b)
       entries.push_back({c.body_b, r, d, c.rb.cross(d), sb.inv_mass[c.body_b] * d, ib});
   }
   std::sort(entries.begin(), entries.end(), [](const SubspaceEntry& x, const SubspaceEntry& y) {
@@ -368,11 +389,11 @@ int subspace_step(const SolverBodies& sb, State& state, std::vector<Contact>& co
   // exact to 1e-6, mu = 1e-3 damps near-dependent directions. If none helps, the step is undone exactly and the
   // sweeps go on.
   double before = 0, after = 0;
-  law_violation(state, contacts, dt, use_bias, &before);
-  std::vector<Vec3> old(contacts.size());  // (pn, pt1, pt2) of each contact the step touches
-  for (const SubspaceRow& row : rows) {
-    const Contact& c = contacts[row.contact];
-    old[row.contact] = Vec3(c.pn, c.pt1, c.pt2);
+  law_violation(state, island, dt, use_bias, &before);
+  std::vector<Vec3> old(m);  // (pn, pt1, pt2) of each row's contact before the step
+  for (int r = 0; r < m; ++r) {
+    const Contact& c = contacts[rows[r].contact];
+    old[r] = Vec3(c.pn, c.pt1, c.pt2);
   }
   auto set_impulses = [&](Contact& c, double pn, double p1, double p2) {
     apply(state, sb, c, c.normal, c.ia_n, c.ib_n, pn - c.pn);
@@ -385,7 +406,7 @@ int subspace_step(const SolverBodies& sb, State& state, std::vector<Contact>& co
   auto undo = [&] {
     for (int r = m - 1; r >= 0; --r) {  // each contact once: the rows of a contact are adjacent
       if (r + 1 < m && rows[r + 1].contact == rows[r].contact) continue;
-      const Vec3& p = old[rows[r].contact];
+      const Vec3& p = old[r];
       set_impulses(contacts[rows[r].contact], p.x(), p.y(), p.z());
     }
   };
@@ -401,7 +422,7 @@ int subspace_step(const SolverBodies& sb, State& state, std::vector<Contact>& co
     // New impulses, projected (normal >= 0, friction in the disk of the new normal impulse), applied per contact.
     for (int r = 0; r < m;) {
       Contact& c = contacts[rows[r].contact];
-      Vec3 p = old[rows[r].contact];
+      Vec3 p = old[r];
       for (const int ci = rows[r].contact; r < m && rows[r].contact == ci; ++r) p[rows[r].k] += dp[r];
       // Rigid rows keep their bound; a crushing row's bound is its law, which the next sweep applies.
       const double pn = c.type == ContactType::rigid ? std::clamp(p.x(), 0.0, c.max_normal_impulse)
@@ -410,7 +431,7 @@ int subspace_step(const SolverBodies& sb, State& state, std::vector<Contact>& co
       const double s = pt > lim ? (pt > 0 ? lim / pt : 0.0) : 1.0;
       set_impulses(c, pn, s * p.y(), s * p.z());
     }
-    law_violation(state, contacts, dt, use_bias, &after);
+    law_violation(state, island, dt, use_bias, &after);
     if (after < before) {
       applied_mu = mu;
       break;
@@ -422,21 +443,22 @@ int subspace_step(const SolverBodies& sb, State& state, std::vector<Contact>& co
 
 }  // namespace
 
-SolverReport solve_contacts(const Model& model, const SolverBodies& sb, State& state, std::vector<Contact>& contacts,
-                            double dt, bool use_bias, int iterations, double tolerance) {
+namespace {
+
+// 3. The sweeps of one island until its largest velocity change is below the tolerance or the sweep cap.
+SolverReport solve_island(const SolverOptions& o, const SolverBodies& sb, State& state, const Island& island,
+                          double dt, bool use_bias, int iterations, double tolerance) {
   SolverReport rep;
-  if (contacts.empty()) return rep;
-  const SolverOptions& o = model.options.solver;
-  const int n = static_cast<int>(contacts.size());
-  // 3. Sweeps: each contact's normal row, then its two friction rows on the new normal impulse; every
-  // subspace_every unconverged sweeps, the subspace minimisation.
+  const int n = island.n;
+  // Each contact's normal row, then its two friction rows on the new normal impulse; every subspace_every
+  // unconverged sweeps, the subspace minimisation.
   bool try_subspace = o.method == "pgs_subspace";
   for (int it = 0; it < iterations; ++it) {
     double change = 0;
     if (o.reverse_order)
-      for (int i = n - 1; i >= 0; --i) change = std::max(change, sweep_contact(state, sb, contacts[i], dt, use_bias));
+      for (int i = n - 1; i >= 0; --i) change = std::max(change, sweep_contact(state, sb, island[i], dt, use_bias));
     else
-      for (int i = 0; i < n; ++i) change = std::max(change, sweep_contact(state, sb, contacts[i], dt, use_bias));
+      for (int i = 0; i < n; ++i) change = std::max(change, sweep_contact(state, sb, island[i], dt, use_bias));
     // 4. Residual and iteration count.
     rep.iterations = it + 1;
     rep.residual = change;
@@ -447,12 +469,104 @@ SolverReport solve_contacts(const Model& model, const SolverBodies& sb, State& s
     // crushing law), and this keeps their cost at about one factorisation per unconverged solve.
     // subspace_above_mps (default 0) can restrict the attempts to sweeps that still change velocities a lot.
     if (try_subspace && (it + 1) % o.subspace_every == 0 && it + 1 < iterations && change > o.subspace_above_mps) {
-      try_subspace = subspace_step(sb, state, contacts, dt, use_bias, o.subspace_max_rows) > 0;
+      try_subspace = subspace_step(sb, state, island, dt, use_bias, o.subspace_max_rows) > 0;
       rep.subspace_solves += try_subspace;
     }
   }
   rep.capped = rep.residual > tolerance;
-  rep.complementarity = law_violation(state, contacts, dt, use_bias);
+  rep.complementarity = law_violation(state, island, dt, use_bias);
+  return rep;
+}
+
+// The contacts grouped into islands: contacts that share a body the impulses move (directly or through other
+// contacts) are in one island; a fixed body (a wall) joins nothing. Islands are ordered by their first contact and
+// keep the contacts' order, so one island holding every contact is solved exactly as the whole list was.
+struct Islands {
+  std::vector<int> index;  // contact indices, island after island
+  std::vector<int> begin;  // island k: index[begin[k] .. begin[k + 1])
+};
+Islands contact_islands(const std::vector<Contact>& contacts, size_t bodies) {
+  std::vector<int> parent(bodies);
+  for (size_t b = 0; b < bodies; ++b) parent[b] = static_cast<int>(b);
+  auto find = [&](int b) {
+    while (parent[b] != b) b = parent[b] = parent[parent[b]];
+    return b;
+  };
+  for (const Contact& c : contacts)
+    if (!c.fixed_a && !c.fixed_b) {
+      const int ra = find(c.body_a), rb = find(c.body_b);
+      if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+    }
+  // Island of each contact by first appearance (a contact between two fixed bodies is an island of its own).
+  const int n = static_cast<int>(contacts.size());
+  std::vector<int> island_of_root(bodies, -1), island(n);
+  int count = 0;
+  for (int i = 0; i < n; ++i) {
+    const Contact& c = contacts[i];
+    if (c.fixed_a && c.fixed_b) {
+      island[i] = count++;
+      continue;
+    }
+    int& id = island_of_root[find(c.fixed_a ? c.body_b : c.body_a)];
+    if (id < 0) id = count++;
+    island[i] = id;
+  }
+  Islands is;
+  is.begin.assign(count + 1, 0);
+  for (int i = 0; i < n; ++i) ++is.begin[island[i] + 1];
+  for (int k = 0; k < count; ++k) is.begin[k + 1] += is.begin[k];
+  is.index.resize(n);
+  std::vector<int> fill(is.begin.begin(), is.begin.end() - 1);
+  for (int i = 0; i < n; ++i) is.index[fill[island[i]]++] = i;
+  return is;
+}
+
+}  // namespace
+
+SolverReport solve_contacts(const Model& model, const SolverBodies& sb, State& state, std::vector<Contact>& contacts,
+                            double dt, bool use_bias, int iterations, double tolerance, ThreadPool* pool) {
+  SolverReport rep;
+  if (contacts.empty()) return rep;
+  const SolverOptions& o = model.options.solver;
+  // Islands are independent problems: each sweeps until it has converged (a pair of floes touching far from the
+  // bow stops after a few sweeps while the bow's rubble takes the cap), and they run on the pool's threads. An
+  // island's result depends only on its own contacts, so it does not depend on the thread count or the schedule.
+  const Islands is = contact_islands(contacts, sb.inv_mass.size());
+  const int count = static_cast<int>(is.begin.size()) - 1;
+  std::vector<SolverReport> reports(count);
+  auto solve = [&](int k) {
+    const Island island{&contacts, is.index.data() + is.begin[k], is.begin[k + 1] - is.begin[k]};
+    reports[k] = solve_island(o, sb, state, island, dt, use_bias, iterations, tolerance);
+  };
+  const int threads = pool ? pool->threads() : 1;
+  if (threads > 1 && count > 1 && contacts.size() >= 64) {
+    // Largest islands first, each to the least loaded thread (by contacts).
+    std::vector<int> order(count);
+    for (int k = 0; k < count; ++k) order[k] = k;
+    auto size = [&](int k) { return is.begin[k + 1] - is.begin[k]; };
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return size(a) > size(b); });
+    std::vector<std::vector<int>> work(threads);
+    std::vector<long> load(threads, 0);
+    for (int k : order) {
+      const int w = static_cast<int>(std::min_element(load.begin(), load.end()) - load.begin());
+      work[w].push_back(k);
+      load[w] += size(k);
+    }
+    pool->parallel_for(threads, [&](int begin, int end, int) {
+      for (int w = begin; w < end; ++w)
+        for (int k : work[w]) solve(k);
+    }, 1);
+  } else {
+    for (int k = 0; k < count; ++k) solve(k);
+  }
+  // The step's report: the worst island (sweeps, residual, violation), the subspace solves of all.
+  for (const SolverReport& r : reports) {
+    rep.iterations = std::max(rep.iterations, r.iterations);
+    rep.subspace_solves += r.subspace_solves;
+    rep.capped = rep.capped || r.capped;
+    rep.residual = std::max(rep.residual, r.residual);
+    rep.complementarity = std::max(rep.complementarity, r.complementarity);
+  }
   return rep;
 }
 

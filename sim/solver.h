@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "sim/model.h"
+#include "sim/parallel.h"
 #include "sim/state.h"
 
 namespace floesim::sim {
@@ -48,9 +49,11 @@ void prepare_contacts(const Model& model, const SolverBodies& bodies, State& sta
 // "pgs_subspace"). use_bias = false is the relax pass: rigid rows only keep non-penetration (and speculative
 // gaps), no push-out; crushing rows have the same local law in both passes (their bias is only the free approach to
 // the crushed depth).
+// The contacts are solved as islands (joined by bodies that move), each to its own convergence, on the pool's
+// threads if one is given; the report is that of the worst island (sweeps, residual, violation).
 SolverReport solve_contacts(const Model& model, const SolverBodies& bodies, State& state,
                             std::vector<Contact>& contacts, double dt, bool use_bias, int iterations,
-                            double tolerance);
+                            double tolerance, ThreadPool* pool = nullptr);
 
 // 4. Keeps the impulses for the next step's warm start (sorted, as the contacts are).
 void store_impulses(const Model& model, State& state, const std::vector<Contact>& contacts);

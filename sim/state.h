@@ -64,6 +64,7 @@ struct Contact {
                                                       // -crush_gap_m / dt (free approach to the crushed depth)
   double pn = 0, pt1 = 0, pt2 = 0;                    // accumulated impulses (N s)
   Vec3 local_a = Vec3::Zero();                        // point in a's body frame (warm-start matching)
+  bool fixed_a = false, fixed_b = false;              // a body the impulses cannot move (a wall)
 };
 
 // The impulses of one contact kept for warm starting the next step, keyed by body/part pair and local point (rigid)
