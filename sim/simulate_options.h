@@ -294,8 +294,9 @@ struct SolverOptions {
             int_in_range(1, 10000));
     v.field("subspace_max_rows", subspace_max_rows, "-",
             "no subspace minimisation when more rows than this are settled: larger sets are the bow's rubble, "
-            "whose steps are nearly always undone (floesim-bench with fracture: 7 of 2,247 kept above 64 rows, "
-            "6 % from 32 to 64, 30-55 % below 16) while their factorisations cost a third of a step",
+            "whose steps are nearly always undone (floesim-bench with fracture, 100 s: 0 of 139 kept above 128 "
+            "rows, 7 of 2,108 from 64 to 128, 6 % from 32 to 64, 30-55 % below 16) while their factorisations "
+            "cost a third of a step at 300; the jam of ten floes (sim_solver_test) needs more than 64",
             int_in_range(1, 1000000));
     v.field("subspace_above_mps", subspace_above_mps, "m/s",
             "subspace minimisations only while the last sweep changed a contact velocity by more than this (the "
