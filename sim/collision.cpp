@@ -33,6 +33,7 @@ struct PartWorld {
   std::vector<Vec3> v;        // vertices
   std::vector<Vec3> n;        // face normals
   std::vector<double> d;      // face plane offsets n.x
+  std::vector<Vec3> face_lo, face_hi;  // box of each face
   Vec3 lo, hi;                // exact box
 };
 
@@ -41,6 +42,8 @@ void transform_part(const ConvexPart& cp, const Vec3& x, const Mat3& R, PartWorl
   w.v.resize(cp.vertices.size());
   w.n.resize(cp.faces.size());
   w.d.resize(cp.faces.size());
+  w.face_lo.resize(cp.faces.size());
+  w.face_hi.resize(cp.faces.size());
   Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
   for (size_t i = 0; i < cp.vertices.size(); ++i) {
     w.v[i] = x + R * cp.vertices[i];
@@ -50,6 +53,13 @@ void transform_part(const ConvexPart& cp, const Vec3& x, const Mat3& R, PartWorl
   for (size_t f = 0; f < cp.faces.size(); ++f) {
     w.n[f] = R * cp.face_normal[f];
     w.d[f] = w.n[f].dot(w.v[cp.faces[f][0]]);
+    Vec3 flo = Vec3::Constant(1e300), fhi = Vec3::Constant(-1e300);
+    for (int i : cp.faces[f]) {
+      flo = flo.cwiseMin(w.v[i]);
+      fhi = fhi.cwiseMax(w.v[i]);
+    }
+    w.face_lo[f] = flo;
+    w.face_hi[f] = fhi;
   }
   w.lo = lo;
   w.hi = hi;
@@ -98,18 +108,10 @@ void clip_faces(const ConvexPart& P, const PartWorld& pw, const Vec3& tp, const 
   // before the clipping (most faces of two floes touching at a corner). The margin keeps every face the tolerance
   // of the half-spaces could let in (1e-9 m, more at a sharp corner of Q: up to 1e-9 / sin(half its angle)).
   constexpr double kBoxMargin = 1e-6;
-  const Vec3 qlo = qw.lo + shift_q - Vec3::Constant(kBoxMargin), qhi = qw.hi + shift_q + Vec3::Constant(kBoxMargin);
+  // Q's box in P's placement (P's faces' boxes are where P is, shifted by tp).
+  const Vec3 qlo = qw.lo + tq - tp - Vec3::Constant(kBoxMargin), qhi = qw.hi + tq - tp + Vec3::Constant(kBoxMargin);
   for (size_t f = 0; f < P.faces.size(); ++f) {
-    {
-      Vec3 flo = Vec3::Constant(1e300), fhi = Vec3::Constant(-1e300);
-      for (int i : P.faces[f]) {
-        flo = flo.cwiseMin(pw.v[i]);
-        fhi = fhi.cwiseMax(pw.v[i]);
-      }
-      flo += shift_p;
-      fhi += shift_p;
-      if ((flo.array() > qhi.array()).any() || (fhi.array() < qlo.array()).any()) continue;
-    }
+    if ((pw.face_lo[f].array() > qhi.array()).any() || (pw.face_hi[f].array() < qlo.array()).any()) continue;
     if (second_side) {
       const double df = pw.d[f] + pw.n[f].dot(shift_p);
       bool coplanar = false;
