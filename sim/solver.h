@@ -23,6 +23,8 @@
 namespace floesim::sim {
 
 struct SolverReport {
+  // Over the islands of the solve: the most sweeps, all subspace solves, any island capped, the largest residual
+  // and violation.
   int iterations = 0;            // sweeps of the last solve
   int subspace_solves = 0;       // subspace minimisations done
   bool capped = false;           // stopped at the sweep cap with the tolerance unmet
