@@ -239,23 +239,13 @@ namespace {
 const std::vector<PropellerJet>* jets_on(const Body& b, const BodyKinematics& k, const std::vector<PropellerJet>& jets) {
   return floe_in_jets(b, k.x, jets) ? &jets : nullptr;
 }
-}  // namespace
 
-Wrench floe_water_drag(const Model& m, const Body& b, const BodyKinematics& k, ForceScratch& s,
-                       const std::vector<PropellerJet>& jets) {
+// floe_water_drag_clipped with the jets that reach the floe already looked up (null: none).
+Wrench drag_clipped(const Model& m, const Body& b, const BodyKinematics& k, ForceScratch& s,
+                    const std::vector<PropellerJet>* jets) {
   Wrench w;
   const double cd = m.options.water.form_drag_cd, cf = m.options.water.skin_friction_cf;
   const double half_rho = 0.5 * m.options.water.density_kg_m3;
-  if (floe_drag_afloat(m, b, k, cd, cf, half_rho, jets_on(b, k, jets), w)) return w;
-  return floe_water_drag_clipped(m, b, k, s, jets);
-}
-
-Wrench floe_water_drag_clipped(const Model& m, const Body& b, const BodyKinematics& k, ForceScratch& s,
-                               const std::vector<PropellerJet>& all_jets) {
-  Wrench w;
-  const double cd = m.options.water.form_drag_cd, cf = m.options.water.skin_friction_cf;
-  const double half_rho = 0.5 * m.options.water.density_kg_m3;
-  const std::vector<PropellerJet>* jets = jets_on(b, k, all_jets);
   s.vertices.resize(b.drag_vertices.size());
   for (size_t i = 0; i < b.drag_vertices.size(); ++i) s.vertices[i] = k.x + k.R * b.drag_vertices[i];
   // Waterline points of the vertical edges (bottom ring vertex i, top ring vertex n + i) that cross the water
@@ -317,6 +307,23 @@ Wrench floe_water_drag_clipped(const Model& m, const Body& b, const BodyKinemati
   }
   return w;
 }
+}  // namespace
+
+Wrench floe_water_drag(const Model& m, const Body& b, const BodyKinematics& k, ForceScratch& s,
+                       const std::vector<PropellerJet>& all_jets) {
+  Wrench w;
+  const double cd = m.options.water.form_drag_cd, cf = m.options.water.skin_friction_cf;
+  const double half_rho = 0.5 * m.options.water.density_kg_m3;
+  const std::vector<PropellerJet>* jets = jets_on(b, k, all_jets);
+  if (floe_drag_afloat(m, b, k, cd, cf, half_rho, jets, w)) return w;
+  return drag_clipped(m, b, k, s, jets);
+}
+
+Wrench floe_water_drag_clipped(const Model& m, const Body& b, const BodyKinematics& k, ForceScratch& s,
+                               const std::vector<PropellerJet>& all_jets) {
+  return drag_clipped(m, b, k, s, jets_on(b, k, all_jets));
+}
+
 
 Wrench floe_wind_drag(const Model& m, const Body& b, const BodyKinematics& k, ForceScratch& s) {
   Wrench w;

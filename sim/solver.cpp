@@ -118,10 +118,47 @@ double crushing_impulse(const Contact& c, double vn, double dt) {
   return std::min(hardening, capped);
 }
 
+// The islands of ContactIslands, from the fixed flags prepare_contacts has set.
+ContactIslands contact_islands(const std::vector<Contact>& contacts, size_t bodies) {
+  std::vector<int> parent(bodies);
+  for (size_t b = 0; b < bodies; ++b) parent[b] = static_cast<int>(b);
+  auto find = [&](int b) {
+    while (parent[b] != b) b = parent[b] = parent[parent[b]];
+    return b;
+  };
+  for (const Contact& c : contacts)
+    if (!c.fixed_a && !c.fixed_b) {
+      const int ra = find(c.body_a), rb = find(c.body_b);
+      if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+    }
+  // Island of each contact by first appearance (a contact between two fixed bodies is an island of its own).
+  const int n = static_cast<int>(contacts.size());
+  std::vector<int> island_of_root(bodies, -1), island(n);
+  int count = 0;
+  for (int i = 0; i < n; ++i) {
+    const Contact& c = contacts[i];
+    if (c.fixed_a && c.fixed_b) {
+      island[i] = count++;
+      continue;
+    }
+    int& id = island_of_root[find(c.fixed_a ? c.body_b : c.body_a)];
+    if (id < 0) id = count++;
+    island[i] = id;
+  }
+  ContactIslands is;
+  is.begin.assign(count + 1, 0);
+  for (int i = 0; i < n; ++i) ++is.begin[island[i] + 1];
+  for (int k = 0; k < count; ++k) is.begin[k + 1] += is.begin[k];
+  is.index.resize(n);
+  std::vector<int> fill(is.begin.begin(), is.begin.end() - 1);
+  for (int i = 0; i < n; ++i) is.index[fill[island[i]]++] = i;
+  return is;
+}
+
 }  // namespace
 
-void prepare_contacts(const Model& model, const SolverBodies& sb, State& state, std::vector<Contact>& contacts,
-                      double dt) {
+ContactIslands prepare_contacts(const Model& model, const SolverBodies& sb, State& state,
+                                std::vector<Contact>& contacts, double dt) {
   const SolverOptions& o = model.options.solver;
   const double match_tol2 = 0.1 * 0.1;  // m^2: a cached point further than 10 cm is another point
   const std::map<std::pair<int, int>, double> pair_stiffness = crushing_law(model.options, contacts);
@@ -193,6 +230,7 @@ void prepare_contacts(const Model& model, const SolverBodies& sb, State& state, 
     apply(state, sb, c, c.t1, c.ia_t1, c.ib_t1, c.pt1);
     apply(state, sb, c, c.t2, c.ia_t2, c.ib_t2, c.pt2);
   }
+  return contact_islands(contacts, sb.inv_mass.size());
 }
 
 namespace {
@@ -478,61 +516,18 @@ SolverReport solve_island(const SolverOptions& o, const SolverBodies& sb, State&
   return rep;
 }
 
-// The contacts grouped into islands: contacts that share a body the impulses move (directly or through other
-// contacts) are in one island; a fixed body (a wall) joins nothing. Islands are ordered by their first contact and
-// keep the contacts' order, so one island holding every contact is solved exactly as the whole list was.
-struct Islands {
-  std::vector<int> index;  // contact indices, island after island
-  std::vector<int> begin;  // island k: index[begin[k] .. begin[k + 1])
-};
-Islands contact_islands(const std::vector<Contact>& contacts, size_t bodies) {
-  std::vector<int> parent(bodies);
-  for (size_t b = 0; b < bodies; ++b) parent[b] = static_cast<int>(b);
-  auto find = [&](int b) {
-    while (parent[b] != b) b = parent[b] = parent[parent[b]];
-    return b;
-  };
-  for (const Contact& c : contacts)
-    if (!c.fixed_a && !c.fixed_b) {
-      const int ra = find(c.body_a), rb = find(c.body_b);
-      if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
-    }
-  // Island of each contact by first appearance (a contact between two fixed bodies is an island of its own).
-  const int n = static_cast<int>(contacts.size());
-  std::vector<int> island_of_root(bodies, -1), island(n);
-  int count = 0;
-  for (int i = 0; i < n; ++i) {
-    const Contact& c = contacts[i];
-    if (c.fixed_a && c.fixed_b) {
-      island[i] = count++;
-      continue;
-    }
-    int& id = island_of_root[find(c.fixed_a ? c.body_b : c.body_a)];
-    if (id < 0) id = count++;
-    island[i] = id;
-  }
-  Islands is;
-  is.begin.assign(count + 1, 0);
-  for (int i = 0; i < n; ++i) ++is.begin[island[i] + 1];
-  for (int k = 0; k < count; ++k) is.begin[k + 1] += is.begin[k];
-  is.index.resize(n);
-  std::vector<int> fill(is.begin.begin(), is.begin.end() - 1);
-  for (int i = 0; i < n; ++i) is.index[fill[island[i]]++] = i;
-  return is;
-}
-
 }  // namespace
 
 SolverReport solve_contacts(const Model& model, const SolverBodies& sb, State& state, std::vector<Contact>& contacts,
-                            double dt, bool use_bias, int iterations, double tolerance, ThreadPool* pool) {
+                            const ContactIslands& is, double dt, bool use_bias, int iterations, double tolerance,
+                            ThreadPool* pool) {
   SolverReport rep;
   if (contacts.empty()) return rep;
   const SolverOptions& o = model.options.solver;
   // Islands are independent problems: each sweeps until it has converged (a pair of floes touching far from the
   // bow stops after a few sweeps while the bow's rubble takes the cap), and they run on the pool's threads. An
   // island's result depends only on its own contacts, so it does not depend on the thread count or the schedule.
-  const Islands is = contact_islands(contacts, sb.inv_mass.size());
-  const int count = static_cast<int>(is.begin.size()) - 1;
+  const int count = is.count();
   std::vector<SolverReport> reports(count);
   auto solve = [&](int k) {
     const Island island{&contacts, is.index.data() + is.begin[k], is.begin[k + 1] - is.begin[k]};

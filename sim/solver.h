@@ -41,10 +41,20 @@ struct SolverBodies {
   std::vector<Mat3> inv_inertia_world;
 };
 
-// 1. Auxiliary data (lever arms, tangents, effective masses, bias) and 2. the warm start: impulses taken from the
-// previous step's cache (matched by body/part pair and nearest local point) and applied to the velocities.
-void prepare_contacts(const Model& model, const SolverBodies& bodies, State& state, std::vector<Contact>& contacts,
-                      double dt);
+// The contacts grouped into islands: contacts that share a body the impulses move (directly or through other
+// contacts) are in one island; a fixed body (a wall) joins nothing. Islands are ordered by their first contact and
+// keep the contacts' order, so one island holding every contact is solved exactly as the whole list was.
+struct ContactIslands {
+  std::vector<int> index;  // contact indices, island after island
+  std::vector<int> begin;  // island k: index[begin[k] .. begin[k + 1])
+  int count() const { return static_cast<int>(begin.size()) - 1; }
+};
+
+// 1. Auxiliary data (lever arms, tangents, effective masses, bias, which bodies are fixed), 2. the warm start:
+// impulses taken from the previous step's cache (matched by body/part pair and nearest local point) and applied to
+// the velocities, and the contacts' islands (the same for every pass over these contacts).
+ContactIslands prepare_contacts(const Model& model, const SolverBodies& bodies, State& state,
+                                std::vector<Contact>& contacts, double dt);
 
 // 3. Gauss-Seidel sweeps until the largest velocity change of a sweep is below `tolerance` or `iterations` sweeps,
 // with a subspace minimisation every solver.subspace_every sweeps while unconverged (solver.method
@@ -54,8 +64,8 @@ void prepare_contacts(const Model& model, const SolverBodies& bodies, State& sta
 // The contacts are solved as islands (joined by bodies that move), each to its own convergence, on the pool's
 // threads if one is given; the report is that of the worst island (sweeps, residual, violation).
 SolverReport solve_contacts(const Model& model, const SolverBodies& bodies, State& state,
-                            std::vector<Contact>& contacts, double dt, bool use_bias, int iterations,
-                            double tolerance, ThreadPool* pool = nullptr);
+                            std::vector<Contact>& contacts, const ContactIslands& islands, double dt, bool use_bias,
+                            int iterations, double tolerance, ThreadPool* pool = nullptr);
 
 // 4. Keeps the impulses for the next step's warm start (sorted, as the contacts are).
 void store_impulses(const Model& model, State& state, const std::vector<Contact>& contacts);

@@ -217,9 +217,10 @@ void World::stage_forces() {
 
 void World::stage_solve() {
   const SolverOptions& o = model_.options.solver;
-  prepare_contacts(model_, solver_bodies_, state_, contacts_, model_.options.time_step_s);
-  report_.solve = solve_contacts(model_, solver_bodies_, state_, contacts_, model_.options.time_step_s, true,
-                                 o.iterations, o.tolerance_mps, &pool_);
+  const double dt = model_.options.time_step_s;
+  islands_ = prepare_contacts(model_, solver_bodies_, state_, contacts_, dt);
+  report_.solve = solve_contacts(model_, solver_bodies_, state_, contacts_, islands_, dt, true, o.iterations,
+                                 o.tolerance_mps, &pool_);
 }
 
 void World::stage_integrate() {
@@ -239,8 +240,8 @@ void World::stage_relax() {
   const SolverOptions& o = model_.options.solver;
   const double dt = model_.options.time_step_s;
   if (o.relax_iterations > 0)
-    report_.relax = solve_contacts(model_, solver_bodies_, state_, contacts_, dt, false, o.relax_iterations,
-                                   o.tolerance_mps, &pool_);
+    report_.relax = solve_contacts(model_, solver_bodies_, state_, contacts_, islands_, dt, false,
+                                   o.relax_iterations, o.tolerance_mps, &pool_);
   store_impulses(model_, state_, contacts_);
   report_.contacts = static_cast<int>(contacts_.size());
   report_.vessel_contacts = vessel_ice_load(contacts_, &report_.ice_load_rigid, &report_.ice_load_compliant);
@@ -252,7 +253,8 @@ void World::stage_relax() {
   if (o.reference_sweeps > 0 && model_.vessel >= 0) {
     State s = state_;
     std::vector<Contact> c = contacts_;
-    solve_contacts(model_, solver_bodies_, s, c, dt, false, o.reference_sweeps, o.tolerance_mps * 1e-3, &pool_);
+    solve_contacts(model_, solver_bodies_, s, c, islands_, dt, false, o.reference_sweeps, o.tolerance_mps * 1e-3,
+                   &pool_);
     Wrench rigid, compliant;
     vessel_ice_load(c, &rigid, &compliant);
     const Vec3 surge = state_.orientation[model_.vessel] * Vec3::UnitX();

@@ -112,6 +112,7 @@ class World {
   ThreadPool pool_;
   std::unique_ptr<CollisionWorld> collision_;
   std::vector<Contact> contacts_;
+  ContactIslands islands_;          // of contacts_ (solve stage), for the solve, relax and reference passes
   std::vector<int> awake_list_;     // bodies integrated this step (ascending)
   std::vector<int> moved_;          // bodies integrated in the previous step (broad phase refresh)
   std::vector<int> island_;         // sleep stage: union-find parent of each awake body (contact islands)
