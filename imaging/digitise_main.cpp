@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   imaging::DigitiseRequest req;
   std::string image, out, config, truth, truth_mask;
   double s = 0;
+  bool check_config = false;
   app.add_option("IMAGE", image, "8-bit grayscale image (pure black = no data)");
   app.add_option("--metres-per-pixel", s, "ground size of one pixel (m)");
   app.add_option("--out", out, "output directory (floes.geojson, labels.png, overlay.png, stats.json)");
@@ -20,6 +21,7 @@ int main(int argc, char** argv) {
   app.add_option("--truth-mask", truth_mask,
                  "hand-labelled floe mask on the image's grid (floes = 8-connected components; or 16-bit truth "
                  "labels): writes score.json with the labelled-mask protocol (floes >= 1 m^2, edge floes dropped)");
+  app.add_flag("--check-config", check_config, "read and check --config (strictly, as a run would), write nothing");
   app.add_flag_callback(
       "--help-config",
       [] {
@@ -28,6 +30,11 @@ int main(int argc, char** argv) {
       },
       "print the options table and exit");
   return run_stage(app, argc, argv, [&] {
+    if (check_config) {
+      FLOESIM_REQUIRE(!config.empty(), "--check-config needs --config FILE");
+      read_options<imaging::DigitiseOptions>(load_json_file(config), config);
+      return;
+    }
     FLOESIM_REQUIRE(!image.empty(), "IMAGE is required (the photograph to digitise)");
     FLOESIM_REQUIRE(app.count("--metres-per-pixel") == 1,
                     "--metres-per-pixel is required (the ground size of one pixel in metres)");

@@ -9,14 +9,21 @@ int main(int argc, char** argv) {
   CLI::App app{"Plot the surge ice load of a simulated transit: raw, moving average and steady-state mean",
                "floesim-plot"};
   std::string results, config, out;
-  app.add_option("--results", results, "simulation results (HDF5, from floesim-simulate)")->required();
+  bool check_config = false;
+  app.add_option("--results", results, "simulation results (HDF5, from floesim-simulate)");
   app.add_option("--config", config, "plot options (JSON; see --help-config)")->required();
-  app.add_option("--out", out, "output directory")->required();
+  app.add_flag("--check-config", check_config, "read and check --config (strictly, as a run would), write nothing");
+  app.add_option("--out", out, "output directory");
   app.add_flag_callback("--help-config", [] {
     std::cout << floesim::options_doc(floesim::render::PlotOptions{});
     throw CLI::Success();
   }, "print the plot options (key, default, unit, meaning) and exit");
   return floesim::run_stage(app, argc, argv, [&] {
+    if (check_config) {
+      floesim::render::read_plot_options(config);
+      return;
+    }
+    if (results.empty() || out.empty()) throw floesim::Error("--results and --out are required (see --help)");
     const auto s = floesim::render::plot_surge_load(results, config, out);
     std::cout << "wrote " << out << "/surge_ice_load.{png,svg,csv}, fracture_events.csv and plot.json: mean ice "
               << "resistance " << s.mean_kN << " kN over t >= " << s.steady_start_s << " s (" << s.contact_model

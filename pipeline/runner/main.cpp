@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "pipeline/runner/runner.h"
+#include "pipeline/runner/sweep.h"
 #include "pipeline/stage_main.h"
 
 int main(int argc, char** argv) {
@@ -18,15 +19,33 @@ int main(int argc, char** argv) {
   run->add_option("--bin", o.bin_dir, "folder of the stage executables (default: beside floesim)");
   run->add_option("-j,--jobs", o.jobs, "stages run in parallel (default: ninja's choice)");
   run->add_flag("-n,--dry-run", o.dry_run, "show what would run, run nothing");
+  floesim::runner::SweepOptions so;
+  std::string sweep_run_dir;
+  auto* sweep = app.add_subcommand(
+      "sweep", "run a sweep (a folder with sweep.json: axes x ensemble over a base case) here or on SLURM");
+  sweep->add_option("sweep", so.sweep_dir, "sweep folder, e.g. cases/speed-concentration")->required();
+  sweep->add_option("--out", sweep_run_dir, "run folder (default: runs/<sweep folder name>)");
+  sweep->add_option("--bin", so.bin_dir, "folder of the stage executables (default: beside floesim)");
+  sweep->add_option("-j,--jobs", so.jobs, "stages run in parallel here (default: ninja's choice)");
+  sweep->add_flag("-n,--dry-run", so.dry_run, "plan and check every member's settings, show what would run");
+  sweep->add_flag("--yes", so.yes, "run a sweep of more than 64 members");
+  sweep->add_flag("--slurm", so.slurm, "submit to SLURM (sbatch job arrays, one per stage level) instead");
+  sweep->add_flag("--wait", so.wait, "with --slurm: wait until the cluster has finished and gathered");
+  // runs/<name of the folder>, also for a folder given with a trailing slash.
+  auto default_run = [](const std::filesystem::path& dir) {
+    const std::filesystem::path a = std::filesystem::absolute(dir).lexically_normal();
+    const std::string name = a.filename().empty() ? a.parent_path().filename().string() : a.filename().string();
+    return "runs/" + name;
+  };
   return floesim::run_stage(app, argc, argv, [&] {
-    std::filesystem::path cd = o.case_dir;
-    if (run_dir.empty()) {
-      std::string name = std::filesystem::absolute(cd).lexically_normal().filename().string();
-      if (name.empty()) name = std::filesystem::absolute(cd).lexically_normal().parent_path().filename().string();
-      run_dir = "runs/" + name;
+    int code = 0;
+    if (*sweep) {
+      so.run_dir = sweep_run_dir.empty() ? default_run(so.sweep_dir) : sweep_run_dir;
+      code = floesim::runner::run_sweep(so);
+    } else {
+      o.run_dir = run_dir.empty() ? default_run(o.case_dir) : run_dir;
+      code = floesim::runner::run_case(o);
     }
-    o.run_dir = run_dir;
-    const int code = floesim::runner::run_case(o);
     if (code != 0) std::exit(code);
   });
 }

@@ -8,6 +8,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pipeline/runner/plan.h"
+
 namespace floesim::runner {
 
 struct RunOptions {
@@ -18,9 +20,6 @@ struct RunOptions {
   bool dry_run = false;             // write the Ninja file, show what would run (ninja -n)
 };
 
-struct Artefact {
-  std::string stage, file, content;
-};
 
 struct StageTiming {
   std::string stage;

@@ -1,0 +1,294 @@
+#include "pipeline/runner/plan.h"
+
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "pipeline/atomic_file.h"
+#include "pipeline/error.h"
+#include "pipeline/options.h"
+#include "pipeline/provenance.h"
+
+namespace fs = std::filesystem;
+
+namespace floesim::runner {
+namespace {
+
+// Ninja path escaping ($, space, colon), and '$' in command lines.
+std::string ninja_path(const fs::path& p) {
+  std::string out;
+  for (char c : p.string()) {
+    if (c == '$' || c == ' ' || c == ':') out += '$';
+    out += c;
+  }
+  return out;
+}
+std::string ninja_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '$') out += '$';
+    out += c;
+  }
+  return out;
+}
+
+const Json& require_object(const Json& j, const std::string& key, const std::string& file) {
+  FLOESIM_REQUIRE(j.contains(key), file, ": missing key \"", key, "\"");
+  FLOESIM_REQUIRE(j.at(key).is_object(), file, ": \"", key, "\" must be an object, got ", j.at(key).dump());
+  return j.at(key);
+}
+
+std::string number(double x) {
+  std::ostringstream s;
+  s.precision(17);
+  s << x;
+  return s.str();
+}
+
+}  // namespace
+
+std::string shell_quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += (c == '\'') ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::string shell_command(const PlannedStage& s) {
+  std::string cmd = shell_quote(s.exe.string());
+  for (const std::string& a : s.args) cmd += " " + shell_quote(a);
+  return cmd;
+}
+
+void write_if_changed(const fs::path& file, const std::string& text) {
+  if (fs::exists(file)) {
+    std::ifstream in(file, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    if (ss.str() == text) return;
+  }
+  write_text_atomic(file, text);
+}
+
+fs::path self_dir() {
+  std::error_code ec;
+  fs::path p = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? fs::current_path() : p.parent_path();
+}
+
+CasePlan plan_case(const Json& c, const fs::path& case_file, const fs::path& case_dir, const fs::path& bin,
+                   const StageLayout& layout, bool render) {
+  const std::string cf = case_file.string();
+  FLOESIM_REQUIRE(c.is_object(), cf, ": the top level must be an object");
+  const std::vector<std::string> known = {"description", "image", "digitise", "floes", "hull", "simulate", "render",
+                                          "plot"};
+  for (auto it = c.begin(); it != c.end(); ++it) {
+    bool ok = false;
+    for (auto& k : known) ok = ok || k == it.key();
+    FLOESIM_REQUIRE(ok, cf, ": unknown key \"", it.key(),
+                    "\" (known: description, image, digitise, floes, hull, simulate, render, plot)");
+  }
+  // Floes come from a photo (image + digitise) or directly from a floes GeoJSON the case owns ("floes": {"file"}).
+  FLOESIM_REQUIRE(c.contains("image") != c.contains("floes"), cf,
+                  ": give exactly one of \"image\" (a photo or synthetic image, digitised into floes) or \"floes\" "
+                  "({\"file\": \"floes.geojson\"}: floe polygons given directly)");
+  FLOESIM_REQUIRE(!(c.contains("floes") && c.contains("digitise")), cf,
+                  ": \"digitise\" has no effect with \"floes\" (the floes are given directly): remove it");
+
+  auto case_input = [&](const Json& j, const std::string& key, const std::string& where) {
+    FLOESIM_REQUIRE(j.contains(key) && j.at(key).is_string(), cf, ": ", where, ".", key, " must be a file name");
+    fs::path p = j.at(key).get<std::string>();
+    if (p.is_relative()) p = fs::absolute(case_dir) / p;
+    FLOESIM_REQUIRE(fs::exists(p), cf, ": ", where, ".", key, " names ", p.string(), ", which does not exist");
+    return p.lexically_normal();
+  };
+
+  CasePlan plan;
+  // What each input file is, for the content keys: another stage's output (that stage's key and the file's name)
+  // or a file of the case (its SHA-256).
+  std::map<fs::path, std::string> identity;
+  auto identify = [&](const fs::path& p) {
+    auto it = identity.find(p);
+    if (it != identity.end()) return it->second;
+    return identity[p] = "file " + sha256_file(p);
+  };
+  // Adds a stage: its key from its name, settings and inputs; then its folder, settings file and outputs.
+  auto add = [&](const std::string& name, const std::string& description, const Json& settings,
+                 std::vector<fs::path> inputs, const std::vector<std::string>& output_names, const char* exe) {
+    PlannedStage s;
+    s.name = name;
+    s.description = description;
+    s.config_text = settings.dump(2) + "\n";
+    std::string id = name + "\n" + s.config_text;
+    for (const fs::path& p : inputs) id += identify(p) + "\n";
+    s.key = sha256_bytes(id).substr(0, 16);
+    s.dir = layout.dir(name, s.key);
+    s.config = layout.config(name, s.key);
+    inputs.push_back(s.config);
+    s.inputs = inputs;
+    for (const std::string& f : output_names) {
+      s.outputs.push_back(s.dir / f);
+      identity[s.outputs.back()] = "stage " + s.key + " " + f;
+    }
+    s.exe = bin / exe;
+    plan.stages.push_back(s);
+    return &plan.stages.back();
+  };
+  auto rel = [&](const fs::path& p, const std::string& base) { return base + "/" + p.filename().string(); };
+
+  // --- floes given directly: the case's GeoJSON goes to simulate as it is (no image, no digitise stage) ---
+  fs::path floes_file;
+  if (c.contains("floes")) {
+    const Json& fl = require_object(c, "floes", cf);
+    for (auto it = fl.begin(); it != fl.end(); ++it)
+      FLOESIM_REQUIRE(it.key() == "file", cf, ": unknown key floes.", it.key(), " (known: file)");
+    floes_file = case_input(fl, "file", "floes");
+  } else {
+    // --- image: a photo the case owns, or a synthetic one made from known floes ---
+    const Json& image = require_object(c, "image", cf);
+    for (auto it = image.begin(); it != image.end(); ++it)
+      FLOESIM_REQUIRE(it.key() == "metres_per_pixel" || it.key() == "synthetic" || it.key() == "file", cf,
+                      ": unknown key image.", it.key(), " (known: metres_per_pixel, file, synthetic)");
+    FLOESIM_REQUIRE(image.contains("metres_per_pixel") && image["metres_per_pixel"].is_number() &&
+                        image["metres_per_pixel"].get<double>() > 0,
+                    cf, ": image.metres_per_pixel must be a number > 0 (the ground size of one pixel)");
+    const double mpp = image["metres_per_pixel"].get<double>();
+    FLOESIM_REQUIRE(image.contains("synthetic") != image.contains("file"), cf,
+                    ": image needs exactly one of \"file\" (a photo) or \"synthetic\" (options for floesim-synth)");
+    fs::path image_png;
+    if (image.contains("synthetic")) {
+      Json s = image["synthetic"];
+      FLOESIM_REQUIRE(s.is_object(), cf, ": image.synthetic must be an object");
+      FLOESIM_REQUIRE(!s.contains("metres_per_pixel"), cf,
+                      ": image.synthetic.metres_per_pixel: set the scale once, in image.metres_per_pixel");
+      s["metres_per_pixel"] = mpp;
+      PlannedStage* st = add("synth", "synthetic helicopter image from known floes", s, {},
+                             {"image.png", "truth.geojson", "truth_labels.png"}, "floesim-synth");
+      st->args = {"--config", st->config.string(), "--out", st->dir.string()};
+      image_png = st->outputs[0];
+      plan.artefacts.push_back({"synth", rel(image_png, "image"), "synthetic helicopter image (8-bit grey)"});
+      plan.artefacts.push_back({"synth", "image/truth.geojson", "the true floe polygons (m)"});
+    } else {
+      image_png = case_input(image, "file", "image");
+    }
+
+    // --- digitise ---
+    Json d = c.contains("digitise") ? c["digitise"] : Json::object();
+    FLOESIM_REQUIRE(d.is_object(), cf, ": digitise must be an object");
+    PlannedStage* st = add("digitise", "floe segmentation and polygons", d, {image_png},
+                           {"floes.geojson", "labels.png", "overlay.png", "stats.json", "fsd.png", "fsd.csv"},
+                           "floesim-digitise");
+    st->args = {image_png.string(), "--metres-per-pixel", number(mpp), "--config", st->config.string(), "--out",
+                st->dir.string()};
+    floes_file = st->outputs[0];
+    plan.artefacts.push_back({"digitise", "floes/floes.geojson", "floe polygons, m (GeoJSON)"});
+    plan.artefacts.push_back({"digitise", "floes/labels.png", "16-bit label image, k = floe id"});
+    plan.artefacts.push_back({"digitise", "floes/overlay.png", "outlines on the photo"});
+    plan.artefacts.push_back({"digitise", "floes/stats.json", "count, concentration, size distribution"});
+    plan.artefacts.push_back({"digitise", "floes/fsd.png", "floe size distribution and power-law fit"});
+  }
+
+  // --- hull: a user's mesh, or the parametric icebreaker ---
+  fs::path hull_obj;
+  {
+    const Json& h = require_object(c, "hull", cf);
+    FLOESIM_REQUIRE(h.contains("generate") != h.contains("file") && h.size() == 1, cf,
+                    ": hull needs exactly one key: \"file\" (an OBJ or any mesh assimp reads) or \"generate\" "
+                    "(options for floesim-hull)");
+    if (h.contains("generate")) {
+      PlannedStage* st = add("hull", "parametric icebreaker hull", h["generate"], {}, {"hull.obj"}, "floesim-hull");
+      hull_obj = st->outputs[0];
+      st->args = {"--config", st->config.string(), "--out", hull_obj.string()};
+      plan.artefacts.push_back({"hull", "hull/hull.obj", "hull as convex parts, m (OBJ)"});
+    } else {
+      hull_obj = case_input(h, "file", "hull");
+    }
+  }
+
+  // --- simulate ---
+  {
+    Json s = c.contains("simulate") ? c["simulate"] : Json::object();
+    FLOESIM_REQUIRE(s.is_object(), cf, ": simulate must be an object");
+    std::vector<fs::path> inputs = {floes_file, hull_obj};
+    // A thrust time series named in the case is an input too (its path made absolute for the stage).
+    if (s.contains("vessel") && s["vessel"].is_object() && s["vessel"].contains("propulsion") &&
+        s["vessel"]["propulsion"].is_object() && s["vessel"]["propulsion"].contains("thrust_file")) {
+      const fs::path tf = case_input(s["vessel"]["propulsion"], "thrust_file", "simulate.vessel.propulsion");
+      s["vessel"]["propulsion"]["thrust_file"] = tf.string();
+      inputs.push_back(tf);
+    }
+    PlannedStage* st = add("simulate", "vessel transit simulation", s, inputs, {"results.h5", "summary.json"},
+                           "floesim-simulate");
+    st->args = {"--floes", floes_file.string(), "--hull", hull_obj.string(), "--config", st->config.string(),
+                "--out", st->dir.string()};
+    plan.results = st->outputs[0];
+    plan.summary = st->outputs[1];
+    plan.artefacts.push_back({"simulate", "sim/results.h5", "time series and floe states (HDF5)"});
+    plan.artefacts.push_back({"simulate", "sim/summary.json", "mean surge ice load and settings"});
+  }
+
+  // --- render and plot (independent of each other) ---
+  {
+    Json r = c.contains("render") ? c["render"] : Json::object();
+    FLOESIM_REQUIRE(r.is_object(), cf, ": render must be an object");
+    if (render) {
+      PlannedStage* st = add("render", "off-screen frames and H.264 video", r, {plan.results}, {"transit.mp4"},
+                             "floesim-render");
+      st->args = {"--results", plan.results.string(), "--config", st->config.string(), "--out",
+                  st->outputs[0].string()};
+      plan.artefacts.push_back({"render", "video/transit.mp4", "rendered transit (H.264 MP4)"});
+    }
+  }
+  {
+    Json p = c.contains("plot") ? c["plot"] : Json::object();
+    FLOESIM_REQUIRE(p.is_object(), cf, ": plot must be an object");
+    PlannedStage* st = add("plot", "surge ice load plots", p, {plan.results},
+                           {"surge_ice_load.png", "surge_ice_load.svg", "fracture_events.csv"}, "floesim-plot");
+    st->args = {"--results", plan.results.string(), "--config", st->config.string(), "--out", st->dir.string()};
+    plan.artefacts.push_back({"plot", "plots/surge_ice_load.png", "surge ice load, moving average and mean (PNG)"});
+    plan.artefacts.push_back({"plot", "plots/surge_ice_load.svg", "the same (SVG)"});
+    plan.artefacts.push_back(
+        {"plot", "plots/fracture_events.csv", "every fracture event: time, mode, floe, force, children"});
+  }
+  return plan;
+}
+
+std::string stage_script(const std::vector<PlannedStage>& stages, size_t k, StageOutput output) {
+  // Stage k's outputs and everything downstream of them (the list is in dependency order).
+  std::vector<fs::path> dirty(stages[k].outputs);
+  for (size_t j = k + 1; j < stages.size(); ++j) {
+    bool depends = false;
+    for (auto& in : stages[j].inputs)
+      for (auto& d : dirty) depends = depends || in == d;
+    if (depends) dirty.insert(dirty.end(), stages[j].outputs.begin(), stages[j].outputs.end());
+  }
+  std::string rm = "rm -f";
+  for (auto& p : dirty) rm += " " + shell_quote(p.string());
+  const PlannedStage& s = stages[k];
+  if (output == StageOutput::console) return rm + " && " + shell_command(s);
+  const std::string log = shell_quote((s.dir / "log.txt").string()), wall = shell_quote((s.dir / "wall_ms").string());
+  // POSIX sh: the wall time from date +%s%N (GNU date: nanoseconds), written after the stage whatever its outcome.
+  return rm + " " + wall + " && t0=$(date +%s%N) && { " + shell_command(s) + " > " + log +
+         " 2>&1; rc=$?; echo $(( ($(date +%s%N) - t0) / 1000000 )) > " + wall + "; [ $rc -eq 0 ] || { tail -n 15 " +
+         log + " >&2; exit $rc; }; }";
+}
+
+void write_ninja(const fs::path& file, const std::string& header, const std::vector<PlannedStage>& stages,
+                 const std::vector<std::string>& descriptions, StageOutput output) {
+  std::ostringstream nf;
+  nf << header << "ninja_required_version = 1.5\n\n"
+     << "rule stage\n  command = $cmd\n  description = $desc\n\n";
+  for (size_t k = 0; k < stages.size(); ++k) {
+    const PlannedStage& s = stages[k];
+    for (auto& p : s.outputs) ensure_directory(p.parent_path());
+    nf << "build";
+    for (auto& p : s.outputs) nf << " " << ninja_path(p);
+    nf << ": stage";
+    for (auto& p : s.inputs) nf << " " << ninja_path(p);
+    nf << " | " << ninja_path(s.exe) << "\n";
+    nf << "  cmd = " << ninja_escape(stage_script(stages, k, output)) << "\n";
+    nf << "  desc = " << descriptions[k] << "\n\n";
+  }
+  write_if_changed(file, nf.str());
+}
+
+}  // namespace floesim::runner
