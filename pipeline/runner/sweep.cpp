@@ -192,7 +192,7 @@ void write_sweep_files(const Sweep& s, const std::vector<Member>& members, const
                             {"stages", stages}});
   }
   Json axes = Json::array(), grid = Json::array();
-  for (const SweepAxis& a : s.axes) axes.push_back({{"key", a.key}, {"values", a.values}});
+  for (const SweepAxis& a : s.axes) axes.push_back({{"key", a.key}, {"paths", a.paths}, {"values", a.values}});
   for (const Member& mb : members)
     if (mb.ensemble_index == 0) grid.push_back({{"index", mb.grid_point}, {"axes", mb.axes}});
   Json vary = Json::array();
@@ -483,12 +483,23 @@ Sweep read_sweep(const fs::path& sweep_dir) {
       const Json& a = j["axes"][i];
       const std::string w = "axes[" + std::to_string(i) + "]";
       FLOESIM_REQUIRE(a.is_object(), f, ": ", w, " must be an object {\"key\": ..., \"values\": [...]}");
-      require_known_keys(a, {"key", "values"}, f, w + ".");
-      FLOESIM_REQUIRE(a.contains("key") && a["key"].is_string(), f, ": ", w, ".key must be a key path string");
+      require_known_keys(a, {"key", "keys", "values"}, f, w + ".");
+      FLOESIM_REQUIRE(a.contains("key") != a.contains("keys"), f, ": ", w,
+                      " needs exactly one of \"key\" (a key path) or \"keys\" (several, set to the same value)");
+      SweepAxis ax;
+      if (a.contains("key")) {
+        FLOESIM_REQUIRE(a["key"].is_string(), f, ": ", w, ".key must be a key path string");
+        ax.paths.push_back(a["key"]);
+      } else {
+        FLOESIM_REQUIRE(a["keys"].is_array() && !a["keys"].empty(), f, ": ", w, ".keys must be a list of key paths");
+        for (const Json& k : a["keys"]) {
+          FLOESIM_REQUIRE(k.is_string(), f, ": ", w, ".keys must be a list of key path strings");
+          ax.paths.push_back(k);
+        }
+      }
+      ax.key = ax.paths[0];
       FLOESIM_REQUIRE(a.contains("values") && a["values"].is_array(), f, ": ", w, ".values must be a list");
-      FLOESIM_REQUIRE(!a["values"].empty(), f, ": ", w, " (", a["key"].get<std::string>(),
-                      ") has no values: give at least one");
-      SweepAxis ax{a["key"], {}};
+      FLOESIM_REQUIRE(!a["values"].empty(), f, ": ", w, " (", ax.key, ") has no values: give at least one");
       for (const Json& v : a["values"]) ax.values.push_back(v);
       for (const SweepAxis& other : s.axes)
         FLOESIM_REQUIRE(other.key != ax.key, f, ": axis ", ax.key, " is given twice");
@@ -588,7 +599,7 @@ std::vector<Member> expand_members(const Sweep& s, const Json& base_case) {
     Json axes = Json::object();
     for (size_t a = 0; a < s.axes.size(); ++a) {
       const Json& v = s.axes[a].values[points[g][a]];
-      set_key_path(c, s.axes[a].key, v, f + ": axis " + s.axes[a].key);
+      for (const std::string& path : s.axes[a].paths) set_key_path(c, path, v, f + ": axis " + s.axes[a].key);
       axes[s.axes[a].key] = v;
     }
     for (int e = 0; e < s.ensemble_size; ++e) {

@@ -5,6 +5,7 @@
 //   {"description": "...",
 //    "base": "../default",                       base case folder (relative to the sweep's folder)
 //    "axes": [{"key": "simulate.vessel.propulsion.speed_mps", "values": [1, 2, 3]}, ...],
+//                                                "keys": [...] instead of "key" sets several paths to each value
 //    "combine": "grid",                          or "zip" (axes of equal length, taken together)
 //    "ensemble": {"size": 3, "vary": ["field_seed", "start"], "start_step_m": 0.001},
 //    "set": {"simulate.duration_s": 100},        key paths set in every member
@@ -38,8 +39,11 @@ struct SweepOptions {
 // Sweeps larger than this need --yes (a typo in an axis can ask for thousands of runs).
 constexpr int kMaxMembersUnasked = 64;
 
+// An axis sets one key path ("key") or several to the same value ("keys": e.g. the target speed and the initial
+// speed); it is named by its first key path.
 struct SweepAxis {
   std::string key;
+  std::vector<std::string> paths;
   std::vector<nlohmann::json> values;
 };
 
