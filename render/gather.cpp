@@ -200,8 +200,9 @@ SweepPlan read_sweep_plan(const fs::path& file) {
       if (c.text(mj, w, "id", m.id, true) && !ids.insert(m.id).second)
         c.problem(PlanChecker::path(w, "id"), "\"" + m.id + "\" repeats a member id");
       if (c.index(mj, w, "grid_point", m.grid_point) && m.grid_point >= p.grid_points.size())
-        c.problem(PlanChecker::path(w, "grid_point"), "is " + std::to_string(m.grid_point) + ", but there are " +
-                                                          std::to_string(p.grid_points.size()) + " grid points");
+        c.problem(PlanChecker::path(w, "grid_point"),
+                  "is " + std::to_string(m.grid_point) + ", but the grid points are 0 to " +
+                      std::to_string(static_cast<long long>(p.grid_points.size()) - 1));
       c.index(mj, w, "ensemble_index", m.ensemble_index);
       if (c.scalars(mj, w, "axes", m.axes, true) && m.grid_point < p.grid_points.size() &&
           m.axes != p.grid_points[m.grid_point].axes)
@@ -619,7 +620,8 @@ void draw_running_mean(const MemberResult& m, const SteadyResistance& s, PlotFil
   body << "set title " << gnuplot_quoted("Running mean of the ice resistance: " + m.id) << " noenhanced font ',14'\n"
        << "set xlabel 'Time (s)'\n"
        << "set ylabel 'Running mean of the ice resistance −F_x (kN)'\n"
-       << "set xrange [" << fmt("%.10g", s.time_s.front()) << ":" << fmt("%.10g", s.time_s.back()) << "]\n"
+       << "set xrange [" << fmt("%.10g", s.time_s.front()) << ":"
+       << fmt("%.10g", std::max(s.time_s.back(), s.time_s.front() + s.time_step_s)) << "]\n"
        << "set yrange [" << fmt("%.10g", y0 - pad) << ":" << fmt("%.10g", y1 + pad) << "]\n";
   if (clipped)
     body << "set label 1 'the first samples of the running mean are off the scale' at graph 0.99, graph 0.96 right "
@@ -818,7 +820,8 @@ std::string gather_table(const SweepPlan& plan, const GatherResult& g) {
   for (const MemberResult& m : g.members) ok += m.ok;
   std::ostringstream os;
   os << "sweep " << plan.name << ": " << g.grid_points.size() << " grid point" << (g.grid_points.size() == 1 ? "" : "s")
-     << ", " << g.members.size() << " members: " << ok << " ok, " << g.members.size() - ok << " failed\n";
+     << ", " << g.members.size() << " member" << (g.members.size() == 1 ? "" : "s") << ": " << ok << " ok, "
+     << g.members.size() - ok << " failed\n";
   // Columns: grid point, one per axis, mean +- 95 % CI, ok/n; each as wide as its widest cell.
   std::vector<std::vector<std::string>> rows = {{"grid"}};
   for (const PlanAxis& a : plan.axes) rows[0].push_back(a.key);
