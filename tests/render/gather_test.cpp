@@ -133,7 +133,8 @@ class Normal {
 
 // Variance of the mean of k consecutive samples of a stationary AR(1), x_t = phi x_{t-1} + e_t with unit-variance
 // innovations: gamma_0 = 1 / (1 - phi^2), rho_j = phi^j, and
-// Var = gamma_0 / k [1 + 2 sum_{j=1}^{k-1} (1 - j/k) phi^j] = gamma_0 / k [(1+phi)/(1-phi) - 2 phi (1-phi^k) / (k (1-phi)^2)].
+// Var = gamma_0 / k [1 + 2 sum_{j=1}^{k-1} (1 - j/k) phi^j]
+//     = gamma_0 / k [(1+phi)/(1-phi) - 2 phi (1-phi^k) / (k (1-phi)^2)].
 double ar1_variance_of_mean(double phi, double k) {
   const double g0 = 1.0 / (1.0 - phi * phi);
   return g0 / k * ((1 + phi) / (1 - phi) - 2 * phi * (1 - std::pow(phi, k)) / (k * (1 - phi) * (1 - phi)));
