@@ -1,31 +1,20 @@
 #include "render/plot.h"
 
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <fstream>
 #include <sstream>
 
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
 #include "pipeline/provenance.h"
+#include "render/gnuplot.h"
 #include "render/signal.h"
-
-extern char** environ;
 
 namespace floesim::render {
 
 namespace fs = std::filesystem;
-
-#ifndef FLOESIM_GNUPLOT
-#error "FLOESIM_GNUPLOT (the gnuplot executable) must be defined by the build"
-#endif
 
 Check<Json> auto_or_number(bool strictly_positive) {
   return [strictly_positive](const Json& j) {
@@ -55,12 +44,8 @@ std::string kN(double x) { return std::abs(x) >= 100 ? fmt("%.0f", x) : fmt("%.3
 // NaN has no JSON spelling: null.
 nlohmann::json json_number(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
 
-// gnuplot single-quoted string: only the quote itself needs escaping (doubled).
-std::string quoted(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("''") : std::string(1, c);
-  return out + "'";
-}
+// A short name for the script building below.
+std::string quoted(const std::string& s) { return gnuplot_quoted(s); }
 
 // For the drawing only (the CSV keeps every sample): with far more samples than pixels, keep each bin's minimum
 // and maximum in time order, so that single-step spikes stay visible and files stay small.
@@ -83,38 +68,9 @@ void write_decimated(std::ostream& os, const std::vector<double>& t, const std::
   }
 }
 
-// Runs a program without a shell (no quoting pitfalls), stdout and stderr into `log`; returns its exit status.
-int run_program(const std::vector<std::string>& args, const fs::path& log) {
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&fa, 1, 2);
-  std::vector<char*> argv;
-  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  const int rc = posix_spawn(&pid, args[0].c_str(), &fa, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&fa);
-  FLOESIM_REQUIRE(rc == 0, "cannot start ", args[0], ": ", std::strerror(rc));
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0)
-    FLOESIM_REQUIRE(errno == EINTR, "waiting for ", args[0], " failed: ", std::strerror(errno));
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
-}
-
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 }  // namespace
 
-SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const fs::path& out_dir,
-                                 const nlohmann::json& provenance, const std::string& source) {
-  SurgeLoadSummary s;
-  // 1. The signal: ice resistance = -Fx (body x, surge) in kN.
+std::vector<double> surge_ice_resistance_kN(const Results& r, const std::string& source) {
   const std::vector<double>& t = r.get("time_s");
   const std::vector<double>& load = r.get("ice_load");
   FLOESIM_REQUIRE(load.size() == 6 * t.size(), source, ": series ice_load does not have 6 columns per step");
@@ -123,6 +79,21 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
   for (size_t i = 0; i < t.size(); ++i)
     FLOESIM_REQUIRE(std::isfinite(res[i]) && std::isfinite(t[i]), source, ": ice_load or time_s is not finite at step ",
                     i, " (t = ", t[i], " s); the simulation blew up");
+  return res;
+}
+
+double recorded_steady_start_s(const Results& r, const std::string& source) {
+  if (!r.attributes.contains("steady_start_s")) return 0;
+  FLOESIM_REQUIRE(r.attributes["steady_start_s"].is_number(), source, ": attribute steady_start_s must be a number");
+  return r.attributes["steady_start_s"].get<double>();
+}
+
+SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const fs::path& out_dir,
+                                 const nlohmann::json& provenance, const std::string& source) {
+  SurgeLoadSummary s;
+  // 1. The signal: ice resistance = -Fx (body x, surge) in kN.
+  const std::vector<double>& t = r.get("time_s");
+  const std::vector<double> res = surge_ice_resistance_kN(r, source);
   s.time_step_s = uniform_step(t, (source + ": series time_s").c_str());
 
   // 2. The window: "auto" follows the contact model the simulator recorded (PHYSICS.md §5).
@@ -147,13 +118,8 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
   if (!s.moving_average_complete) f0 = 0, f1 = res.size();
 
   // 3. The steady part and its mean (of the unfiltered signal: the primary validation metric).
-  s.steady_start_s = 0;
-  if (o.steady_start_s.is_number()) {
-    s.steady_start_s = o.steady_start_s.get<double>();
-  } else if (attrs.contains("steady_start_s")) {
-    FLOESIM_REQUIRE(attrs["steady_start_s"].is_number(), source, ": attribute steady_start_s must be a number");
-    s.steady_start_s = attrs["steady_start_s"].get<double>();
-  }
+  s.steady_start_s =
+      o.steady_start_s.is_number() ? o.steady_start_s.get<double>() : recorded_steady_start_s(r, source);
   const SteadyMean m = mean_from(t, res, s.steady_start_s);
   s.mean_kN = m.mean;
   s.steady_samples = m.samples;
@@ -312,12 +278,7 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
   }
 
   // 7. gnuplot, checked: exit status, and both images non-empty.
-  const int rc = run_program({FLOESIM_GNUPLOT, script.tmp().string()}, log.tmp());
-  FLOESIM_REQUIRE(rc == 0, "gnuplot (", FLOESIM_GNUPLOT, ") failed with exit status ", rc, " drawing ",
-                  png.path().string(), ":\n", read_text(log.tmp()));
-  std::error_code e1, e2;
-  FLOESIM_REQUIRE(fs::file_size(png.tmp(), e1) > 0 && !e1 && fs::file_size(svg.tmp(), e2) > 0 && !e2,
-                  "gnuplot wrote no image to ", out_dir.string(), ":\n", read_text(log.tmp()));
+  run_gnuplot(script.tmp(), log.tmp(), {png.tmp(), svg.tmp()}, png.path().string());
 
   // 8. The numbers, then everything into place.
   nlohmann::json j = {

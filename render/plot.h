@@ -6,6 +6,7 @@
 #pragma once
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -59,6 +60,13 @@ struct SurgeLoadSummary {
   size_t vessel_splitting_events = 0;        // at the vessel, marked on the plot
   size_t vessel_bending_radial_events = 0;   // at the vessel, marked on the plot
 };
+
+// The signal the plot stage averages, shared with the sweep gather so that both report the same mean: ice
+// resistance = -Fx (ice_load column 0, body x, surge) in kN, one sample per step. Error naming `source` if the
+// series is malformed or not finite (the simulation blew up).
+std::vector<double> surge_ice_resistance_kN(const Results& r, const std::string& source);
+// The steady start the simulation recorded (results attribute steady_start_s), 0 if absent.
+double recorded_steady_start_s(const Results& r, const std::string& source);
 
 // Writes DIR/surge_ice_load.{png,svg,csv}, DIR/fracture_events.csv and DIR/plot.json; each appears only when
 // complete.

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <boost/math/distributions/students_t.hpp>
+
 #include "pipeline/error.h"
 
 namespace floesim::render {
@@ -75,6 +77,56 @@ SteadyMean mean_from(const std::vector<double>& t, const std::vector<double>& x,
                   t.empty() ? 0.0 : t.back(), " s): lower steady_start_s");
   m.mean = static_cast<double>(sum / static_cast<long double>(m.samples));
   return m;
+}
+
+std::vector<double> running_mean(const std::vector<double>& x) {
+  std::vector<double> y(x.size());
+  long double sum = 0;  // long double: a 1e6-sample running sum keeps ~1e-13 relative error
+  for (size_t i = 0; i < x.size(); ++i) {
+    sum += x[i];
+    y[i] = static_cast<double>(sum / static_cast<long double>(i + 1));
+  }
+  return y;
+}
+
+double batch_means_standard_error(const std::vector<double>& x, size_t batches) {
+  FLOESIM_REQUIRE(batches >= 2, "batch means need at least 2 batches, got ", batches);
+  FLOESIM_REQUIRE(x.size() >= batches, "batch means: ", x.size(), " samples cannot fill ", batches,
+                  " batches; a longer steady part is needed");
+  const size_t m = x.size() / batches;
+  const size_t first = x.size() - batches * m;  // the remainder, dropped at the start
+  std::vector<double> means(batches);
+  for (size_t b = 0; b < batches; ++b) {
+    long double sum = 0;
+    for (size_t i = first + b * m; i < first + (b + 1) * m; ++i) sum += x[i];
+    means[b] = static_cast<double>(sum / static_cast<long double>(m));
+  }
+  const ConfidenceInterval ci = student_t_interval(means);
+  return ci.std / std::sqrt(static_cast<double>(batches));
+}
+
+ConfidenceInterval student_t_interval(const std::vector<double>& x, double level) {
+  FLOESIM_REQUIRE(level > 0 && level < 1, "confidence level must be in (0, 1), got ", level);
+  ConfidenceInterval c;
+  c.n = x.size();
+  const double nan = std::nan("");
+  c.mean = c.std = c.t_quantile = c.half_width = nan;
+  if (c.n == 0) return c;
+  long double sum = 0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    FLOESIM_REQUIRE(std::isfinite(x[i]), "confidence interval: sample ", i, " is not finite (", x[i], ")");
+    sum += x[i];
+  }
+  c.mean = static_cast<double>(sum / static_cast<long double>(c.n));
+  if (c.n < 2) return c;
+  // Two passes (deviations from the mean): no cancellation when the spread is small against the mean.
+  long double ss = 0;
+  for (double v : x) ss += (v - c.mean) * static_cast<long double>(v - c.mean);
+  c.std = std::sqrt(static_cast<double>(ss / static_cast<long double>(c.n - 1)));
+  const boost::math::students_t dist(static_cast<double>(c.n - 1));
+  c.t_quantile = boost::math::quantile(dist, 0.5 + 0.5 * level);
+  c.half_width = c.t_quantile * c.std / std::sqrt(static_cast<double>(c.n));
+  return c;
 }
 
 double uniform_step(const std::vector<double>& t, const char* what) {

@@ -31,6 +31,29 @@ struct SteadyMean {
 };
 SteadyMean mean_from(const std::vector<double>& t, const std::vector<double>& x, double t_start);
 
+// Running (cumulative) mean: y_n = mean of x_0 .. x_n. Shows whether a run was long enough for its mean to settle.
+std::vector<double> running_mean(const std::vector<double>& x);
+
+// Standard error of the mean of a correlated, stationary series by batch means: the series is cut into `batches`
+// consecutive batches of m = floor(n / batches) samples, and SE = s_b / sqrt(batches), where s_b is the sample
+// standard deviation (n - 1 denominator) of the batch means. Batches much longer than the correlation time have
+// nearly independent means, so unlike the naive s / sqrt(n) this does not understate the error of a correlated
+// signal. The n - batches * m leftover samples are dropped at the START: in a steady part those are the samples
+// nearest the start-up transient. Error if batches < 2 or there are fewer samples than batches.
+double batch_means_standard_error(const std::vector<double>& x, size_t batches);
+
+// Student-t confidence interval of the mean of independent samples (e.g. the members of an ensemble):
+// mean +- t_{(1+level)/2, n-1} s / sqrt(n), with s the sample standard deviation (n - 1 denominator).
+struct ConfidenceInterval {
+  size_t n = 0;
+  double mean = 0;        // NaN if n = 0
+  double std = 0;         // sample standard deviation; NaN if n < 2
+  double t_quantile = 0;  // t_{(1+level)/2, n-1}; NaN if n < 2
+  double half_width = 0;  // t_quantile * std / sqrt(n); NaN if n < 2
+};
+// Error if level is not in (0, 1) or a sample is not finite.
+ConfidenceInterval student_t_interval(const std::vector<double>& x, double level = 0.95);
+
 // Sample step of a time column: (t_last - t_first) / (n - 1); Error if fewer than 2 samples, not increasing, or
 // not uniform to 1 % (the averages above assume a fixed step).
 double uniform_step(const std::vector<double>& t, const char* what);

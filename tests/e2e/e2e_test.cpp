@@ -127,6 +127,86 @@ TEST_F(TinyCase, SeriesFramesAndVideoAgreeWithTheSettings) {
   EXPECT_TRUE(std::isfinite(summary["mean_surge_ice_load_N"].get<double>()));
 }
 
+// Runs a command line (already quoted) with its output into `log`; returns the exit code and the output.
+RunOutput run_logged(const std::string& cmd, const fs::path& log) {
+  const int status = std::system((cmd + " > '" + log.string() + "' 2>&1").c_str());
+  std::ifstream in(log);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : 1, ss.str()};
+}
+
+// The sweep gather on a real transit as a one-member plan: its row is the run's summary, and the series it takes
+// the standard error from (the plot stage's steady part) has the summary's mean, to round-off. The tiny case's
+// own transit meets no ice in its 6 s, so this one runs 40 s through the same floes (about 2 s of simulation).
+TEST_F(TinyCase, GatherOfARealTransitAgreesWithItsSummary) {
+  ASSERT_EQ(first_.code, 0) << first_.text;
+  const fs::path dir = root_ / "gather";
+  fs::create_directories(dir);
+  std::ofstream(dir / "simulate.json") << R"({"duration_s": 40.0, "output_interval_s": 1.0, "steady_start_s": 10.0,
+    "vessel": {"heading_deg": 0.0, "initial_speed_mps": 2.0, "x_m": 10.0, "y_m": 82.0}})";
+  const RunOutput sim = run_logged("'" + (kBin / "floesim-simulate").string() + "' --floes '" +
+                                       (run_ / "floes" / "floes.geojson").string() + "' --hull '" +
+                                       (run_ / "hull" / "hull.obj").string() + "' --config '" +
+                                       (dir / "simulate.json").string() + "' --out '" + (dir / "sim").string() + "'",
+                                   dir / "simulate.log");
+  ASSERT_EQ(sim.code, 0) << sim.text;
+
+  const fs::path summary_file = dir / "sim" / "summary.json", results_file = dir / "sim" / "results.h5";
+  const Json stage = {{"name", "simulate"},
+                      {"outputs", {results_file.string(), summary_file.string()}},
+                      {"log", (dir / "simulate.log").string()}};
+  const Json plan = {{"format", "floesim-sweep-plan/1"},
+                     {"name", "tiny-40s"},
+                     {"axes", Json::array()},
+                     {"grid_points", Json::array({{{"index", 0}, {"axes", Json::object()}}})},
+                     {"members", Json::array({{{"id", "transit"},
+                                               {"grid_point", 0},
+                                               {"ensemble_index", 0},
+                                               {"axes", Json::object()},
+                                               {"summary", summary_file.string()},
+                                               {"results", results_file.string()},
+                                               {"stages", Json::array({stage})}}})}};
+  std::ofstream(dir / "plan.json") << plan.dump(2);
+  const RunOutput gather = run_logged("'" + (kBin / "floesim-gather").string() + "' --plan '" +
+                                          (dir / "plan.json").string() + "' --out '" + dir.string() + "'",
+                                      dir / "gather.log");
+  ASSERT_EQ(gather.code, 0) << gather.text;
+
+  const Json summary = load_json_file(summary_file);
+  const Json gathered = load_json_file(dir / "sweep.json");
+  const Json& row = gathered["members"][0];
+  ASSERT_EQ(row["status"], "ok") << row.dump(2);
+  const double mean_kN = summary["mean_surge_ice_resistance_N"].get<double>() / 1000.0;
+  ASSERT_GT(mean_kN, 10.0) << "the transit should meet ice";
+  EXPECT_EQ(row["mean_surge_ice_resistance_kN"].get<double>(), mean_kN);
+  EXPECT_EQ(row["mean_speed_mps"].get<double>(), summary["mean_vessel_speed_mps"].get<double>());
+  for (const char* mode : {"bending", "radial", "splitting"})
+    EXPECT_EQ(row[std::string("fracture_") + mode], summary["fracture"]["events"][mode]) << mode;
+  // The same samples: the summary's steady part (t >= steady_start_s) is the gather's.
+  EXPECT_EQ(row["steady_series"]["samples"], summary["steady_part"]["samples"]);
+  // Summed in another order and unit (N against kN): equal to round-off, against the size of the signal.
+  const double spread_kN = summary["std_surge_ice_load_N"].get<double>() / 1000.0;
+  EXPECT_NEAR(row["steady_series"]["mean_kN"].get<double>(), mean_kN, 1e-12 * (std::abs(mean_kN) + spread_kN));
+  // A correlated signal: the batch-means SE is positive and well below the spread of the signal itself.
+  const double se = row["batch_means_se_kN"].get<double>();
+  EXPECT_GT(se, 0.0);
+  EXPECT_LT(se, spread_kN);
+  // The 0.5 s peak: the summary's 0.5 s window is a 50-sample boxcar, the gather's the centred 51-tap average with
+  // half-weighted ends (signal.h); the same span, so nearly the same peak.
+  const double summary_peak_kN = summary["moving_average_surge_ice_load"][0]["max_resistance_N"].get<double>() / 1e3;
+  ASSERT_EQ(summary["moving_average_surge_ice_load"][0]["window_s"].get<double>(), 0.5);
+  EXPECT_NEAR(row["peak_0.5s_resistance_kN"].get<double>(), summary_peak_kN, 0.02 * summary_peak_kN);
+  // The CSV carries the speed exactly as summary.json writes it.
+  std::ifstream csv_in(dir / "sweep.csv");
+  std::string header, line;
+  std::getline(csv_in, header);
+  std::getline(csv_in, line);
+  EXPECT_NE(line.find("," + summary["mean_vessel_speed_mps"].dump() + ","), std::string::npos) << line;
+  for (const char* f : {"ensemble.png", "ensemble.svg", "running_mean.png", "running_mean.svg"})
+    EXPECT_GT(fs::file_size(dir / f), 0u) << f;
+}
+
 TEST_F(TinyCase, RerunWithNothingChangedDoesNothing) {
   ASSERT_EQ(first_.code, 0) << first_.text;
   const auto t_results = mtime(run_ / "sim" / "results.h5");

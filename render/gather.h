@@ -1,0 +1,148 @@
+// The sweep gather stage: after `floesim sweep` has run the members of a sweep (the points of a grid of case
+// values, each run as an ensemble of seeds), it reads the sweep's plan (RUN/plan.json), gathers every member's
+// summary and results into one table (sweep.csv, sweep.json) with ensemble statistics per grid point, and plots
+// the mean ice resistance against each axis with 95 % confidence intervals, and the running mean of one member
+// (was the run long enough?). Members that failed are listed with the tail of their failed stage's log; they do
+// not stop the gather.
+// floesim-gather is a thin main over gather_sweep().
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "pipeline/options.h"
+#include "pipeline/results_io.h"
+#include "render/signal.h"
+
+namespace floesim::render {
+
+inline constexpr const char* kSweepPlanFormat = "floesim-sweep-plan/1";
+
+// Batches for the batch-means standard error of a member's mean. Schmeiser (1982, "Batch size effects in the
+// analysis of simulation output", Oper. Res. 30(3)) finds 10 to 30 batches a good choice: fewer leave the error
+// estimate itself too uncertain (few degrees of freedom), more make each batch too short for the batch means of a
+// correlated series to be independent.
+inline constexpr size_t kBatchMeansBatches = 20;
+// Window of the peak resistance: PHYSICS.md §5's moving average for compliant contacts.
+inline constexpr double kPeakWindowS = 0.5;
+// Non-empty log lines quoted for a failed member.
+inline constexpr size_t kErrorLogLines = 3;
+
+// ---- The plan (written by floesim sweep) ----
+
+struct PlanAxis {
+  std::string key;           // a case key path, e.g. "simulate.vessel.propulsion.speed_mps"
+  std::vector<Json> values;  // numbers, strings or booleans, in sweep order
+};
+
+struct PlanStage {
+  std::string name;                             // "synth", "digitise", ... (the member's stages are in run order)
+  std::vector<std::filesystem::path> outputs;   // the artefacts it makes
+  std::filesystem::path log;                    // its stdout and stderr ("" if the plan gives none)
+  std::filesystem::path wall_ms;                // one integer: milliseconds it took ("" if the plan gives none)
+};
+
+struct PlanMember {
+  std::string id;               // e.g. "g000-e00"
+  size_t grid_point = 0;        // index into SweepPlan::grid_points
+  size_t ensemble_index = 0;
+  Json axes = Json::object();   // axis key -> value (those of its grid point)
+  Json seeds = Json::object();  // key the ensemble set -> value (may be empty)
+  std::filesystem::path dir, summary, results;
+  std::vector<PlanStage> stages;
+};
+
+struct PlanGridPoint {
+  size_t index = 0;
+  Json axes = Json::object();  // axis key -> value
+};
+
+struct SweepPlan {
+  std::string name;
+  std::string sweep_file;      // informational ("" if absent)
+  std::vector<PlanAxis> axes;  // empty: a pure ensemble
+  Json ensemble = nullptr;     // informational, copied into sweep.json
+  std::vector<PlanGridPoint> grid_points;
+  std::vector<PlanMember> members;
+};
+
+// Reads a plan: format "floesim-sweep-plan/1" (any other is an error), then every problem at once, each naming the
+// file and the key path ("plan.json: members[2].summary is missing"). Keys the reader does not know are ignored:
+// the plan is written by a program, not by hand, and an incompatible change bumps the format. Relative paths are
+// taken from the plan's folder.
+SweepPlan read_sweep_plan(const std::filesystem::path& file);
+
+// ---- One member's resistance series ----
+
+// The steady part of the surge ice resistance, exactly as the plot stage averages it: -Fx of the ice load in kN
+// (surge_ice_resistance_kN) at the samples with t >= the results attribute steady_start_s (0 if absent).
+struct SteadyResistance {
+  double steady_start_s = 0;
+  double time_step_s = 0;
+  std::vector<double> time_s;
+  std::vector<double> resistance_kN;
+};
+// Error naming `source` if the series is malformed or has no sample at or after the steady start.
+SteadyResistance steady_resistance(const Results& r, const std::string& source);
+
+struct ResistanceStats {
+  double steady_start_s = 0;
+  double time_step_s = 0;
+  size_t samples = 0;
+  double mean_kN = 0;                // the plot stage's mean, bit for bit
+  size_t batches = 0;
+  size_t batch_samples = 0;          // floor(samples / batches)
+  size_t dropped_samples = 0;        // the remainder, dropped at the start of the steady part
+  double batch_means_se_kN = 0;      // NaN if samples < batches
+  double peak_window_s = 0;
+  size_t peak_window_samples = 0;
+  double peak_kN = 0;                // largest centred moving average, full windows only; NaN if none fits
+};
+ResistanceStats resistance_stats(const SteadyResistance& s, size_t batches = kBatchMeansBatches,
+                                 double peak_window_s = kPeakWindowS);
+
+// ---- Gathering ----
+
+struct MemberResult {
+  std::string id;
+  size_t grid_point = 0;
+  size_t ensemble_index = 0;
+  bool ok = false;            // summary.json and results.h5 both readable
+  std::string error;          // failed: the last non-empty lines of the failed stage's log, or "not run"
+  std::string failed_stage;   // the stage whose log `error` quotes ("" if none)
+  std::filesystem::path failed_log;
+  // From summary.json (NaN / 0 for a failed member).
+  double mean_resistance_kN = 0;   // mean_surge_ice_resistance_N / 1000
+  double mean_speed_mps = 0;       // mean_vessel_speed_mps
+  int64_t fracture_bending = 0, fracture_radial = 0, fracture_splitting = 0;
+  ResistanceStats series;          // from results.h5
+  double wall_s = 0;               // sum of the stages' wall_ms / 1000; NaN if none was recorded
+};
+
+struct GridPointResult {
+  size_t index = 0;
+  Json axes = Json::object();
+  size_t n_members = 0;
+  ConfidenceInterval ci;  // of the ok members' mean resistance (kN); ci.n = number of ok members
+};
+
+struct GatherResult {
+  std::vector<std::string> columns;  // of sweep.csv
+  std::vector<MemberResult> members;  // in plan order
+  std::vector<GridPointResult> grid_points;
+  std::vector<std::string> files;  // written into the output directory
+};
+
+// Writes OUT/sweep.csv, OUT/sweep.json and the plots (PNG and SVG): resistance_vs_<axis>.* per axis (or
+// ensemble.* for a pure ensemble) and running_mean.* for the first ok member; plots need at least one ok member.
+// Each file appears only when all are complete. Failed members do not make it fail; a broken plan or a plotting
+// failure does. `plan_file` is hashed into the provenance.
+GatherResult gather_sweep(const SweepPlan& plan, const std::filesystem::path& plan_file,
+                          const std::filesystem::path& out_dir);
+GatherResult gather_sweep(const std::filesystem::path& plan_file, const std::filesystem::path& out_dir);
+
+// The short report floesim-gather prints: per grid point mean +- 95 % CI and ok/n, then the failed members.
+std::string gather_table(const SweepPlan& plan, const GatherResult& g);
+
+}  // namespace floesim::render

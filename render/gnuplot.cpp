@@ -1,0 +1,72 @@
+#include "render/gnuplot.h"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "pipeline/error.h"
+
+extern char** environ;
+
+namespace floesim::render {
+
+namespace fs = std::filesystem;
+
+#ifndef FLOESIM_GNUPLOT
+#error "FLOESIM_GNUPLOT (the gnuplot executable) must be defined by the build"
+#endif
+
+std::string gnuplot_quoted(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("''") : std::string(1, c);
+  return out + "'";
+}
+
+namespace {
+
+// Runs a program without a shell, stdout and stderr into `log`; returns its exit status.
+int run_program(const std::vector<std::string>& args, const fs::path& log) {
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
+  std::vector<char*> argv;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, args[0].c_str(), &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  FLOESIM_REQUIRE(rc == 0, "cannot start ", args[0], ": ", std::strerror(rc));
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0)
+    FLOESIM_REQUIRE(errno == EINTR, "waiting for ", args[0], " failed: ", std::strerror(errno));
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+void run_gnuplot(const fs::path& script, const fs::path& log, const std::vector<fs::path>& images,
+                 const std::string& what) {
+  const int rc = run_program({FLOESIM_GNUPLOT, script.string()}, log);
+  FLOESIM_REQUIRE(rc == 0, "gnuplot (", FLOESIM_GNUPLOT, ") failed with exit status ", rc, " drawing ", what, ":\n",
+                  read_text(log));
+  for (const fs::path& image : images) {
+    std::error_code ec;
+    FLOESIM_REQUIRE(fs::file_size(image, ec) > 0 && !ec, "gnuplot wrote no image drawing ", what, ":\n",
+                    read_text(log));
+  }
+}
+
+}  // namespace floesim::render
