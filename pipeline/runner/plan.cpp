@@ -261,13 +261,22 @@ std::string stage_script(const std::vector<PlannedStage>& stages, size_t k, Stag
       for (auto& d : dirty) depends = depends || in == d;
     if (depends) dirty.insert(dirty.end(), stages[j].outputs.begin(), stages[j].outputs.end());
   }
-  std::string rm = "rm -f";
-  for (auto& p : dirty) rm += " " + shell_quote(p.string());
   const PlannedStage& s = stages[k];
-  if (output == StageOutput::console) return rm + " && " + shell_command(s);
+  if (output == StageOutput::console) {
+    std::string rm = "rm -f";
+    for (auto& p : dirty) rm += " " + shell_quote(p.string());
+    return rm + " && " + shell_command(s);
+  }
+  // A sweep's stage is shared by members that come and go: the list of what lies downstream of it is a file
+  // beside it (written with its settings), so that a new member does not change its command and rerun it.
+  std::string list;
+  for (auto& p : dirty) list += p.string() + "\n";
+  write_if_changed(s.dir / "downstream.txt", list);
   const std::string log = shell_quote((s.dir / "log.txt").string()), wall = shell_quote((s.dir / "wall_ms").string());
+  const std::string rm = "tr '\\n' '\\0' < " + shell_quote((s.dir / "downstream.txt").string()) +
+                         " | xargs -0 rm -f && rm -f " + wall;
   // POSIX sh: the wall time from date +%s%N (GNU date: nanoseconds), written after the stage whatever its outcome.
-  return rm + " " + wall + " && t0=$(date +%s%N) && { " + shell_command(s) + " > " + log +
+  return rm + " && t0=$(date +%s%N) && { " + shell_command(s) + " > " + log +
          " 2>&1; rc=$?; echo $(( ($(date +%s%N) - t0) / 1000000 )) > " + wall + "; [ $rc -eq 0 ] || { tail -n 15 " +
          log + " >&2; exit $rc; }; }";
 }

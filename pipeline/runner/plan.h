@@ -59,7 +59,9 @@ enum class StageOutput {
 };
 
 // The shell command that runs stage k of `stages`: first removes its outputs and those of every stage downstream
-// of them (a failed stage then leaves nothing that looks complete), then runs it.
+// of them (a failed stage then leaves nothing that looks complete), then runs it. `logged` keeps that list in
+// DIR/downstream.txt (written here), out of the command: a sweep's shared stage keeps its command, and so is not
+// rerun, when members are added downstream of it.
 std::string stage_script(const std::vector<PlannedStage>& stages, size_t k, StageOutput output);
 
 // Writes a Ninja file with one edge per stage (outputs <- inputs | executable) and the given description per stage;

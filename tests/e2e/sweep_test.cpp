@@ -83,7 +83,8 @@ std::vector<std::map<std::string, std::string>> read_csv(const fs::path& p) {
 std::map<fs::path, fs::file_time_type> stage_files(const fs::path& run) {
   std::map<fs::path, fs::file_time_type> out;
   for (const auto& e : fs::recursive_directory_iterator(run / "stages"))
-    if (e.is_regular_file() && e.path().filename() != "log.txt" && e.path().filename() != "wall_ms")
+    if (e.is_regular_file() && e.path().filename() != "log.txt" && e.path().filename() != "wall_ms" &&
+        e.path().filename() != "downstream.txt")  // the runner's list of what lies downstream, not a result
       out[e.path()] = fs::last_write_time(e.path());
   return out;
 }
