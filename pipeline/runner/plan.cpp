@@ -75,6 +75,28 @@ fs::path self_dir() {
   return ec ? fs::current_path() : p.parent_path();
 }
 
+std::string run_folder(const std::string& stage) {
+  static const std::map<std::string, std::string> folder = {{"synth", "image"},  {"digitise", "floes"},
+                                                            {"hull", "hull"},    {"simulate", "sim"},
+                                                            {"render", "video"}, {"plot", "plots"}};
+  return folder.at(stage);
+}
+
+void absolute_case_files(Json& c, const fs::path& case_dir) {
+  auto fix = [&](Json* j, const char* key) {
+    if (j && j->is_object() && j->contains(key) && (*j)[key].is_string()) {
+      const fs::path p = (*j)[key].get<std::string>();
+      if (p.is_relative()) (*j)[key] = (fs::absolute(case_dir) / p).lexically_normal().string();
+    }
+  };
+  auto at = [](Json& j, const char* key) { return j.is_object() && j.contains(key) ? &j[key] : nullptr; };
+  fix(at(c, "image"), "file");
+  fix(at(c, "floes"), "file");
+  fix(at(c, "hull"), "file");
+  if (Json* s = at(c, "simulate"))
+    if (Json* v = at(*s, "vessel")) fix(at(*v, "propulsion"), "thrust_file");
+}
+
 CasePlan plan_case(const Json& c, const fs::path& case_file, const fs::path& case_dir, const fs::path& bin,
                    const StageLayout& layout, bool render) {
   const std::string cf = case_file.string();

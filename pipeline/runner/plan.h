@@ -70,6 +70,13 @@ void write_ninja(const std::filesystem::path& file, const std::string& header,
                  const std::vector<PlannedStage>& stages, const std::vector<std::string>& descriptions,
                  StageOutput output);
 
+// The folder of a stage's outputs in a run folder: image, floes, hull, sim, video, plots.
+std::string run_folder(const std::string& stage);
+
+// The case's own files (image.file, floes.file, hull.file, simulate.vessel.propulsion.thrust_file) made absolute
+// against case_dir, so that the case can be run from another folder.
+void absolute_case_files(nlohmann::json& c, const std::filesystem::path& case_dir);
+
 // Writes text only if the file's content differs, so that its modification time marks real changes only.
 void write_if_changed(const std::filesystem::path& file, const std::string& text);
 

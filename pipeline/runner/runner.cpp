@@ -31,10 +31,8 @@ std::vector<Artefact> prepare_run(const RunOptions& o) {
   const fs::path run = fs::absolute(o.run_dir);
   const fs::path bin = o.bin_dir.empty() ? self_dir() : fs::absolute(o.bin_dir);
   // One run: each stage in its fixed folder, its settings in config/<stage>.json.
-  const std::map<std::string, std::string> folder = {{"synth", "image"},    {"digitise", "floes"}, {"hull", "hull"},
-                                                     {"simulate", "sim"},   {"render", "video"},   {"plot", "plots"}};
   StageLayout layout;
-  layout.dir = [&](const std::string& stage, const std::string&) { return run / folder.at(stage); };
+  layout.dir = [&](const std::string& stage, const std::string&) { return run / run_folder(stage); };
   layout.config = [&](const std::string& stage, const std::string&) { return run / "config" / (stage + ".json"); };
   const CasePlan plan = plan_case(c, case_file, o.case_dir, bin, layout);
   ensure_directory(run / "config");

@@ -156,8 +156,6 @@ void write_sweep_files(const Sweep& s, const std::vector<Member>& members, const
     ensure_directory(st.dir);
     write_if_changed(st.config, st.config_text);
   }
-  const std::map<std::string, std::string> folder = {{"synth", "image"},    {"digitise", "floes"}, {"hull", "hull"},
-                                                     {"simulate", "sim"},   {"render", "video"},   {"plot", "plots"}};
   Json plan_members = Json::array();
   for (size_t m = 0; m < members.size(); ++m) {
     const Member& mb = members[m];
@@ -168,7 +166,7 @@ void write_sweep_files(const Sweep& s, const std::vector<Member>& members, const
     for (int k : p.member_stages[m]) {
       const PlannedStage& st = p.stages[k];
       // A link replaced atomically: made under a temporary name, renamed over the old one.
-      const fs::path link = dir / folder.at(st.name), tmp = dir / (folder.at(st.name) + ".tmp-link");
+      const fs::path link = dir / run_folder(st.name), tmp = dir / (run_folder(st.name) + ".tmp-link");
       std::error_code ec;
       fs::remove(tmp, ec);
       fs::create_directory_symlink(fs::path("../../stages") / st.dir.filename(), tmp);
@@ -622,6 +620,7 @@ std::vector<Member> expand_members(const Sweep& s, const Json& base_case) {
       }
       for (auto it = m.seeds.begin(); it != m.seeds.end(); ++it)
         set_key_path(m.case_json, it.key(), *it, f + ": ensemble");
+      absolute_case_files(m.case_json, s.base_dir);  // a member's case.json runs from its own folder too
       out.push_back(m);
     }
   }
