@@ -97,9 +97,9 @@ void absolute_case_files(Json& c, const fs::path& case_dir) {
     if (Json* v = at(*s, "vessel")) fix(at(*v, "propulsion"), "thrust_file");
 }
 
-CasePlan plan_case(const Json& c, const fs::path& case_file, const fs::path& case_dir, const fs::path& bin,
+CasePlan plan_case(const Json& c, const std::string& where, const fs::path& case_dir, const fs::path& bin,
                    const StageLayout& layout, bool render) {
-  const std::string cf = case_file.string();
+  const std::string& cf = where;
   FLOESIM_REQUIRE(c.is_object(), cf, ": the top level must be an object");
   const std::vector<std::string> known = {"description", "image", "digitise", "floes", "hull", "simulate", "render",
                                           "plot"};

@@ -41,9 +41,9 @@ struct CasePlan {
 };
 
 // The stages a case runs; `render` false leaves out the video. Validates the case's top level and its own files
-// (relative names resolve against case_dir); errors name `case_file`. Stage settings are checked by the stages
-// (`--check-config`), not here.
-CasePlan plan_case(const nlohmann::json& c, const std::filesystem::path& case_file,
+// (relative names resolve against case_dir); errors begin with `where` (the case file, or a sweep's member). Stage
+// settings are checked by the stages themselves (`--check-config`), not here.
+CasePlan plan_case(const nlohmann::json& c, const std::string& where,
                    const std::filesystem::path& case_dir, const std::filesystem::path& bin,
                    const StageLayout& layout, bool render = true);
 

@@ -34,7 +34,7 @@ std::vector<Artefact> prepare_run(const RunOptions& o) {
   StageLayout layout;
   layout.dir = [&](const std::string& stage, const std::string&) { return run / run_folder(stage); };
   layout.config = [&](const std::string& stage, const std::string&) { return run / "config" / (stage + ".json"); };
-  const CasePlan plan = plan_case(c, case_file, o.case_dir, bin, layout);
+  const CasePlan plan = plan_case(c, case_file.string(), o.case_dir, bin, layout);
   ensure_directory(run / "config");
   std::vector<std::string> descriptions;
   for (const PlannedStage& s : plan.stages) {
