@@ -46,7 +46,8 @@ struct ResistanceOptions {
   template <class V>
   void visit(V& v) {
     v.field("model", model, "-",
-            "quadratic (R = a u + b u|u|, a fit of trials) | ittc57 (R = 1/2 rho S u|u| ((1 + k) C_F(Re) + C_A))",
+            "quadratic (R = a u + b u abs(u), a fit of trials) or ittc57 (R = 1/2 rho S u abs(u) ((1 + k) C_F(Re) + "
+            "C_A), the simulator's curve)",
             one_of({"quadratic", "ittc57"}));
     v.field("a_n_per_mps", a_n_per_mps, "N/(m/s)", "quadratic: linear coefficient a");
     v.field("b_n_per_mps2", b_n_per_mps2, "N/(m/s)^2", "quadratic: quadratic coefficient b");
