@@ -11,6 +11,8 @@
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
 #include "pipeline/provenance.h"
+#include <Eigen/Dense>
+
 #include "render/signal.h"
 #include "sim/model.h"
 
@@ -109,9 +111,23 @@ MeasuredSeries read_measured_csv(const fs::path& file) {
                   " (header): give all three measured accelerations du_mps2, dv_mps2, dr_radps2 or none (then they "
                   "come from differentiating the velocities)");
   const bool with_acc = n_acc == 3;
+  // IMUs: imu1.., each with both columns; they replace du/dv/dr, so both at once would be ambiguous.
+  size_t n_imu = 0;
+  for (size_t k = 1; k <= 5; ++k) {
+    const std::string ax = "imu" + std::to_string(k) + "_ax_mps2", ay = "imu" + std::to_string(k) + "_ay_mps2";
+    const bool hx = index.count(ax) > 0, hy = index.count(ay) > 0;
+    if (!hx && !hy) break;
+    FLOESIM_REQUIRE(hx && hy, f, ": line ", lineno, " (header): IMU ", k, " needs both columns ", ax, " and ", ay);
+    FLOESIM_REQUIRE(k <= 4, f, ": line ", lineno, " (header): column ", ax, ": at most 4 IMUs");
+    n_imu = k;
+  }
+  FLOESIM_REQUIRE(n_imu == 0 || !with_acc, f, ": line ", lineno,
+                  " (header): give either the accelerations du_mps2, dv_mps2, dr_radps2 or IMU columns, not both");
 
   // 2. Rows: finite numbers, plausible units, increasing time.
   MeasuredSeries m;
+  m.imu_ax_mps2.resize(n_imu);
+  m.imu_ay_mps2.resize(n_imu);
   std::vector<size_t> row_line;  // the file line of each sample, for the messages below
   while (std::getline(in, line)) {
     ++lineno;
@@ -151,6 +167,18 @@ MeasuredSeries read_measured_csv(const fs::path& file) {
       FLOESIM_REQUIRE(std::abs(m.dr_radps2[i]) <= kMaxYawAccelerationRadps2,
                       implausible(where, "dr_radps2", m.dr_radps2[i], "|dr| > 1 rad/s^2", "rad/s^2"));
     }
+    for (size_t k = 0; k < n_imu; ++k)
+      for (const char* axis : {"ax", "ay"}) {
+        const std::string col = "imu" + std::to_string(k + 1) + "_" + axis + "_mps2";
+        const std::string& c = cells[index.at(col)];
+        char* end = nullptr;
+        const double x = c.empty() ? NAN : std::strtod(c.c_str(), &end);
+        FLOESIM_REQUIRE(!c.empty() && end == c.c_str() + c.size() && std::isfinite(x), where, ", column ", col,
+                        ": '", c, "' is not a finite number");
+        FLOESIM_REQUIRE(std::abs(x) <= kMaxAccelerationMps2,
+                        implausible(where, col.c_str(), x, "|a| > 5 m/s^2; gravity not removed?", "m/s^2"));
+        (axis[1] == 'x' ? m.imu_ax_mps2 : m.imu_ay_mps2)[k].push_back(x);
+      }
     FLOESIM_REQUIRE(i == 0 || m.time_s[i] > m.time_s[i - 1], where, ", column time_s: ", m.time_s[i],
                     " s is not after the previous sample's ", i == 0 ? 0.0 : m.time_s[i - 1],
                     " s (time must increase strictly: sort the rows or drop the repeated ones)");
@@ -171,6 +199,32 @@ MeasuredSeries read_measured_csv(const fs::path& file) {
                     " s (more than 1.5 x the median step ", median,
                     " s): identify the parts either side of the gap separately");
   return m;
+}
+
+Load3 combine_imus(const std::vector<ImuSample>& imus, double r, double r_dot) {
+  FLOESIM_REQUIRE(!imus.empty(), "combine_imus: no IMU");
+  // b_k = a_k + r^2 p_k = a_G + r_dot z x p_k, with z x p = (-p_y, p_x): linear in (a_Gx, a_Gy, r_dot).
+  bool distinct = false;
+  for (const ImuSample& s : imus)
+    distinct = distinct || std::hypot(s.x_m - imus[0].x_m, s.y_m - imus[0].y_m) > 1e-6;
+  if (!distinct) {  // r_dot is unobservable from one point: use the one given
+    double ax = 0, ay = 0;
+    for (const ImuSample& s : imus) {
+      ax += s.ax_mps2 + r * r * s.x_m + r_dot * s.y_m;
+      ay += s.ay_mps2 + r * r * s.y_m - r_dot * s.x_m;
+    }
+    return {ax / double(imus.size()), ay / double(imus.size()), r_dot};
+  }
+  // Least squares by the normal equations; rows (1, 0, -p_y) and (0, 1, p_x) per IMU.
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+  for (const ImuSample& s : imus) {
+    const Eigen::Vector3d rx(1, 0, -s.y_m), ry(0, 1, s.x_m);
+    ata += rx * rx.transpose() + ry * ry.transpose();
+    atb += rx * (s.ax_mps2 + r * r * s.x_m) + ry * (s.ay_mps2 + r * r * s.y_m);
+  }
+  const Eigen::Vector3d x = ata.ldlt().solve(atb);
+  return {x[0], x[1], x[2]};
 }
 
 double open_water_resistance(double u, const ResistanceOptions& o) {
@@ -214,7 +268,11 @@ Identification identify(const MeasuredSeries& m, const IdentifyOptions& o) {
                   " s is longer than the output interval ", T, " s (filters.output_interval_s): lengthen it");
   FLOESIM_REQUIRE(m.time_s.back() - m.time_s.front() >= T * (1 - 1e-9), "identify: the series lasts ",
                   m.time_s.back() - m.time_s.front(), " s, less than one output interval of ", T, " s");
-  id.differentiated = !m.has_accelerations();
+  const size_t n_imu = m.imu_ax_mps2.size();
+  FLOESIM_REQUIRE(n_imu == o.imus.size(), "the measured data give ", n_imu, " IMU(s) (columns imu<k>_ax_mps2, "
+                  "imu<k>_ay_mps2) but the config's imus lists ", o.imus.size(), ": give one position per IMU");
+  id.from_imus = n_imu > 0;
+  id.differentiated = !m.has_accelerations() && !id.from_imus;
   auto derivative = [&](const std::vector<double>& x) {
     std::vector<double> d(n);
     d[0] = (x[1] - x[0]) / (m.time_s[1] - m.time_s[0]);
@@ -225,6 +283,20 @@ Identification identify(const MeasuredSeries& m, const IdentifyOptions& o) {
   std::vector<double> du = id.differentiated ? derivative(m.u_mps) : m.du_mps2;
   std::vector<double> dv = id.differentiated ? derivative(m.v_mps) : m.dv_mps2;
   std::vector<double> dr = id.differentiated ? derivative(m.r_radps) : m.dr_radps2;
+  if (id.from_imus) {
+    // IMUs measure the inertial acceleration in body axes, a_G = nu_dot + [-r v, r u]: hence nu_dot.
+    const std::vector<double> r_dot = derivative(m.r_radps);
+    du.assign(n, 0.0), dv.assign(n, 0.0), dr.assign(n, 0.0);
+    std::vector<ImuSample> at(n_imu);
+    for (size_t i = 0; i < n; ++i) {
+      for (size_t k = 0; k < n_imu; ++k)
+        at[k] = {o.imus[k].position_m[0], o.imus[k].position_m[1], m.imu_ax_mps2[k][i], m.imu_ay_mps2[k][i]};
+      const Load3 a = combine_imus(at, m.r_radps[i], r_dot[i]);
+      du[i] = a.surge + m.r_radps[i] * m.v_mps[i];
+      dv[i] = a.sway - m.r_radps[i] * m.u_mps[i];
+      dr[i] = a.yaw;
+    }
+  }
   id.acceleration_window_samples = render::window_samples(o.filters.acceleration_window_s, id.median_step_s);
   du = render::moving_average_centred(du, id.acceleration_window_samples);
   dv = render::moving_average_centred(dv, id.acceleration_window_samples);
@@ -235,7 +307,13 @@ Identification identify(const MeasuredSeries& m, const IdentifyOptions& o) {
   s.time_s = m.time_s;
   s.u_mps = m.u_mps;
   for (size_t i = 0; i < n; ++i) {
-    const Load3 inertia{o.mass.surge_kg * du[i], o.mass.sway_kg * dv[i], o.mass.yaw_kg_m2 * dr[i]};
+    Load3 inertia{o.mass.surge_kg * du[i], o.mass.sway_kg * dv[i], o.mass.yaw_kg_m2 * dr[i]};
+    if (o.coriolis) {  // + C(nu) nu of the diagonal M (Fossen 2011, rigid body and added mass lumped)
+      const double u = m.u_mps[i], v = m.v_mps[i], r = m.r_radps[i];
+      inertia.surge += -o.mass.sway_kg * v * r;
+      inertia.sway += o.mass.surge_kg * u * r;
+      inertia.yaw += (o.mass.sway_kg - o.mass.surge_kg) * u * v;
+    }
     const Load3 thrust{m.thrust_n[i], 0, 0};
     const Load3 hydro{-open_water_resistance(m.u_mps[i], o.resistance), -o.damping.sway_n_per_mps * m.v_mps[i],
                       -o.damping.yaw_nm_per_radps * m.r_radps[i]};
@@ -337,7 +415,9 @@ std::string run_identify(const fs::path& measured_file, const fs::path& config_f
   j["mean_samples"] = id.mean_samples;
   j["samples"] = m.time_s.size();
   j["median_step_s"] = id.median_step_s;
-  j["accelerations"] = id.differentiated ? "central differences of the velocities" : "measured";
+  j["accelerations"] = id.differentiated ? "central differences of the velocities"
+                      : id.from_imus     ? "IMUs combined to the centre of gravity"
+                                         : "measured";
   j["acceleration_window_samples"] = id.acceleration_window_samples;
   j["output_samples"] = id.output.time_s.size();
   j["sign_convention"] =
@@ -355,7 +435,8 @@ std::string run_identify(const fs::path& measured_file, const fs::path& config_f
   rep << std::fixed << std::setprecision(1);
   rep << "floesim-identify: " << m.time_s.size() << " samples, median step " << std::setprecision(4)
       << id.median_step_s << " s, accelerations "
-      << (id.differentiated ? "from central differences" : "measured") << ", moving average of "
+      << (id.differentiated ? "from central differences" : id.from_imus ? "from the IMUs" : "measured")
+      << ", moving average of "
       << id.acceleration_window_samples << " samples\n";
   rep << std::setprecision(1) << "mean surge ice load " << id.mean_ice.surge / 1e3 << " kN (resistance "
       << -id.mean_ice.surge / 1e3 << " kN) over " << id.mean_t0_s << " to " << id.mean_t1_s << " s\n";

@@ -110,6 +110,22 @@ struct IdentifyFilterOptions {
   }
 };
 
+// An IMU of the ship: its position relative to the centre of gravity; its accelerations are the CSV columns
+// imu<k>_ax_mps2, imu<k>_ay_mps2 (k = 1.. in list order).
+struct ImuOptions {
+  std::vector<double> position_m;  // [x, y] from the centre of gravity, body axes (x forward, y to port)
+  template <class V>
+  void visit(V& v) {
+    v.field("position_m", position_m, "m",
+            "[x, y] of the IMU from the centre of gravity, body axes (x forward, y to port)",
+            Check<std::vector<double>>([](const std::vector<double>& p) -> std::string {
+              if (p.size() != 2) return "must be [x, y] (2 numbers)";
+              if (!std::isfinite(p[0]) || !std::isfinite(p[1])) return "must be finite numbers";
+              return "";
+            }));
+  }
+};
+
 struct IdentifyOptions {
   IdentifyMassOptions mass;
   ResistanceOptions resistance;
@@ -117,6 +133,8 @@ struct IdentifyOptions {
   IdentifyWindOptions wind;
   IdentifyFilterOptions filters;
   std::vector<double> mean_window_s;  // [t0, t1] of the mean; empty = the whole series
+  bool coriolis = false;              // add Fossen's C(nu) nu of the diagonal M to M nu_dot
+  std::vector<ImuOptions> imus;       // IMUs whose accelerations the CSV gives (imu<k>_ax_mps2, imu<k>_ay_mps2)
   template <class V>
   void visit(V& v) {
     v.section("mass", mass, "diagonal mass matrix, surge/sway/yaw");
@@ -132,25 +150,46 @@ struct IdentifyOptions {
               if (!std::isfinite(w[0]) || !std::isfinite(w[1]) || !(w[0] < w[1])) return "must have t0 < t1";
               return "";
             }));
+    v.field("coriolis", coriolis, "-",
+            "add the Coriolis-centripetal terms of the diagonal M (Fossen): C(nu) nu = [-M22 v r, M11 u r, "
+            "(M22 - M11) u v]; false = M nu_dot alone, as in the seed's model (matters in turns: M22 r u)");
+    v.list("imus", imus,
+           "up to 4 IMUs (positions); the CSV then gives imu<k>_ax_mps2, imu<k>_ay_mps2 (k = 1..), the horizontal "
+           "accelerations each measures (gravity removed), combined to the centre of gravity; [] = none");
+    if (imus.size() > 4) v.problem("imus", "has " + std::to_string(imus.size()) + " IMUs, at most 4");
   }
 };
 
+// A surge/sway/yaw triple (N, N, N m), body axes.
+struct Load3 {
+  double surge = 0, sway = 0, yaw = 0;
+};
+
 // The measured series (one entry per CSV row), checked. Accelerations are empty when the file has none.
+// du/dv/dr are the time derivatives of u, v, r (nu_dot); an IMU at the centre of gravity measures u_dot - r v and
+// v_dot + r u instead (give the IMU columns, which are converted, or correct the columns first).
 struct MeasuredSeries {
   std::vector<double> time_s, u_mps, v_mps, r_radps, thrust_n, wind_speed_mps, wind_angle_deg;
   std::vector<double> du_mps2, dv_mps2, dr_radps2;
+  std::vector<std::vector<double>> imu_ax_mps2, imu_ay_mps2;  // per IMU (k = 1.. in order), per sample
   bool has_accelerations() const { return !du_mps2.empty(); }
 };
 
 // Reads and checks the measured CSV: header with the required columns (any order, extra ones ignored; all three
 // acceleration columns or none), finite numbers, strictly increasing time without gaps (no step > 1.5 x the median
 // step), plausible values. Errors name the file, the line and the column, and the fix.
+// IMU columns imu<k>_ax_mps2, imu<k>_ay_mps2 are read for k = 1.. while present (both of each, at most 4); they
+// exclude du/dv/dr.
 MeasuredSeries read_measured_csv(const std::filesystem::path& file);
 
-// A surge/sway/yaw triple (N, N, N m), body axes.
-struct Load3 {
-  double surge = 0, sway = 0, yaw = 0;
+// The acceleration at the centre of gravity from IMUs at positions p_k (rigid body in the plane):
+// a_k = a_G + r_dot z x p_k - r^2 p_k. With two or more IMUs at distinct positions (a_Gx, a_Gy, r_dot) by least
+// squares; with one (or all at one point) r_dot is given (differentiated yaw rate) and a_G = mean(a_k - r_dot z x
+// p_k + r^2 p_k). Returns {a_Gx, a_Gy, r_dot}: the inertial acceleration in body axes, nu_dot + [-r v, r u].
+struct ImuSample {
+  double x_m, y_m, ax_mps2, ay_mps2;
 };
+Load3 combine_imus(const std::vector<ImuSample>& imus, double r_radps, double r_dot_radps2);
 
 // Open-water resistance R(u) (N, positive opposing u > 0, odd in u).
 double open_water_resistance(double u_mps, const ResistanceOptions& o);
@@ -162,7 +201,7 @@ Load3 wind_load(double speed_mps, double angle_deg, const IdentifyWindOptions& o
 // The identified series: per input sample (full rate) and averaged per output interval.
 struct IdentifiedSeries {
   std::vector<double> time_s;
-  std::vector<Load3> inertia, thrust, hydro, wind, ice;  // inertia = M nu_dot (filtered accelerations)
+  std::vector<Load3> inertia, thrust, hydro, wind, ice;  // inertia = M nu_dot (+ C(nu) nu)
   std::vector<double> u_mps;  // averaged velocity (output series only)
 };
 struct Identification {
@@ -171,6 +210,7 @@ struct Identification {
   size_t acceleration_window_samples = 1;
   double median_step_s = 0;
   bool differentiated = false;  // accelerations from central differences of the velocities
+  bool from_imus = false;       // accelerations from the IMU columns, combined to the centre of gravity
   double mean_t0_s = 0, mean_t1_s = 0;
   size_t mean_samples = 0;
   Load3 mean_ice;  // arithmetic mean of the full-rate ice load over [mean_t0_s, mean_t1_s]
