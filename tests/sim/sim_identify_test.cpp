@@ -202,6 +202,85 @@ TEST(SimIdentify, OutputIsTheMeanOverEachInterval) {
   EXPECT_NEAR(id.mean_ice.surge, -1e5 * 10 / 26, 1e-6);
 }
 
+// Coriolis-centripetal terms of a diagonal M (Fossen), hand-worked at a steady u = 2, v = 0.1, r = 0.01 with
+// M11 = 1.3e7, M22 = 1.5e7 and no acceleration: C(nu) nu = [-M22 v r, M11 u r, (M22 - M11) u v]
+// = [-15 000 N, 260 000 N, 400 000 N m]. Thrust 500 kN against R = 1e5 u^2 = 400 kN: surge ice -115 000 N.
+TEST(SimIdentify, CoriolisTermsHandWorked) {
+  const fs::path d = temp_dir("identify_coriolis");
+  std::vector<Row> rows;
+  for (int i = 0; i <= 20; ++i) rows.push_back({i * 0.1, 2, 0.1, 0.01, 5e5, 0, 0, 0, 0, 0});
+  write_csv(d / "m.csv", rows, true);
+  IdentifyOptions o;
+  o.mass.sway_kg = 1.5e7;
+  o.resistance.model = "quadratic";
+  o.resistance.b_n_per_mps2 = 1e5;
+  o.coriolis = true;
+  const Identification id = identify(read_measured_csv(d / "m.csv"), o);
+  EXPECT_NEAR(id.mean_ice.surge, -115000, 1e-6);
+  EXPECT_NEAR(id.mean_ice.sway, 260000, 1e-6);
+  EXPECT_NEAR(id.mean_ice.yaw, 400000, 1e-6);
+  o.coriolis = false;  // the seed's M nu_dot alone: only the thrust deficit
+  const Identification plain = identify(read_measured_csv(d / "m.csv"), o);
+  EXPECT_NEAR(plain.mean_ice.surge, -100000, 1e-6);
+  EXPECT_NEAR(plain.mean_ice.sway, 0, 1e-6);
+}
+
+// Two IMUs 100 m apart on the centre line, r = 0.02 rad/s, r_dot = 0.001 rad/s^2, a_G = (0.1, 0.05) m/s^2:
+// a_k = a_G + r_dot (-p_y, p_x) - r^2 p: IMU at (50, 0) reads (0.1 - 0.0004 * 50, 0.05 + 0.001 * 50) = (0.08, 0.10);
+// at (-50, 0) reads (0.12, 0.00). Combined back: (0.1, 0.05) and r_dot 0.001 (not the 0.5 passed for one point).
+TEST(SimIdentify, CombineImusHandWorked) {
+  const Load3 a = combine_imus({{50, 0, 0.08, 0.10}, {-50, 0, 0.12, 0.0}}, 0.02, 0.5);
+  EXPECT_NEAR(a.surge, 0.1, 1e-12);
+  EXPECT_NEAR(a.sway, 0.05, 1e-12);
+  EXPECT_NEAR(a.yaw, 0.001, 1e-12);
+  // One IMU: r_dot is the one given; a_G = a + r^2 p + r_dot (p_y, -p_x) = (0.08 + 0.02, 0.10 - 0.05).
+  const Load3 b = combine_imus({{50, 0, 0.08, 0.10}}, 0.02, 0.001);
+  EXPECT_NEAR(b.surge, 0.1, 1e-12);
+  EXPECT_NEAR(b.sway, 0.05, 1e-12);
+  EXPECT_NEAR(b.yaw, 0.001, 1e-12);
+}
+
+// (1) with IMUs: the trajectory of RecoversConstantIceLoadFromVelocities (constant nu_dot), measured by IMUs that
+// read the rigid-body acceleration at their positions, a_k = nu_dot + [-r v, r u] + r_dot (-p_y, p_x) - r^2 p_k.
+TEST(SimIdentify, RecoversConstantIceLoadFromImus) {
+  const double M1 = 13e6, M2 = 13e6, M3 = 9.2864e9;
+  const Load3 ice{-2.5e5, -4e4, 3e6};
+  const Load3 w = hand_wind(15, 150, 1.3, 400, 900, 107.75, 0.7, 0.8, 0.1);
+  const double du = -0.005, dv = (ice.sway + w.sway) / M2, dr = (ice.yaw + w.yaw) / M3;
+  const std::vector<std::vector<double>> layouts[] = {{{40, 5}, {-30, -8}, {0, 10}}, {{12, -3}}};
+  for (const auto& pos : layouts) {
+    SCOPED_TRACE(pos.size());
+    const fs::path d = temp_dir("identify_imus" + std::to_string(pos.size()));
+    std::ofstream f(d / "m.csv");
+    f.precision(17);
+    f << "time_s,u_mps,v_mps,r_radps,thrust_n,wind_speed_mps,wind_angle_deg";
+    for (size_t k = 1; k <= pos.size(); ++k) f << ",imu" << k << "_ax_mps2,imu" << k << "_ay_mps2";
+    f << "\n";
+    for (int i = 0; i <= 600; ++i) {  // 30 s at 20 Hz
+      const double t = i * 0.05, u = 3 + du * t, v = -0.1 + dv * t, r = 0.01 + dr * t;
+      f << t << ',' << u << ',' << v << ',' << r << ',' << M1 * du + 1e5 * u * u - w.surge - ice.surge << ",15,150";
+      for (const auto& p : pos)
+        f << ',' << du - r * v - dr * p[1] - r * r * p[0] << ',' << dv + r * u + dr * p[0] - r * r * p[1];
+      f << "\n";
+    }
+    f.close();
+    IdentifyOptions o;
+    o.resistance.model = "quadratic";
+    o.resistance.b_n_per_mps2 = 1e5;
+    for (const auto& p : pos) o.imus.push_back({p});
+    const Identification id = identify(read_measured_csv(d / "m.csv"), o);
+    EXPECT_TRUE(id.from_imus);
+    for (size_t k = 0; k < id.output.time_s.size(); ++k) {
+      EXPECT_NEAR(id.output.ice[k].surge, ice.surge, 1e-5) << k;
+      EXPECT_NEAR(id.output.ice[k].sway, ice.sway, 1e-5) << k;
+      EXPECT_NEAR(id.output.ice[k].yaw, ice.yaw, 1e-2) << k;
+    }
+    // The config must give one position per IMU.
+    o.imus.push_back({{0, 0}});
+    expect_error([&] { identify(read_measured_csv(d / "m.csv"), o); }, {"IMU", "one position per IMU"});
+  }
+}
+
 // (3) Bad input: clear errors naming the file, the line and the column; nothing written.
 TEST(SimIdentify, BadInputNamesLineAndColumnAndWritesNothing) {
   const fs::path d = temp_dir("identify_bad");
@@ -240,6 +319,12 @@ TEST(SimIdentify, BadInputNamesLineAndColumnAndWritesNothing) {
   check("gravity", "time_s,u_mps,v_mps,r_radps,thrust_n,wind_speed_mps,wind_angle_deg,du_mps2,dv_mps2,dr_radps2\n"
                    "0,2,0,0,5e5,5,10,0,0,0\n0.1,2,0,0,5e5,5,10,0,0,0\n0.2,2,0,0,5e5,5,10,0,-9.81,0\n",
         {"line 4", "dv_mps2", "gravity"});
+  check("imu_half", head.substr(0, head.size() - 1) + ",imu1_ax_mps2\n0,2,0,0,5e5,5,10,0\n",
+        {"line 1", "imu1_ay_mps2"});
+  check("imu_and_acc", head.substr(0, head.size() - 1) + ",du_mps2,dv_mps2,dr_radps2,imu1_ax_mps2,imu1_ay_mps2\n",
+        {"line 1", "either"});
+  check("imu_gravity", head.substr(0, head.size() - 1) + ",imu1_ax_mps2,imu1_ay_mps2\n0,2,0,0,5e5,5,10,9.81,0\n",
+        {"line 2", "imu1_ax_mps2", "gravity"});
   check("cells", head + "0,2,0,0,5e5,5\n", {"line 2", "6 cells"});
   check("short", head + "0,2,0,0,5e5,5,10\n", {"short.csv", "at least 3"});
   check("empty", "", {"empty.csv", "empty file"});
