@@ -13,7 +13,7 @@
 
 #include "pipeline/options.h"
 #include "pipeline/results_io.h"
-#include "render/signal.h"
+#include "pipeline/signal.h"
 
 namespace floesim::render {
 

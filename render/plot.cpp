@@ -10,7 +10,7 @@
 #include "pipeline/error.h"
 #include "pipeline/provenance.h"
 #include "render/gnuplot.h"
-#include "render/signal.h"
+#include "pipeline/signal.h"
 
 namespace floesim::render {
 

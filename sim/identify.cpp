@@ -13,7 +13,7 @@
 #include "pipeline/provenance.h"
 #include <Eigen/Dense>
 
-#include "render/signal.h"
+#include "pipeline/signal.h"
 #include "sim/model.h"
 
 namespace floesim::sim {
@@ -257,7 +257,7 @@ Identification identify(const MeasuredSeries& m, const IdentifyOptions& o) {
   Identification id;
 
   // 1. Accelerations: measured, or central differences of the velocities (one-sided at the two ends); then the
-  //    centred moving average (render/signal.h), whose N comes from the median step.
+  //    centred moving average (pipeline/signal.h), whose N comes from the median step.
   std::vector<double> steps(n - 1);
   for (size_t i = 0; i + 1 < n; ++i) steps[i] = m.time_s[i + 1] - m.time_s[i];
   std::vector<double> sorted = steps;
@@ -297,10 +297,10 @@ Identification identify(const MeasuredSeries& m, const IdentifyOptions& o) {
       dr[i] = a.yaw;
     }
   }
-  id.acceleration_window_samples = render::window_samples(o.filters.acceleration_window_s, id.median_step_s);
-  du = render::moving_average_centred(du, id.acceleration_window_samples);
-  dv = render::moving_average_centred(dv, id.acceleration_window_samples);
-  dr = render::moving_average_centred(dr, id.acceleration_window_samples);
+  id.acceleration_window_samples = window_samples(o.filters.acceleration_window_s, id.median_step_s);
+  du = moving_average_centred(du, id.acceleration_window_samples);
+  dv = moving_average_centred(dv, id.acceleration_window_samples);
+  dr = moving_average_centred(dr, id.acceleration_window_samples);
 
   // 2. Every term per sample; the ice load by difference.
   IdentifiedSeries& s = id.samples;

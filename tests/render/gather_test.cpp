@@ -14,7 +14,7 @@
 #include "pipeline/error.h"
 #include "pipeline/results_io.h"
 #include "render/gather.h"
-#include "render/signal.h"
+#include "pipeline/signal.h"
 #include "synthetic_results.h"
 
 using namespace floesim;

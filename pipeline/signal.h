@@ -5,7 +5,7 @@
 #include <utility>
 #include <vector>
 
-namespace floesim::render {
+namespace floesim {
 
 // Samples in a window of `window_s` seconds at sample step `dt_s`: N = round(T_w / dt), at least 1.
 size_t window_samples(double window_s, double dt_s);
@@ -58,4 +58,4 @@ ConfidenceInterval student_t_interval(const std::vector<double>& x, double level
 // not uniform to 1 % (the averages above assume a fixed step).
 double uniform_step(const std::vector<double>& t, const char* what);
 
-}  // namespace floesim::render
+}  // namespace floesim

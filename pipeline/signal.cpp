@@ -1,4 +1,4 @@
-#include "render/signal.h"
+#include "pipeline/signal.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include "pipeline/error.h"
 
-namespace floesim::render {
+namespace floesim {
 
 size_t window_samples(double window_s, double dt_s) {
   FLOESIM_REQUIRE(std::isfinite(window_s) && window_s >= 0, "moving-average window must be >= 0 s, got ", window_s);
@@ -141,4 +141,4 @@ double uniform_step(const std::vector<double>& t, const char* what) {
   return dt;
 }
 
-}  // namespace floesim::render
+}  // namespace floesim

@@ -1,10 +1,9 @@
 #include <gtest/gtest.h>
 
 #include "pipeline/error.h"
-#include "render/signal.h"
+#include "pipeline/signal.h"
 
 using namespace floesim;
-using namespace floesim::render;
 
 namespace {
 std::vector<double> ramp(size_t n, double a, double b) {
