@@ -74,7 +74,10 @@ std::vector<double> interval_means(const ShipData& d, double T, size_t K) {
 }
 
 struct RoundTrip {
-  double sim_mean = 0, id_mean = 0, rel_error = 0, rms = 0, sim_sd = 0;
+  double sim_mean = 0;       // summary.json's mean surge ice load (steady part, every step)
+  double sim_rows_mean = 0;  // the simulated load's mean over the rows written (every k-th step)
+  double id_mean = 0, rel_error = 0, rms = 0, sim_sd = 0;
+  double m11 = 0;
 };
 
 // Identify with the sidecar; compare means over the steady part and the 0.5 s (2 Hz) series over the same part.
@@ -86,6 +89,11 @@ RoundTrip round_trip(const ShipDataOptions& so) {
   rt.sim_mean = tr.summary["mean_surge_ice_load_N"].get<double>();
   rt.id_mean = id.mean_ice.surge;
   rt.rel_error = (rt.id_mean - rt.sim_mean) / std::abs(rt.sim_mean);
+  rt.m11 = d.identify.mass.surge_kg;
+  double sr = 0, nr = 0;
+  for (size_t i = 0; i < d.measured.time_s.size(); ++i)
+    if (d.measured.time_s[i] >= d.mean_t0_s) sr += d.sim_ice[i].surge, nr += 1;
+  rt.sim_rows_mean = sr / nr;
   const std::vector<double> sim = interval_means(d, d.identify.filters.output_interval_s, id.output.time_s.size());
   double se = 0, m = 0, m2 = 0, n = 0;
   for (size_t k = 0; k < sim.size(); ++k) {
@@ -120,12 +128,14 @@ TEST(ShipData, SidecarIsTheSimulatedShip) {
   EXPECT_FALSE(d.wind);
 }
 
-// Noise off: the identified mean surge ice load within 2 % of the simulated one, and the 0.5 s series within 5 % of
-// the mean load RMS (measured: see the [measured] line).
+// Noise off: the identified mean surge ice load within 2 % of the simulated one (measured -0.16 %: the trim, see
+// RemainderIsTheTrim), and the 0.5 s series within an RMS error of 5 % of the simulated 0.5 s series' standard
+// deviation (measured 1.05 kN = 2.2 % of 48.7 kN, against a mean of 213 kN): what is left is the trim term and the
+// 0.1 s moving average identify puts on the accelerations, which leaks across the 0.5 s intervals' edges.
 TEST(ShipData, RoundTripWithoutNoise) {
   const RoundTrip rt = round_trip({});
   EXPECT_LT(std::abs(rt.rel_error), 0.02);
-  EXPECT_LT(rt.rms, 0.05 * std::abs(rt.sim_mean));
+  EXPECT_LT(rt.rms, 0.05 * rt.sim_sd);
 }
 
 // Accelerations left to identify (central differences, 0.1 s moving average): the mean is the same within 2 %
@@ -134,12 +144,14 @@ TEST(ShipData, RoundTripDifferentiated) {
   ShipDataOptions so;
   so.write_accelerations = false;
   const RoundTrip rt = round_trip(so);
-  EXPECT_LT(std::abs(rt.rel_error), 0.02);
-  EXPECT_LT(rt.rms, 0.10 * std::abs(rt.sim_mean));
+  EXPECT_LT(std::abs(rt.rel_error), 0.02);  // measured -0.15 %
+  EXPECT_LT(rt.rms, 0.05 * rt.sim_sd);      // measured 1.27 kN = 2.6 % of the sd
 }
 
-// IMU noise 0.02 m/s^2 (surge, sway), 0.001 rad/s^2 (yaw), bias 2e-4 m/s^2, velocity noise 0.005 m/s: the bias
-// shifts the mean by M11 b (about 3 kN), the noise averages out over 3000 samples (M11 0.02 / sqrt(3000) ~ 5 kN).
+// IMU noise 0.02 m/s^2 (surge, sway; a MEMS IMU at 100 Hz), 0.001 rad/s^2 (yaw), bias 2e-4 m/s^2, velocity noise
+// 0.005 m/s. Expected: the bias shifts the mean by M11 b = +2.7 kN (1.3 %); the noise's mean over the 3000 samples of
+// the steady part has a standard error M11 0.02 / sqrt(3000) = 5 kN (2.3 %); the 0.5 s series carries the noise's
+// 0.5 s mean, M11 0.02 / sqrt(50) = 38.6 kN RMS. Measured (seed 7): mean +1.11 % (within 2 %), RMS 38.7 kN.
 TEST(ShipData, RoundTripWithNoise) {
   ShipDataOptions so;
   so.noise.surge_sd_mps2 = 0.02;
@@ -150,23 +162,31 @@ TEST(ShipData, RoundTripWithNoise) {
   so.noise.velocity_sd_mps = 0.005;
   so.seed = 7;
   const RoundTrip rt = round_trip(so);
-  const double m11 = make_ship_data(transit().results, transit().summary, so).identify.mass.surge_kg;
-  // The expected shift M11 b plus 4 standard errors of the noise's mean.
-  const double tol = m11 * (2e-4 + 4 * 0.02 / std::sqrt(3000.0));
-  EXPECT_LT(std::abs(rt.id_mean - rt.sim_mean), tol + 0.02 * std::abs(rt.sim_mean));
-  // Deterministic: the same seed gives the same data.
+  // Any seed: the bias shift within 4 standard errors of the noise's mean plus the noise-free error bound (2 %).
+  const double se = rt.m11 * 0.02 / std::sqrt(3000.0);
+  EXPECT_NEAR(rt.id_mean - rt.sim_mean, rt.m11 * 2e-4, 4 * se + 0.02 * std::abs(rt.sim_mean));
+  // This seed: within 2 % (the draw's mean is small; another seed may miss it by the 5 kN standard error).
+  EXPECT_LT(std::abs(rt.rel_error), 0.02);
+  // The filtered series: the noise's 0.5 s mean, within 20 %.
+  EXPECT_NEAR(rt.rms, rt.m11 * 0.02 / std::sqrt(50.0), 0.2 * rt.m11 * 0.02 / std::sqrt(50.0));
+  // Deterministic: the same seed gives the same data; another seed other data.
   const ShipData a = make_ship_data(transit().results, transit().summary, so);
   const ShipData b = make_ship_data(transit().results, transit().summary, so);
   EXPECT_EQ(a.measured.du_mps2, b.measured.du_mps2);
   EXPECT_EQ(a.measured.u_mps, b.measured.u_mps);
+  so.seed = 8;
+  EXPECT_NE(make_ship_data(transit().results, transit().summary, so).measured.du_mps2, a.measured.du_mps2);
 }
 
-// Every k-th step: a 0.05 s ship log still gives the mean within 2 %.
+// Every k-th step (a 20 Hz ship log): identify recovers the mean of the load at the rows it is given within 0.5 %
+// (measured: 0.16 %); against the full-rate mean that subsampling of a spiky load costs more (measured -1.5 %).
 TEST(ShipData, EveryFifthStep) {
   ShipDataOptions so;
   so.every = 5;
   const RoundTrip rt = round_trip(so);
-  EXPECT_LT(std::abs(rt.rel_error), 0.02);
+  std::printf("[measured] every 5th step: identified vs the same rows' simulated mean %+.3f %%\n",
+              100 * (rt.id_mean - rt.sim_rows_mean) / std::abs(rt.sim_rows_mean));
+  EXPECT_NEAR(rt.id_mean, rt.sim_rows_mean, 0.005 * std::abs(rt.sim_rows_mean));
 }
 
 // The executables: results.h5 + summary.json -> CSV + sidecar; the sidecar passes identify's --check-config and
@@ -212,4 +232,35 @@ TEST(ShipData, Executables) {
   EXPECT_NE(out4.find("another run"), std::string::npos) << out4;
   EXPECT_FALSE(fs::exists(dir / "other.csv"));
   fs::remove_all(dir);
+}
+
+// Where the remaining error of the noise-free round trip comes from: identify's model is the horizontal plane, but
+// the simulated ship trims (pitch ~ 1e-3 rad), so gravity and the buoyancy (in hydro_load: buoyancy, heave/pitch
+// damping, resistance, cross flow) each have a surge component of ~110 kN along the body x axis, which cancel only as
+// far as buoyancy balances the weight (the vertical ice load upsets it); with M11 r v (the simulator's M11 (u_dot -
+// r v), not in identify's M nu_dot) they close the balance: identified - simulated = mean(hydro_x + R(u) + gravity_x
+// + M11 r v) up to the step's discretisation (loads recorded in the end-of-step axes).
+TEST(ShipData, RemainderIsTheTrim) {
+  const Transit& tr = transit();
+  const ShipData d = make_ship_data(tr.results, tr.summary, {});
+  const Identification id = identify(d.measured, d.identify);
+  const auto& hyd = tr.results.get("hydro_load");
+  const auto& q = tr.results.get("vessel_quaternion_wxyz");
+  const double M11 = d.identify.mass.surge_kg, m = tr.model.bodies[tr.model.vessel].mass_kg;
+  const double g = tr.model.options.water.gravity_mps2;
+  double rv = 0, hx = 0, gx = 0, sim = 0, n = 0;
+  for (size_t i = 0; i < d.measured.time_s.size(); ++i) {
+    if (d.measured.time_s[i] < d.mean_t0_s) continue;
+    const Mat3 R = Quat(q[4 * i], q[4 * i + 1], q[4 * i + 2], q[4 * i + 3]).toRotationMatrix();
+    rv += M11 * d.measured.r_radps[i] * d.measured.v_mps[i];
+    hx += hyd[6 * i] + open_water_resistance(d.measured.u_mps[i], d.identify.resistance);
+    gx += (R.transpose() * Vec3(0, 0, -g * m)).x();
+    sim += d.sim_ice[i].surge;
+    n += 1;
+  }
+  rv /= n, hx /= n, gx /= n, sim /= n;
+  const double err = id.mean_ice.surge - sim, terms = hx + gx + rv;
+  std::printf("[measured] identified - simulated %.3f kN; hydro_x + R(u) %.3f kN, gravity_x %.3f kN, M11 r v %.4f "
+              "kN: sum %.3f kN\n", err / 1e3, hx / 1e3, gx / 1e3, rv / 1e3, terms / 1e3);
+  EXPECT_NEAR(err, terms, 0.2 * std::abs(err) + 1e-4 * std::abs(sim));
 }
