@@ -274,7 +274,7 @@ TEST(ShipData, Executables) {
 }
 
 // Where the remaining error of the noise-free round trip comes from: identify's model is the horizontal plane, but
-// the simulated ship trims (pitch ~ 1e-3 rad), so gravity and the buoyancy (in hydro_load: buoyancy, heave/pitch
+// the simulated ship trims slightly, so gravity and the buoyancy (in hydro_load: buoyancy, heave/pitch
 // damping, resistance, cross flow) each have a surge component of ~110 kN along the body x axis, which cancel only as
 // far as buoyancy balances the weight (the vertical ice load upsets it); with M11 r v (the simulator's M11 (u_dot -
 // r v), not in identify's M nu_dot) they close the balance: identified - simulated = mean(hydro_x + R(u) + gravity_x
