@@ -62,6 +62,10 @@ struct ShipDataOptions {
     v.field("truth_columns", truth_columns, "-",
             "also write sim_ice_surge_n, sim_ice_sway_n, sim_ice_yaw_nm (the simulated ice load; identify "
             "ignores extra columns)");
+    const ShipDataNoiseOptions& e = noise;
+    if (!write_accelerations && (e.surge_sd_mps2 != 0 || e.sway_sd_mps2 != 0 || e.yaw_sd_radps2 != 0 ||
+                                 e.surge_bias_mps2 != 0 || e.sway_bias_mps2 != 0 || e.yaw_bias_radps2 != 0))
+      v.problem("noise", "gives IMU noise or bias, but write_accelerations is false (no accelerations are written)");
   }
 };
 

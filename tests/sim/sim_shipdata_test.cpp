@@ -303,3 +303,22 @@ TEST(ShipData, RemainderIsTheTrim) {
               "kN: sum %.3f kN\n", err / 1e3, hx / 1e3, gx / 1e3, rv / 1e3, terms / 1e3);
   EXPECT_NEAR(err, terms, 0.2 * std::abs(err) + 1e-4 * std::abs(sim));
 }
+
+// The config is strict: unknown keys, bad values and IMU noise without accelerations are errors naming the key.
+TEST(ShipData, BadConfig) {
+  auto problem = [](const char* text) {
+    try {
+      read_options<ShipDataOptions>(nlohmann::json::parse(text), "cfg.json");
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(problem(R"({"noise": {"surge_sd": 0.1}})").find("noise.surge_sd"), std::string::npos);
+  EXPECT_NE(problem(R"({"every": 0})").find("every"), std::string::npos);
+  EXPECT_NE(problem(R"({"noise": {"sway_sd_mps2": -1}})").find("noise.sway_sd_mps2"), std::string::npos);
+  EXPECT_NE(problem(R"({"write_accelerations": false, "noise": {"surge_bias_mps2": 0.01}})")
+                .find("write_accelerations is false"),
+            std::string::npos);
+  EXPECT_EQ(problem(R"({"write_accelerations": false, "noise": {"velocity_sd_mps": 0.01}})"), "");
+}
