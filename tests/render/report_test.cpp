@@ -1,0 +1,301 @@
+// The report of a run of the tiny case: self-contained (no network reference in any src or href; every image and
+// the video a data: URI that decodes, by the test's own base64 decoder, to the bytes of its artefact file), the
+// reference error against hand-worked numbers, a run without its video says so, and a run without its summary is
+// an error that writes nothing.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "pipeline/error.h"
+#include "pipeline/options.h"
+#include "render/report.h"
+
+namespace fs = std::filesystem;
+using namespace floesim;
+using namespace floesim::render;
+
+namespace {
+
+const fs::path kBin = FLOESIM_BIN_DIR;
+const fs::path kSource = FLOESIM_SOURCE_DIR;
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+struct Cmd {
+  int code;
+  std::string text;
+};
+Cmd sh(const std::string& cmd, const fs::path& log) {
+  const int status = std::system((cmd + " > '" + log.string() + "' 2>&1").c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : 1, slurp(log)};
+}
+
+// RFC 4648 base64, written here independently of the library's encoder (OpenSSL).
+std::string decode_base64(const std::string& s) {
+  auto value = [](char c) -> int {
+    if (c >= 'A' && c <= 'Z') return c - 'A';
+    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+    if (c >= '0' && c <= '9') return c - '0' + 52;
+    if (c == '+') return 62;
+    if (c == '/') return 63;
+    return -1;
+  };
+  EXPECT_EQ(s.size() % 4, 0u);
+  std::string out;
+  for (size_t i = 0; i + 3 < s.size(); i += 4) {
+    int v[4];
+    int pad = 0;
+    for (int k = 0; k < 4; ++k) {
+      if (s[i + k] == '=') {
+        v[k] = 0;
+        ++pad;
+      } else {
+        v[k] = value(s[i + k]);
+        EXPECT_GE(v[k], 0) << "not base64: '" << s[i + k] << "' at " << i + k;
+      }
+    }
+    const uint32_t w = (v[0] << 18) | (v[1] << 12) | (v[2] << 6) | v[3];
+    out += char((w >> 16) & 0xff);
+    if (pad < 2) out += char((w >> 8) & 0xff);
+    if (pad < 1) out += char(w & 0xff);
+  }
+  return out;
+}
+
+// The src values of every <img> and <video> tag, with the tag name (found by hand: std::regex recurses per
+// character and overflows the stack on a megabyte of base64).
+std::vector<std::pair<std::string, std::string>> media_sources(const std::string& html) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const std::string tag : {"img", "video"}) {
+    for (size_t p = html.find("<" + tag + " "); p != std::string::npos; p = html.find("<" + tag + " ", p + 1)) {
+      const size_t end = html.find('>', p);
+      const size_t s = html.find(" src=\"", p);
+      if (s == std::string::npos || s > end) {
+        out.push_back({tag, ""});
+        continue;
+      }
+      const size_t a = s + 6, b = html.find('"', a);
+      out.push_back({tag, html.substr(a, b - a)});
+    }
+  }
+  return out;
+}
+
+// True if a src or href attribute holds a network address (scheme http(s) or protocol-relative //).
+bool has_network_attribute(const std::string& html) {
+  for (const std::string attr : {"src=", "href="}) {
+    for (size_t p = html.find(attr); p != std::string::npos; p = html.find(attr, p + 1)) {
+      size_t v = p + attr.size();
+      if (v < html.size() && (html[v] == '"' || html[v] == '\'')) ++v;
+      const std::string head = html.substr(v, 8);
+      if (head.rfind("http:", 0) == 0 || head.rfind("https:", 0) == 0 || head.rfind("//", 0) == 0) return true;
+    }
+  }
+  return false;
+}
+
+// One run of the tiny case shared by the tests (the tests copy it before editing).
+class TinyRun : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    root_ = fs::temp_directory_path() / ("floesim_report_" + std::to_string(::getpid()));
+    fs::remove_all(root_);
+    fs::create_directories(root_);
+    run_ = root_ / "run";
+    ran_ = sh("'" + (kBin / "floesim").string() + "' run '" + (kSource / "tests/e2e/tiny").string() +
+                  "' --out '" + run_.string() + "'",
+              root_ / "run.log");
+  }
+  static void TearDownTestSuite() {
+    if (!std::getenv("FLOESIM_KEEP_TEST_OUTPUT")) fs::remove_all(root_);
+  }
+  static fs::path copy_run(const std::string& name) {
+    const fs::path d = root_ / name;
+    fs::copy(run_, d, fs::copy_options::recursive);
+    return d;
+  }
+  static fs::path root_, run_;
+  static Cmd ran_;
+};
+fs::path TinyRun::root_, TinyRun::run_;
+Cmd TinyRun::ran_;
+
+}  // namespace
+
+TEST(Report, ReferenceErrorAgainstHandValues) {
+  // 1100 kN simulated against the seed's 1038 kN full scale: +62 kN, 62 / 1038 = +5.973 %.
+  const auto c = compare_to_reference(1100, {"full scale", 1038});
+  EXPECT_EQ(c.label, "full scale");
+  EXPECT_DOUBLE_EQ(c.error_kN, 62);
+  EXPECT_NEAR(c.error_percent, 5.97303, 1e-5);
+  // Against SAMS, 974 kN: +126 kN, +12.936 %.
+  EXPECT_NEAR(compare_to_reference(1100, {"SAMS", 974}).error_percent, 12.93634, 1e-5);
+}
+
+TEST(Report, Base64AndEscaping) {
+  EXPECT_EQ(base64_encode(""), "");
+  EXPECT_EQ(base64_encode("f"), "Zg==");
+  EXPECT_EQ(base64_encode("fo"), "Zm8=");
+  EXPECT_EQ(base64_encode("foobar"), "Zm9vYmFy");
+  // Across the encoder's chunk boundary (3 MiB) the text is one unbroken stream.
+  std::string big(3 * (1 << 20) + 5, '\0');
+  for (size_t i = 0; i < big.size(); ++i) big[i] = char(i * 131 + 7);
+  EXPECT_EQ(decode_base64(base64_encode(big)), big);
+  EXPECT_EQ(html_escape("<a href=\"x\">&'"), "&lt;a href=&quot;x&quot;&gt;&amp;&#39;");
+}
+
+TEST(Report, ReferencesFromTheConfig) {
+  const auto o = read_options<ReportOptions>(
+      Json::parse(R"({"reference_kN": 1038, "reference_label": "full scale", "references": [{"label": "SAMS",
+                  "kN": 974}]})"),
+      "report.json");
+  const auto r = o.all_references();
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_EQ(r[0].label, "full scale");
+  EXPECT_EQ(r[1].kN, 974);
+  // A typo and a bad value are reported together, naming the key.
+  try {
+    read_options<ReportOptions>(Json::parse(R"({"referense_kN": 1, "references": [{"label": "x", "kN": -1}]})"),
+                                "report.json");
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("referense_kN"), std::string::npos) << m;
+    EXPECT_NE(m.find("references[0].kN"), std::string::npos) << m;
+  }
+}
+
+TEST_F(TinyRun, ReportIsSelfContainedAndEmbedsTheArtefacts) {
+  ASSERT_EQ(ran_.code, 0) << ran_.text;
+  const fs::path config = root_ / "report.json", out = root_ / "out" / "report.html";
+  std::ofstream(config) << R"({"reference_kN": 1038, "reference_label": "full scale",
+                              "references": [{"label": "SAMS", "kN": 974}]})";
+  // Through the executable: exit code and what it prints.
+  const Cmd c = sh("'" + (kBin / "floesim-report").string() + "' --run '" + run_.string() + "' --config '" +
+                       config.string() + "' --out '" + out.string() + "'",
+                   root_ / "report.log");
+  ASSERT_EQ(c.code, 0) << c.text;
+  EXPECT_NE(c.text.find("video embedded"), std::string::npos) << c.text;
+  EXPECT_EQ(c.text.find("missing"), std::string::npos) << c.text;
+  ASSERT_TRUE(fs::exists(out));
+  const std::string html = slurp(out);
+
+  // No network reference in any src or href attribute (nor anywhere: the page names none).
+  EXPECT_FALSE(has_network_attribute(html));
+  EXPECT_EQ(html.find("http://"), std::string::npos);
+  EXPECT_EQ(html.find("https://"), std::string::npos);
+  EXPECT_EQ(html.find("<link"), std::string::npos);
+  EXPECT_EQ(html.find("<script src"), std::string::npos);
+
+  // Every image and the video: a data: URI decoding to the bytes of one artefact, each artefact once.
+  std::map<std::string, std::string> expected = {
+      {"image/image.png", slurp(run_ / "image/image.png")},
+      {"floes/overlay.png", slurp(run_ / "floes/overlay.png")},
+      {"floes/fsd.png", slurp(run_ / "floes/fsd.png")},
+      {"plots/surge_ice_load.png", slurp(run_ / "plots/surge_ice_load.png")},
+      {"video/transit.mp4", slurp(run_ / "video/transit.mp4")}};
+  const auto sources = media_sources(html);
+  EXPECT_EQ(sources.size(), expected.size());
+  for (const auto& [tag, src] : sources) {
+    const std::string prefix = tag == "img" ? "data:image/png;base64," : "data:video/mp4;base64,";
+    ASSERT_EQ(src.rfind(prefix, 0), 0u) << tag << " src starts " << src.substr(0, 40);
+    const std::string bytes = decode_base64(src.substr(prefix.size()));
+    bool found = false;
+    for (auto it = expected.begin(); it != expected.end(); ++it)
+      if (it->second == bytes) {
+        expected.erase(it);
+        found = true;
+        break;
+      }
+    EXPECT_TRUE(found) << tag << ": " << bytes.size() << " decoded bytes match no artefact";
+  }
+  for (const auto& [name, bytes] : expected) ADD_FAILURE() << name << " is not embedded";
+
+  // The reference rows from the run's own mean (read here from summary.json).
+  const double mean_kN = load_json_file(run_ / "sim/summary.json")["mean_surge_ice_resistance_N"].get<double>() / 1000;
+  char row[128];
+  std::snprintf(row, sizeof row, "%+.1f</td><td class=\"n\">%+.1f", mean_kN - 1038, 100 * (mean_kN - 1038) / 1038);
+  EXPECT_NE(html.find(row), std::string::npos) << row;
+  EXPECT_NE(html.find("SAMS"), std::string::npos);
+  // The settings, escaped: every stage's config file is on the page.
+  for (const char* s : {"config/simulate.json", "config/digitise.json", "config/plot.json"})
+    EXPECT_NE(html.find(s), std::string::npos) << s;
+  EXPECT_EQ(html.find("id=\"missing\""), std::string::npos);
+}
+
+TEST_F(TinyRun, ReferenceErrorOnThePageAgainstAHandValue) {
+  ASSERT_EQ(ran_.code, 0) << ran_.text;
+  const fs::path run = copy_run("hand");
+  Json s = load_json_file(run / "sim/summary.json");
+  s["mean_surge_ice_resistance_N"] = 1100e3;
+  std::ofstream(run / "sim/summary.json") << s.dump(2);
+  ReportOptions o;
+  o.reference_kN = 1038;
+  o.reference_label = "full scale";
+  o.references = {{"SAMS", 974}};
+  const auto r = write_report(run, o, root_ / "hand.html", Json::object());
+  ASSERT_EQ(r.references.size(), 2u);
+  EXPECT_NEAR(r.references[0].error_percent, 5.97303, 1e-5);
+  const std::string html = slurp(root_ / "hand.html");
+  // 1100 - 1038 = +62.0 kN, +6.0 %; 1100 - 974 = +126.0 kN, +12.9 %.
+  EXPECT_NE(html.find("<th>full scale</th><td class=\"n\">1038</td><td class=\"n\">+62.0</td><td class=\"n\">+6.0"),
+            std::string::npos);
+  EXPECT_NE(html.find("<th>SAMS</th><td class=\"n\">974</td><td class=\"n\">+126.0</td><td class=\"n\">+12.9"),
+            std::string::npos);
+}
+
+TEST_F(TinyRun, MissingVideoIsSaidOnThePageAndInStdout) {
+  ASSERT_EQ(ran_.code, 0) << ran_.text;
+  const fs::path run = copy_run("novideo");
+  fs::remove(run / "video/transit.mp4");
+  const fs::path out = root_ / "novideo.html";
+  const Cmd c = sh("'" + (kBin / "floesim-report").string() + "' --run '" + run.string() + "' --out '" +
+                       out.string() + "'",
+                   root_ / "novideo.log");
+  ASSERT_EQ(c.code, 0) << c.text;
+  EXPECT_NE(c.text.find("missing from the run (1)"), std::string::npos) << c.text;
+  EXPECT_NE(c.text.find("video/transit.mp4"), std::string::npos) << c.text;
+  const std::string html = slurp(out);
+  EXPECT_NE(html.find("id=\"missing\""), std::string::npos);
+  EXPECT_NE(html.find("The video is missing (video/transit.mp4)"), std::string::npos);
+  EXPECT_EQ(html.find("<video"), std::string::npos);
+}
+
+TEST_F(TinyRun, VideoLargerThanTheLimitIsNamedNotEmbedded) {
+  ASSERT_EQ(ran_.code, 0) << ran_.text;
+  ReportOptions o;
+  o.max_video_mb = 1e-6;  // 1 byte
+  const auto r = write_report(run_, o, root_ / "big.html", Json::object());
+  EXPECT_FALSE(r.video_embedded);
+  const std::string html = slurp(root_ / "big.html");
+  EXPECT_EQ(html.find("<video"), std::string::npos);
+  EXPECT_NE(html.find("id=\"video-not-embedded\""), std::string::npos);
+}
+
+TEST_F(TinyRun, NoSummaryIsAnErrorAndWritesNothing) {
+  ASSERT_EQ(ran_.code, 0) << ran_.text;
+  const fs::path run = copy_run("nosummary");
+  fs::remove(run / "sim/summary.json");
+  const fs::path out = root_ / "nosummary" / "report.html";
+  const Cmd c = sh("'" + (kBin / "floesim-report").string() + "' --run '" + run.string() + "' --out '" +
+                       out.string() + "'",
+                   root_ / "nosummary.log");
+  EXPECT_NE(c.code, 0);
+  EXPECT_NE(c.text.find("sim/summary.json is missing"), std::string::npos) << c.text;
+  EXPECT_FALSE(fs::exists(out));
+  for (const auto& e : fs::directory_iterator(out.parent_path()))
+    EXPECT_EQ(e.path().filename().string().find("report"), std::string::npos) << e.path();
+}
