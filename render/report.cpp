@@ -86,6 +86,8 @@ std::string fmt(const char* f, double a) {
 // Loads in kN as the plot stage prints them: whole kN from 100 kN up, three significant digits below.
 std::string kN(double x) {
   if (!std::isfinite(x)) return "&ndash;";
+  x += 0.0;  // -0 reads as 0
+  if (std::abs(x) < 0.0005) x = 0;  // and so does what rounds to it
   return std::abs(x) >= 100 ? fmt("%.0f", x) : fmt("%.3g", x);
 }
 
@@ -177,7 +179,7 @@ h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-to
 table{border-collapse:collapse;margin:.5em 0}th,td{border:1px solid #ccc;padding:.25em .6em;text-align:left}
 td.n{text-align:right;font-variant-numeric:tabular-nums}
 img,video{max-width:100%;height:auto;border:1px solid #ddd}
-.pair{display:flex;gap:1em;flex-wrap:wrap}.pair figure{flex:1 1 400px;margin:0}
+.pair{display:flex;gap:1em;flex-wrap:wrap}.pair figure{flex:1 1 400px;margin:0}.pair img{width:100%}
 figcaption{font-size:.9em;color:#555}
 .missing{border:2px solid #c60;background:#fff4e5;padding:.5em 1em}
 .error{border:2px solid #c00;background:#fee;padding:.5em 1em}
@@ -185,20 +187,27 @@ pre{background:#f6f6f6;padding:.6em;overflow:auto;font-size:.85em}
 .note{color:#555;font-size:.9em}
 )";
 
-// Marks the page: <html data-media="ok"> once every image has decoded and the video's metadata has loaded, else
-// "failed: ..." and a visible error box (what a browser that cannot show an embedded file would tell its reader).
+// Marks the page: <html data-media="ok"> once every image has decoded and the video has decoded its first frame
+// (readyState >= 2, HAVE_CURRENT_DATA; data-video then says its size and duration), else "failed: ..." and a
+// visible error box (what a browser that cannot show an embedded file tells its reader).
 const char* kMediaCheck = R"(
 (function(){
   var imgs=[].slice.call(document.images), vids=[].slice.call(document.querySelectorAll('video'));
   var pending=imgs.length+vids.length, bad=[];
   function done(){ if(--pending>0) return;
     document.documentElement.setAttribute('data-media', bad.length ? 'failed: '+bad.join(', ') : 'ok');
-    if(bad.length){ var e=document.getElementById('media-error'); e.textContent='This browser could not show: '+bad.join(', '); e.hidden=false; } }
+    if(bad.length){ var e=document.getElementById('media-error');
+      e.textContent='This browser could not show: '+bad.join(', '); e.hidden=false; } }
   if(!pending){ document.documentElement.setAttribute('data-media','ok'); return; }
   imgs.forEach(function(i){ var f=function(){ if(!(i.naturalWidth>0)) bad.push(i.alt); done(); };
     if(i.complete) f(); else { i.addEventListener('load',f); i.addEventListener('error',f); } });
-  vids.forEach(function(v){ if(v.readyState>=1){ done(); return; }
-    v.addEventListener('loadedmetadata',done); v.addEventListener('error',function(){ bad.push('video'); done(); }); });
+  vids.forEach(function(v){ var seen=false;
+    var ok=function(){ if(seen) return; seen=true;
+      document.documentElement.setAttribute('data-video', v.videoWidth+'x'+v.videoHeight+' '+v.duration+' s');
+      if(!(v.videoWidth>0)) bad.push('video'); done(); };
+    if(v.readyState>=2){ ok(); return; }
+    v.addEventListener('loadeddata',ok);
+    v.addEventListener('error',function(){ if(seen) return; seen=true; bad.push('video'); done(); }); });
 })();
 )";
 
@@ -238,14 +247,17 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
 
   // 3. The sections, each from its artefact; a missing one is named in the box at the top.
   std::ostringstream body;
-  const std::string title = o.title.empty() ? "floesim run " + fs::absolute(run_dir).lexically_normal()
-                                                                      .filename().string()
-                                            : o.title;
+  // The default title names the case (the folder of its case.json), else the run folder.
   const std::string run_name = fs::absolute(run_dir).lexically_normal().string();
+  const fs::path case_json = case_file(run_dir).lexically_normal();
+  std::string title = o.title;
+  if (title.empty())
+    title = "floesim report: " + (case_json.empty() ? fs::path(run_name).filename().string()
+                                                    : case_json.parent_path().filename().string());
 
   // Case.
   body << "<h2>Case</h2>\n<table>\n<tr><th>run folder</th><td>" << html_escape(run_name) << "</td></tr>\n";
-  if (const fs::path cf = case_file(run_dir); !cf.empty()) {
+  if (const fs::path& cf = case_json; !cf.empty()) {
     body << "<tr><th>case file</th><td>" << html_escape(cf.string()) << "</td></tr>\n";
     if (fs::is_regular_file(cf)) {
       try {
@@ -369,7 +381,7 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
     const std::string size = fmt("%.2f MB", rs.video_bytes / 1e6);
     if (rs.video_bytes <= o.max_video_mb * 1e6) {
       pg.inputs.push_back({"video", video});
-      body << "<video controls preload=\"metadata\" src=\"data:video/mp4;base64,"
+      body << "<video controls preload=\"auto\" src=\"data:video/mp4;base64,"
            << base64_encode(read_bytes(video)) << "\"></video>\n<p class=\"note\">video/transit.mp4, " << size
            << ", embedded.</p>\n";
       rs.video_embedded = true;

@@ -29,7 +29,7 @@ struct ReferenceLoad {
 };
 
 struct ReportOptions {
-  std::string title = "";                        // page title; "" for "floesim run <run folder name>"
+  std::string title = "";                        // page title; "" for "floesim report: <case name>"
   double reference_kN = 0;                       // kN; one reference value (0: none)
   std::string reference_label = "reference";     // its label
   std::vector<ReferenceLoad> references;         // further references, e.g. [{"label": "SAMS", "kN": 974}]
@@ -37,7 +37,8 @@ struct ReportOptions {
 
   template <class V>
   void visit(V& v) {
-    v.field("title", title, "-", "page title (empty: \"floesim run <run folder name>\")");
+    v.field("title", title, "-",
+            "page title (empty: \"floesim report: <case folder name>\", else the run folder's name)");
     v.field("reference_kN", reference_kN, "kN", "a reference mean surge ice resistance (0: none)", non_negative());
     v.field("reference_label", reference_label, "-", "label of reference_kN");
     v.list("references", references, "further references: a list of {\"label\", \"kN\"}");

@@ -27,7 +27,8 @@ int main(int argc, char** argv) {
     }
     if (run.empty() || out.empty()) throw floesim::Error("--run and --out are required (see --help)");
     const auto s = floesim::render::write_report(run, config, out);
-    std::cout << "wrote " << out << " (" << s.bytes / 1000 << " kB): mean ice resistance " << s.mean_kN << " kN";
+    const double mean_kN = s.mean_kN == 0 ? 0.0 : s.mean_kN;  // -0 (no contact at all) prints as 0
+    std::cout << "wrote " << out << " (" << s.bytes / 1000 << " kB): mean ice resistance " << mean_kN << " kN";
     for (const auto& r : s.references)
       std::cout << "; " << r.label << " " << r.reference_kN << " kN: error " << r.error_kN << " kN ("
                 << r.error_percent << " %)";
