@@ -315,38 +315,44 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
     pg.missing.push_back("plots/plot.json (plot numbers)");
   }
 
-  // Input and digitised field.
-  body << "<h2>Ice field</h2>\n<div class=\"pair\">\n";
-  fs::path photo = run_dir / "image/image.png";
-  if (!fs::is_regular_file(photo) && !fs::exists(run_dir / "config/synth.json")) {
-    const fs::path p = photo_from_ninja(run_dir);
-    if (!p.empty()) photo = p;
+  // Input and digitised field; a case that gives its floes directly ("floes": {"file"}) has neither, and that is
+  // no gap in the run (the runner wrote no digitise settings).
+  body << "<h2>Ice field</h2>\n";
+  if (!fs::exists(run_dir / "config/digitise.json")) {
+    body << "<p>The floes were given directly (case key <code>floes.file</code>): no image was digitised.</p>\n";
+  } else {
+    body << "<div class=\"pair\">\n";
+    fs::path photo = run_dir / "image/image.png";
+    if (!fs::is_regular_file(photo) && !fs::exists(run_dir / "config/synth.json")) {
+      const fs::path p = photo_from_ninja(run_dir);
+      if (!p.empty()) photo = p;
+    }
+    if (fs::is_regular_file(photo) && photo.extension() == ".png")
+      body << "<figure>" << pg.img(photo, "image", "input image") << "<figcaption>Input image ("
+           << html_escape(photo.filename().string()) << ")</figcaption></figure>\n";
+    else
+      pg.missing.push_back((fs::is_regular_file(photo) ? photo.string() + " (input photo: not a PNG, not embedded)"
+                                                       : std::string("image/image.png (input image)")));
+    if (pg.have("floes/overlay.png", "digitised field"))
+      body << "<figure>" << pg.img(run_dir / "floes/overlay.png", "overlay", "digitised field")
+           << "<figcaption>Digitised floes (outlines and ids on the image)</figcaption></figure>\n";
+    body << "</div>\n";
+    if (pg.have("floes/stats.json", "digitisation statistics")) {
+      const Json st = pg.json("floes/stats.json", "floe statistics");
+      body << "<table>\n" << scalar_rows(st);
+      if (const Json* img = find(st, {"image"})) body << scalar_rows(*img, "image.");
+      for (const char* fit : {"mle", "truncated_mle"})
+        if (const Json* a = find(st, {"power_law", fit}))
+          body << "<tr><th>power-law exponent (" << fit << ")</th><td>" << scalar_text(a->value("alpha", Json()))
+               << " &plusmn; " << scalar_text(a->value("alpha_stderr", Json())) << " (n = "
+               << scalar_text(a->value("n", Json())) << ", d_min = " << scalar_text(a->value("d_min_m", Json()))
+               << " m)</td></tr>\n";
+      body << "</table>\n";
+    }
+    if (pg.have("floes/fsd.png", "floe size distribution plot"))
+      body << "<figure>" << pg.img(run_dir / "floes/fsd.png", "fsd", "floe size distribution")
+           << "<figcaption>Floe size distribution and power-law fit</figcaption></figure>\n";
   }
-  if (fs::is_regular_file(photo) && photo.extension() == ".png")
-    body << "<figure>" << pg.img(photo, "image", "input image") << "<figcaption>Input image ("
-         << html_escape(photo.filename().string()) << ")</figcaption></figure>\n";
-  else
-    pg.missing.push_back((fs::is_regular_file(photo) ? photo.string() + " (input photo: not a PNG, not embedded)"
-                                                     : std::string("image/image.png (input image)")));
-  if (pg.have("floes/overlay.png", "digitised field"))
-    body << "<figure>" << pg.img(run_dir / "floes/overlay.png", "overlay", "digitised field")
-         << "<figcaption>Digitised floes (outlines and ids on the image)</figcaption></figure>\n";
-  body << "</div>\n";
-  if (pg.have("floes/stats.json", "digitisation statistics")) {
-    const Json st = pg.json("floes/stats.json", "floe statistics");
-    body << "<table>\n" << scalar_rows(st);
-    if (const Json* img = find(st, {"image"})) body << scalar_rows(*img, "image.");
-    for (const char* fit : {"mle", "truncated_mle"})
-      if (const Json* a = find(st, {"power_law", fit}))
-        body << "<tr><th>power-law exponent (" << fit << ")</th><td>" << scalar_text(a->value("alpha", Json()))
-             << " &plusmn; " << scalar_text(a->value("alpha_stderr", Json())) << " (n = "
-             << scalar_text(a->value("n", Json())) << ", d_min = " << scalar_text(a->value("d_min_m", Json()))
-             << " m)</td></tr>\n";
-    body << "</table>\n";
-  }
-  if (pg.have("floes/fsd.png", "floe size distribution plot"))
-    body << "<figure>" << pg.img(run_dir / "floes/fsd.png", "fsd", "floe size distribution")
-         << "<figcaption>Floe size distribution and power-law fit</figcaption></figure>\n";
 
   // Hull.
   body << "<h2>Hull</h2>\n<table>\n";
