@@ -48,12 +48,17 @@ struct Output {
   std::string text;  // stdout and stderr
 };
 
-// Runs a program (argv[0] searched in PATH) and collects its output.
-Output run_capture(const std::vector<std::string>& args) {
+// A program running with its stdout and stderr coming back through a pipe (argv[0] searched in PATH; `env` set in
+// the child only).
+struct Child {
+  pid_t pid = -1;
+  FILE* out = nullptr;
+};
+Child spawn_piped(const std::vector<std::string>& args, const std::vector<std::pair<std::string, std::string>>& env = {}) {
   int fd[2];
   FLOESIM_REQUIRE(pipe(fd) == 0, "cannot create a pipe to run ", args[0]);
-  std::vector<char*> argv;
   std::vector<std::string> a = args;
+  std::vector<char*> argv;
   for (auto& s : a) argv.push_back(s.data());
   argv.push_back(nullptr);
   std::cout.flush();
@@ -64,19 +69,31 @@ Output run_capture(const std::vector<std::string>& args) {
     dup2(fd[1], 2);
     close(fd[0]);
     close(fd[1]);
+    for (const auto& [k, v] : env) setenv(k.c_str(), v.c_str(), 1);
     execvp(argv[0], argv.data());
-    std::fprintf(stderr, "cannot execute %s\n", argv[0]);
+    std::fprintf(stderr, "floesim: cannot execute %s (is it installed?)\n", argv[0]);
     _exit(127);
   }
   close(fd[1]);
+  return {pid, fdopen(fd[0], "r")};
+}
+
+// Closes the pipe and waits: the exit status (128 + the signal if killed).
+int wait_child(Child& c) {
+  std::fclose(c.out);
+  int status = 0;
+  waitpid(c.pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+// Runs a program and collects its output.
+Output run_capture(const std::vector<std::string>& args) {
+  Child c = spawn_piped(args);
   Output out;
   char buf[4096];
-  ssize_t n;
-  while ((n = read(fd[0], buf, sizeof buf)) > 0) out.text.append(buf, static_cast<size_t>(n));
-  close(fd[0]);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  out.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, c.out)) > 0) out.text.append(buf, n);
+  out.code = wait_child(c);
   return out;
 }
 
@@ -212,26 +229,8 @@ void write_sweep_files(const Sweep& s, const std::vector<Member>& members, const
 int run_ninja(const fs::path& run, int jobs, const std::vector<Member>& members, const SweepPlan& p) {
   std::vector<std::string> args = {FLOESIM_NINJA, "-C", run.string(), "-f", "build.ninja", "-k", "0"};
   if (jobs > 0) args.push_back("-j" + std::to_string(jobs));
-  int fd[2];
-  FLOESIM_REQUIRE(pipe(fd) == 0, "cannot create a pipe to run ninja");
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  std::cout.flush();
-  const pid_t pid = fork();
-  FLOESIM_REQUIRE(pid >= 0, "cannot start ninja: fork failed");
-  if (pid == 0) {
-    dup2(fd[1], 1);
-    dup2(fd[1], 2);
-    close(fd[0]);
-    close(fd[1]);
-    setenv("NINJA_STATUS", "[%f/%t %r] ", 1);  // finished / total edges, running
-    execv(argv[0], argv.data());
-    std::fprintf(stderr, "floesim: cannot execute %s (is ninja-build installed?)\n", argv[0]);
-    _exit(127);
-  }
-  close(fd[1]);
-  FILE* in = fdopen(fd[0], "r");
+  Child ninja = spawn_piped(args, {{"NINJA_STATUS", "[%f/%t %r] "}});  // finished / total edges, running
+  FILE* in = ninja.out;
   const bool tty = isatty(1);
   const auto t0 = std::chrono::steady_clock::now();
   std::set<int> failed_stages;
@@ -281,15 +280,13 @@ int run_ninja(const fs::path& run, int jobs, const std::vector<Member>& members,
     if (tty) std::cout << "\n";
     std::cout << l << std::flush;
   }
-  std::fclose(in);
-  int status = 0;
-  waitpid(pid, &status, 0);
+  const int code = wait_child(ninja);
   int done = 0;
   for (size_t m = 0; m < members.size(); ++m) done += member_done(m);
   const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::cout << (tty ? "\n" : "") << "members " << done << "/" << members.size() << " complete, "
             << members.size() - done << " not; " << static_cast<int>(std::round(el)) << " s\n";
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 1;
+  return code;
 }
 
 // The gather stage: RUN/sweep.csv, sweep.json and plots from the members' results.
