@@ -78,7 +78,8 @@ fs::path self_dir() {
 std::string run_folder(const std::string& stage) {
   static const std::map<std::string, std::string> folder = {{"synth", "image"},  {"digitise", "floes"},
                                                             {"hull", "hull"},    {"simulate", "sim"},
-                                                            {"render", "video"}, {"plot", "plots"}};
+                                                            {"render", "video"}, {"plot", "plots"},
+                                                            {"report", "report"}};
   return folder.at(stage);
 }
 
@@ -98,16 +99,16 @@ void absolute_case_files(Json& c, const fs::path& case_dir) {
 }
 
 CasePlan plan_case(const Json& c, const std::string& where, const fs::path& case_dir, const fs::path& bin,
-                   const StageLayout& layout, bool render) {
+                   const StageLayout& layout, bool render, bool report) {
   const std::string& cf = where;
   FLOESIM_REQUIRE(c.is_object(), cf, ": the top level must be an object");
   const std::vector<std::string> known = {"description", "image", "digitise", "floes", "hull", "simulate", "render",
-                                          "plot"};
+                                          "plot", "report"};
   for (auto it = c.begin(); it != c.end(); ++it) {
     bool ok = false;
     for (auto& k : known) ok = ok || k == it.key();
     FLOESIM_REQUIRE(ok, cf, ": unknown key \"", it.key(),
-                    "\" (known: description, image, digitise, floes, hull, simulate, render, plot)");
+                    "\" (known: description, image, digitise, floes, hull, simulate, render, plot, report)");
   }
   // Floes come from a photo (image + digitise) or directly from a floes GeoJSON the case owns ("floes": {"file"}).
   FLOESIM_REQUIRE(c.contains("image") != c.contains("floes"), cf,
@@ -249,6 +250,7 @@ CasePlan plan_case(const Json& c, const std::string& where, const fs::path& case
   }
 
   // --- render and plot (independent of each other) ---
+  fs::path video, plot_png;
   {
     Json r = c.contains("render") ? c["render"] : Json::object();
     FLOESIM_REQUIRE(r.is_object(), cf, ": render must be an object");
@@ -257,6 +259,7 @@ CasePlan plan_case(const Json& c, const std::string& where, const fs::path& case
                              "floesim-render");
       st->args = {"--results", plan.results.string(), "--config", st->config.string(), "--out",
                   st->outputs[0].string()};
+      video = st->outputs[0];
       plan.artefacts.push_back({"render", "video/transit.mp4", "rendered transit (H.264 MP4)"});
     }
   }
@@ -266,10 +269,27 @@ CasePlan plan_case(const Json& c, const std::string& where, const fs::path& case
     PlannedStage* st = add("plot", "surge ice load plots", p, {plan.results},
                            {"surge_ice_load.png", "surge_ice_load.svg", "fracture_events.csv"}, "floesim-plot");
     st->args = {"--results", plan.results.string(), "--config", st->config.string(), "--out", st->dir.string()};
+    plot_png = st->outputs[0];
     plan.artefacts.push_back({"plot", "plots/surge_ice_load.png", "surge ice load, moving average and mean (PNG)"});
     plan.artefacts.push_back({"plot", "plots/surge_ice_load.svg", "the same (SVG)"});
     plan.artefacts.push_back(
         {"plot", "plots/fracture_events.csv", "every fracture event: time, mode, floe, force, children"});
+  }
+
+  // --- report: one self-contained page over the run folder (only a run's: it reads the folder's layout) ---
+  {
+    Json r = c.contains("report") ? c["report"] : Json::object();
+    FLOESIM_REQUIRE(r.is_object(), cf, ": report must be an object");
+    if (render && report) {
+      // It reads the whole run folder; the summary, the plot and the video are what make it stale (every other
+      // artefact it shows lies upstream of the summary).
+      PlannedStage* st = add("report", "self-contained HTML report", r, {plan.summary, plot_png, video},
+                             {"report.html"}, "floesim-report");
+      st->args = {"--run", st->dir.parent_path().string(), "--config", st->config.string(), "--out",
+                  st->outputs[0].string()};
+      plan.artefacts.push_back({"report", "report/report.html", "the run on one page: case, loads, plots, field, "
+                                                                "hull, fracture, settings, video (HTML)"});
+    }
   }
   return plan;
 }

@@ -40,12 +40,13 @@ struct CasePlan {
   std::filesystem::path results, summary;
 };
 
-// The stages a case runs; `render` false leaves out the video. Validates the case's top level and its own files
+// The stages a case runs; `render` false leaves out the video, `report` false the HTML report (which reads a run
+// folder's layout: `floesim run` only). Validates the case's top level and its own files
 // (relative names resolve against case_dir); errors begin with `where` (the case file, or a sweep's member). Stage
 // settings are checked by the stages themselves (`--check-config`), not here.
 CasePlan plan_case(const nlohmann::json& c, const std::string& where,
                    const std::filesystem::path& case_dir, const std::filesystem::path& bin,
-                   const StageLayout& layout, bool render = true);
+                   const StageLayout& layout, bool render = true, bool report = false);
 
 // POSIX shell quoting of one word.
 std::string shell_quote(const std::string& s);
@@ -70,7 +71,7 @@ void write_ninja(const std::filesystem::path& file, const std::string& header,
                  const std::vector<PlannedStage>& stages, const std::vector<std::string>& descriptions,
                  StageOutput output);
 
-// The folder of a stage's outputs in a run folder: image, floes, hull, sim, video, plots.
+// The folder of a stage's outputs in a run folder: image, floes, hull, sim, video, plots, report.
 std::string run_folder(const std::string& stage);
 
 // The case's own files (image.file, floes.file, hull.file, simulate.vessel.propulsion.thrust_file) made absolute

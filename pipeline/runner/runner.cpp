@@ -34,7 +34,7 @@ std::vector<Artefact> prepare_run(const RunOptions& o) {
   StageLayout layout;
   layout.dir = [&](const std::string& stage, const std::string&) { return run / run_folder(stage); };
   layout.config = [&](const std::string& stage, const std::string&) { return run / "config" / (stage + ".json"); };
-  const CasePlan plan = plan_case(c, case_file.string(), o.case_dir, bin, layout);
+  const CasePlan plan = plan_case(c, case_file.string(), o.case_dir, bin, layout, true, true);
   ensure_directory(run / "config");
   std::vector<std::string> descriptions;
   for (const PlannedStage& s : plan.stages) {
@@ -51,7 +51,8 @@ std::vector<StageTiming> stage_timings(const fs::path& run_dir, fs::file_time_ty
   // The first output of each stage, in the order prepare_run lists them.
   const std::vector<std::pair<std::string, std::string>> firsts = {
       {"synth", "image/image.png"},   {"digitise", "floes/floes.geojson"}, {"hull", "hull/hull.obj"},
-      {"simulate", "sim/results.h5"}, {"plot", "plots/surge_ice_load.png"}, {"render", "video/transit.mp4"}};
+      {"simulate", "sim/results.h5"}, {"plot", "plots/surge_ice_load.png"}, {"render", "video/transit.mp4"},
+      {"report", "report/report.html"}};
   std::map<std::string, double> last;  // output path -> wall seconds of its last build
   std::ifstream log(run_dir / ".ninja_log");
   std::string line;

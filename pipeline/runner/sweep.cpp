@@ -26,7 +26,8 @@ namespace fs = std::filesystem;
 namespace floesim::runner {
 namespace {
 
-const std::vector<std::string> kCaseKeys = {"image", "digitise", "floes", "hull", "simulate", "render", "plot"};
+const std::vector<std::string> kCaseKeys = {"image", "digitise", "floes", "hull", "simulate", "render", "plot",
+                                            "report"};
 
 std::string join(const std::vector<std::string>& v, const std::string& sep) {
   std::string out;
