@@ -370,6 +370,14 @@ Wrench vessel_cross_flow(const Model& m, const BodyKinematics& k) {
   return w;
 }
 
+Vec3 fossen_wind_xyn(double q, double gamma_rad, double frontal_area_m2, double lateral_area_m2, double length_oa_m,
+                     double cx, double cy, double cn) {
+  return Vec3(-q * cx * std::cos(gamma_rad) * frontal_area_m2,  // head wind pushes astern
+              -q * cy * std::sin(gamma_rad) * lateral_area_m2,  // wind from port pushes to starboard
+              // Wind on the bow quarter turns the bow away from the wind (Fossen's C_N ~ sin 2 gamma).
+              -q * cn * std::sin(2 * gamma_rad) * lateral_area_m2 * length_oa_m);
+}
+
 Wrench vessel_wind(const Model& m, const BodyKinematics& k) {
   Wrench w;
   const WindOptions& o = m.options.wind;
@@ -380,12 +388,10 @@ Wrench vessel_wind(const Model& m, const BodyKinematics& k) {
   // gamma: angle the relative wind comes from, 0 = head wind, positive from port (y to port, z up).
   const double gamma = std::atan2(-a.y(), -a.x());
   const double q = 0.5 * o.air_density_kg_m3 * ah2;
-  const double fx = -q * o.cx * std::cos(gamma) * o.frontal_area_m2;  // head wind pushes astern
-  const double fy = -q * o.cy * std::sin(gamma) * o.lateral_area_m2;  // wind from port pushes to starboard
-  // Wind on the bow quarter turns the bow away from the wind (Fossen's C_N ~ sin 2 gamma).
-  const double mz = -q * o.cn * std::sin(2 * gamma) * o.lateral_area_m2 * m.vessel_info.length_oa_m;
-  w.force = k.R * Vec3(fx, fy, 0);
-  w.torque = k.R * Vec3(0, 0, mz);
+  const Vec3 xyn = fossen_wind_xyn(q, gamma, o.frontal_area_m2, o.lateral_area_m2, m.vessel_info.length_oa_m, o.cx,
+                                   o.cy, o.cn);
+  w.force = k.R * Vec3(xyn.x(), xyn.y(), 0);
+  w.torque = k.R * Vec3(0, 0, xyn.z());
   return w;
 }
 

@@ -94,6 +94,11 @@ Wrench floe_wind_drag(const Model& m, const Body& b, const BodyKinematics& k, Fo
 Wrench vessel_resistance(const Model& m, const BodyKinematics& k);
 // Cross-flow drag on strips along the waterline length: sway and yaw damping.
 Wrench vessel_cross_flow(const Model& m, const BodyKinematics& k);
+// Fossen-type wind load in body axes for dynamic pressure q = ½ rho_a V² of the relative wind coming from gamma
+// (0 = head wind, positive from port; y to port, z up): X = -q cx cos(gamma) A_F, Y = -q cy sin(gamma) A_L,
+// N = -q cn sin(2 gamma) A_L L_oa. Returns (X, Y, N). Shared by the simulator and floesim-identify.
+Vec3 fossen_wind_xyn(double q, double gamma_rad, double frontal_area_m2, double lateral_area_m2, double length_oa_m,
+                     double cx, double cy, double cn);
 // Fossen-type wind load from the relative wind.
 Wrench vessel_wind(const Model& m, const BodyKinematics& k);
 // Thrust along the body x axis at the centre of mass, by propulsion mode (bollard_pull: thrust_n is made, but the

@@ -14,6 +14,7 @@
 #include <Eigen/Dense>
 
 #include "pipeline/signal.h"
+#include "sim/forces.h"
 #include "sim/model.h"
 
 namespace floesim::sim {
@@ -242,12 +243,13 @@ double open_water_resistance(double u, const ResistanceOptions& o) {
 }
 
 Load3 wind_load(double speed_mps, double angle_deg, const IdentifyWindOptions& o) {
-  const double g = angle_deg * kPi / 180;
   const double q = 0.5 * o.air_density_kg_m3 * speed_mps * speed_mps;
+  const Vec3 xyn = fossen_wind_xyn(q, angle_deg * kPi / 180, o.frontal_area_m2, o.lateral_area_m2, o.length_oa_m,
+                                   o.cx, o.cy, o.cn);  // the simulator's own wind law
   Load3 w;
-  w.surge = -q * o.cx * std::cos(g) * o.frontal_area_m2;  // head wind pushes astern
-  w.sway = -q * o.cy * std::sin(g) * o.lateral_area_m2;   // wind from port pushes to starboard (-y)
-  w.yaw = -q * o.cn * std::sin(2 * g) * o.lateral_area_m2 * o.length_oa_m;  // bow turns away from the wind
+  w.surge = xyn.x();
+  w.sway = xyn.y();
+  w.yaw = xyn.z();
   return w;
 }
 
