@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "pipeline/atomic_file.h"
+#include "pipeline/csv.h"
 #include "pipeline/error.h"
 #include "pipeline/provenance.h"
 #include "render/gnuplot.h"
@@ -320,6 +321,91 @@ SurgeLoadSummary plot_surge_load(const fs::path& results, const fs::path& config
   const Results r = read_results(results, /*with_states=*/false);
   const auto prov = make_provenance("floesim-plot", {{"results", results}, {"config", config}}, options_to_json(o));
   return plot_surge_load(r, o, out_dir, prov, results.string());
+}
+
+IdentifiedPlotSummary plot_identified_load(const fs::path& identify_dir, const PlotOptions& o,
+                                           const fs::path& out_dir) {
+  // 1. The identification's numbers: its series (resistance = -surge load) and its means.
+  const NumericCsv c = read_numeric_csv(identify_dir / "identified.csv", {"time_s", "ice_surge_n"});
+  const Json id = load_json_file(identify_dir / "identified.json");
+  const std::string idf = (identify_dir / "identified.json").string();
+  FLOESIM_REQUIRE(id.contains("mean_surge_ice_resistance_n") && id["mean_surge_ice_resistance_n"].is_number() &&
+                      id.contains("mean_window_s") && id["mean_window_s"].is_array() &&
+                      id["mean_window_s"].size() == 2,
+                  idf, ": no mean_surge_ice_resistance_n or mean_window_s: rerun floesim-identify");
+  IdentifiedPlotSummary s;
+  const std::vector<double>& t = c.column("time_s");
+  FLOESIM_REQUIRE(t.size() >= 2, c.file.string(), ": ", t.size(), " rows; at least 2 are needed for a plot");
+  s.samples = t.size();
+  s.known = c.has("known_ice_surge_n") && id.contains("known_load");
+  s.mean_identified_kN = id["mean_surge_ice_resistance_n"].get<double>() / 1000;
+  if (s.known) s.mean_known_kN = id["known_load"].value("mean_surge_ice_resistance_n", NAN) / 1000;
+  const double w0 = id["mean_window_s"][0].get<double>(), w1 = id["mean_window_s"][1].get<double>();
+  auto resistance_kN = [](const std::vector<double>& surge_n) {
+    std::vector<double> r(surge_n.size());
+    for (size_t i = 0; i < r.size(); ++i) r[i] = -surge_n[i] / 1000;
+    return r;
+  };
+  const std::vector<double> ident = resistance_kN(c.column("ice_surge_n"));
+  const std::vector<double> known = s.known ? resistance_kN(c.column("known_ice_surge_n")) : std::vector<double>();
+  const double step = t[1] - t[0];
+
+  // 2. Data and script; gnuplot draws both images.
+  ensure_directory(out_dir);
+  AtomicFile png(out_dir / "identified_load.png"), svg(out_dir / "identified_load.svg");
+  AtomicFile data(out_dir / "identified_load.plot-data.txt"), script(out_dir / "identified_load.plot.gp"),
+      log(out_dir / "identified_load.gnuplot.log");
+  {
+    std::ofstream os(data.tmp());
+    for (size_t i = 0; i < t.size(); ++i)
+      os << fmt("%.9g", t[i]) << ' ' << fmt("%.9g", ident[i]) << ' '
+         << (s.known ? fmt("%.9g", known[i]) : std::string("NaN")) << '\n';
+    os << "\n\n"
+       << fmt("%.9g", std::max(w0, t.front())) << ' ' << fmt("%.9g", s.mean_identified_kN) << ' '
+       << fmt("%.9g", s.mean_known_kN) << '\n'
+       << fmt("%.9g", std::min(w1, t.back())) << ' ' << fmt("%.9g", s.mean_identified_kN) << ' '
+       << fmt("%.9g", s.mean_known_kN) << '\n';
+    FLOESIM_REQUIRE(os.flush(), data.tmp().string(), ": write failed (disk full?)");
+  }
+  double lo = 0, hi = 0;
+  for (double x : ident) lo = std::min(lo, x), hi = std::max(hi, x);
+  for (double x : known) lo = std::min(lo, x), hi = std::max(hi, x);
+  if (o.y_max_kN.is_number()) hi = o.y_max_kN.get<double>();
+  const double pad = 0.05 * std::max(hi - lo, 1e-3);
+  {
+    std::ostringstream gp;
+    gp << "set encoding utf8\n"
+       << "set terminal pngcairo size " << o.width_px << "," << o.height_px
+       << " enhanced font 'DejaVu Sans,11' linewidth 1.0\n"
+       << "set output " << quoted(png.tmp().string()) << "\n"
+       << "set title " << quoted("Surge ice load identified from the ship's data") << " noenhanced font ',14'\n"
+       << "set xlabel 'Time (s)'\nset ylabel 'Ice resistance  −F_x  (kN)'\n"
+       << "set border lc rgb '#404040'\nset grid xtics ytics lc rgb '#d9d9d9' lw 1 dt 1\n"
+       << "set key outside below center horizontal maxrows 2 samplen 2.5 width 2\n"
+       << "set xrange [" << fmt("%.9g", t.front()) << ":" << fmt("%.9g", t.back()) << "]\n"
+       << "set yrange [" << fmt("%.9g", lo - pad) << ":" << fmt("%.9g", hi + pad) << "]\n";
+    const std::string rate = fmt("%g", step) + " s means";
+    gp << "plot " << quoted(data.tmp().string()) << " index 0 using 1:2 with lines lc rgb '#2f7fc1' lw 1.2 title "
+       << quoted("identified (" + rate + ")") << " noenhanced";
+    if (s.known)
+      gp << ", \\\n  '' index 0 using 1:3 with lines lc rgb '#101010' lw 1.2 title "
+         << quoted("simulated, the same " + rate) << " noenhanced";
+    gp << ", \\\n  '' index 1 using 1:2 with lines lc rgb '#2f7fc1' lw 2.5 dt (8,4) title "
+       << quoted("identified mean: " + kN(s.mean_identified_kN) + " kN") << " noenhanced";
+    if (s.known)
+      gp << ", \\\n  '' index 1 using 1:3 with lines lc rgb '#d1232a' lw 2.5 dt (8,4) title "
+         << quoted("simulated mean: " + kN(s.mean_known_kN) + " kN") << " noenhanced";
+    gp << "\nset terminal svg size " << o.width_px << "," << o.height_px
+       << " dynamic enhanced font 'DejaVu Sans,11' background rgb 'white'\n"
+       << "set output " << quoted(svg.tmp().string()) << "\nreplot\nunset output\n";
+    std::ofstream os(script.tmp());
+    os << gp.str();
+    FLOESIM_REQUIRE(os.flush(), script.tmp().string(), ": write failed (disk full?)");
+  }
+  run_gnuplot(script.tmp(), log.tmp(), {png.tmp(), svg.tmp()}, png.path().string());
+  png.commit();
+  svg.commit();
+  return s;
 }
 
 }  // namespace floesim::render

@@ -4,6 +4,7 @@
 // and radial), and every fracture event is listed in fracture_events.csv.
 // floesim-plot is a thin main over plot_surge_load().
 #pragma once
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -74,5 +75,18 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const s
                                  const nlohmann::json& provenance, const std::string& source);
 SurgeLoadSummary plot_surge_load(const std::filesystem::path& results, const std::filesystem::path& config,
                                  const std::filesystem::path& out_dir);
+
+// The identified ice load of floesim-identify (its folder: identified.csv and identified.json) against time at its
+// output rate: the identified resistance and, when the measured data carried a known load (a simulated ship's), that
+// load averaged over the same intervals; each with its mean over the identification's mean window. The comparison
+// a reader checks by eye: same filter, same window. Writes DIR/identified_load.{png,svg}, each only when complete.
+struct IdentifiedPlotSummary {
+  size_t samples = 0;            // output-rate rows plotted
+  bool known = false;            // the known load was plotted too
+  double mean_identified_kN = 0;  // identified.json mean_surge_ice_resistance_n / 1000
+  double mean_known_kN = NAN;     // identified.json known_load.mean_surge_ice_resistance_n / 1000
+};
+IdentifiedPlotSummary plot_identified_load(const std::filesystem::path& identify_dir, const PlotOptions& o,
+                                           const std::filesystem::path& out_dir);
 
 }  // namespace floesim::render

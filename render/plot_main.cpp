@@ -8,12 +8,15 @@
 int main(int argc, char** argv) {
   CLI::App app{"Plot the surge ice load of a simulated transit: raw, moving average and steady-state mean",
                "floesim-plot"};
-  std::string results, config, out;
+  std::string results, config, out, identified;
   bool check_config = false;
   app.add_option("--results", results, "simulation results (HDF5, from floesim-simulate)");
   app.add_option("--config", config, "plot options (JSON; see --help-config)")->required();
   app.add_flag("--check-config", check_config, "read and check --config (strictly, as a run would), write nothing");
   app.add_option("--out", out, "output directory");
+  app.add_option("--identified", identified,
+                 "also plot the ice load floesim-identify found (its output folder: identified.csv and "
+                 "identified.json) as identified_load.{png,svg}");
   app.add_flag_callback("--help-config", [] {
     std::cout << floesim::options_doc(floesim::render::PlotOptions{});
     throw CLI::Success();
@@ -29,5 +32,14 @@ int main(int argc, char** argv) {
               << "resistance " << s.mean_kN << " kN over t >= " << s.steady_start_s << " s (" << s.contact_model
               << " contacts, " << s.window_s << " s moving average); " << s.fracture_events << " fracture events, "
               << s.vessel_splitting_events + s.vessel_bending_radial_events << " at the vessel\n";
+    if (!identified.empty()) {
+      const auto p = floesim::render::plot_identified_load(identified, floesim::render::read_plot_options(config),
+                                                           out);
+      std::cout << "wrote " << out << "/identified_load.{png,svg}: identified mean resistance "
+                << p.mean_identified_kN << " kN" << (p.known ? ", simulated " + std::to_string(p.mean_known_kN) +
+                                                                   " kN over the same window"
+                                                             : std::string())
+                << "\n";
+    }
   });
 }

@@ -315,6 +315,52 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
     pg.missing.push_back("plots/plot.json (plot numbers)");
   }
 
+  // Identified load: the case's "identify" section ran the identification (config/identify.json is its settings).
+  if (fs::exists(run_dir / "config/identify.json")) {
+    body << "<h2>Ice load identified from the ship's data</h2>\n";
+    const bool round_trip = fs::exists(run_dir / "config/shipdata.json");
+    body << "<p class=\"note\">"
+         << (round_trip ? "The data are the simulated ship's, as a ship would record them (shipdata/measured.csv, "
+                          "sensor settings in config/shipdata.json), identified with the simulated ship's own "
+                          "model (shipdata/measured.json): the round trip checks the identification against the "
+                          "known simulated load."
+                        : "The data are the ship's measured data named in the case (identify.measured).")
+         << " The model is M &nu;&#775; = &tau;<sub>thr</sub> + &tau;<sub>hyd</sub> + &tau;<sub>wind</sub> + "
+            "&tau;<sub>ice</sub> in surge, sway and yaw, solved for &tau;<sub>ice</sub> (PHYSICS.md &sect;4.4).</p>\n";
+    if (pg.have("identify/identified.json", "identification numbers")) {
+      const Json ij = pg.json("identify/identified.json", "identification numbers");
+      rs.identified_kN = number_or_nan(ij, {"mean_surge_ice_resistance_n"}) / 1000;
+      const Json* w = find(ij, {"mean_window_s"});
+      const std::string window = w && w->is_array() && w->size() == 2
+                                     ? fmt("%g", (*w)[0].get<double>()) + " to " + fmt("%g", (*w)[1].get<double>()) + " s"
+                                     : std::string("?");
+      body << "<table id=\"identified\">\n<tr><th>quantity</th><th>kN</th></tr>\n"
+           << "<tr><th>identified mean surge ice resistance (" << window << ")</th><td class=\"n\" "
+           << "id=\"identified-kN\">" << kN(rs.identified_kN) << "</td></tr>\n";
+      if (const Json* k = find(ij, {"known_load"})) {
+        rs.identified_known_kN = number_or_nan(*k, {"mean_surge_ice_resistance_n"}) / 1000;
+        rs.identified_error_percent = -number_or_nan(*k, {"surge_error_percent"});
+        body << "<tr><th>the simulated load over the same window</th><td class=\"n\">" << kN(rs.identified_known_kN)
+             << "</td></tr>\n<tr><th>identified &minus; simulated</th><td class=\"n\">"
+             << fmt("%+.1f", rs.identified_kN - rs.identified_known_kN) << " (" << fmt("%+.2f", rs.identified_error_percent)
+             << " %)</td></tr>\n<tr><th>RMS error of the filtered series (standard deviation of the simulated "
+                "one)</th><td class=\"n\">"
+             << kN(number_or_nan(*k, {"output_rate_surge_rms_error_n"}) / 1000) << " ("
+             << kN(number_or_nan(*k, {"output_rate_surge_known_sd_n"}) / 1000) << ")</td></tr>\n";
+      } else {
+        body << "<tr><th>simulated &minus; identified</th><td class=\"n\">"
+             << fmt("%+.1f", rs.mean_kN - rs.identified_kN) << " ("
+             << fmt("%+.1f", 100 * (rs.mean_kN - rs.identified_kN) / rs.identified_kN) << " %)</td></tr>\n";
+      }
+      body << "</table>\n";
+    }
+    if (pg.have("plots/identified_load.png", "identified load plot"))
+      body << "<figure>" << pg.img(run_dir / "plots/identified_load.png", "identified", "identified load plot")
+           << "<figcaption>The identified surge ice resistance at the identification's output rate"
+           << (round_trip ? " and the simulated one averaged over the same intervals" : "")
+           << ", with their means over the identification's window.</figcaption></figure>\n";
+  }
+
   // Input and digitised field; a case that gives its floes directly ("floes": {"file"}) has neither, and that is
   // no gap in the run (the runner wrote no digitise settings).
   body << "<h2>Ice field</h2>\n";

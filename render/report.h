@@ -6,6 +6,7 @@
 // a box on the page (and returned); a run without sim/summary.json is an error and nothing is written.
 // floesim-report is a thin main over write_report().
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -69,6 +70,9 @@ struct ReportSummary {
   double moving_average_window_s = 0;
   std::vector<ReferenceComparison> references;
   std::vector<std::string> missing;         // artefacts the page lacks, "path (what)", relative to the run folder
+  double identified_kN = NAN;                // identify/identified.json's mean resistance (NaN: no identification)
+  double identified_known_kN = NAN;          // ... the known (simulated) load's over the same window (round trip)
+  double identified_error_percent = NAN;     // identified against known, % (round trip)
   bool video_embedded = false;
   uintmax_t video_bytes = 0;                // 0 if no video
 };

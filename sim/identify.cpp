@@ -9,10 +9,12 @@
 #include <sstream>
 
 #include "pipeline/atomic_file.h"
+#include "pipeline/csv.h"
 #include "pipeline/error.h"
 #include "pipeline/provenance.h"
 #include <Eigen/Dense>
 
+#include "pipeline/geometry2d.h"
 #include "pipeline/signal.h"
 #include "sim/forces.h"
 #include "sim/model.h"
@@ -23,8 +25,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 // Plausibility limits: a value beyond them is far more likely a unit mistake (knots, km/h, deg/s, kN) than real.
 constexpr double kMaxSpeedMps = 15.0;        // ~29 kn: no icebreaker goes faster through the water
 constexpr double kMaxYawRateRadps = 1.0;     // 57 deg/s
@@ -34,40 +34,31 @@ constexpr double kMaxAccelerationMps2 = 5.0;  // half of g: an IMU with gravity 
 constexpr double kMaxYawAccelerationRadps2 = 1.0;
 constexpr double kMaxGapRatio = 1.5;         // a step longer than this x the median step is a gap
 
+// Column groups: the required ones; the measured accelerations (all three or none); a known ice load (all three or
+// none), which a simulated ship's data carry so that identification can be checked against it.
+enum class Group { required, acceleration, known_load };
+
 struct Column {
   const char* name;
-  bool required;
+  Group group;
   std::vector<double> MeasuredSeries::*member;
 };
 
 const Column kColumns[] = {
-    {"time_s", true, &MeasuredSeries::time_s},
-    {"u_mps", true, &MeasuredSeries::u_mps},
-    {"v_mps", true, &MeasuredSeries::v_mps},
-    {"r_radps", true, &MeasuredSeries::r_radps},
-    {"thrust_n", true, &MeasuredSeries::thrust_n},
-    {"wind_speed_mps", true, &MeasuredSeries::wind_speed_mps},
-    {"wind_angle_deg", true, &MeasuredSeries::wind_angle_deg},
-    {"du_mps2", false, &MeasuredSeries::du_mps2},
-    {"dv_mps2", false, &MeasuredSeries::dv_mps2},
-    {"dr_radps2", false, &MeasuredSeries::dr_radps2},
+    {"time_s", Group::required, &MeasuredSeries::time_s},
+    {"u_mps", Group::required, &MeasuredSeries::u_mps},
+    {"v_mps", Group::required, &MeasuredSeries::v_mps},
+    {"r_radps", Group::required, &MeasuredSeries::r_radps},
+    {"thrust_n", Group::required, &MeasuredSeries::thrust_n},
+    {"wind_speed_mps", Group::required, &MeasuredSeries::wind_speed_mps},
+    {"wind_angle_deg", Group::required, &MeasuredSeries::wind_angle_deg},
+    {"du_mps2", Group::acceleration, &MeasuredSeries::du_mps2},
+    {"dv_mps2", Group::acceleration, &MeasuredSeries::dv_mps2},
+    {"dr_radps2", Group::acceleration, &MeasuredSeries::dr_radps2},
+    {"sim_ice_surge_n", Group::known_load, &MeasuredSeries::known_ice_surge_n},
+    {"sim_ice_sway_n", Group::known_load, &MeasuredSeries::known_ice_sway_n},
+    {"sim_ice_yaw_nm", Group::known_load, &MeasuredSeries::known_ice_yaw_nm},
 };
-
-std::string trim(const std::string& s) {
-  size_t a = 0, b = s.size();
-  while (a < b && (s[a] == ' ' || s[a] == '\t' || s[a] == '\r' || s[a] == '"')) ++a;
-  while (b > a && (s[b - 1] == ' ' || s[b - 1] == '\t' || s[b - 1] == '\r' || s[b - 1] == '"')) --b;
-  return s.substr(a, b - a);
-}
-
-std::vector<std::string> split_csv(const std::string& line) {
-  std::vector<std::string> cells;
-  std::string cell;
-  std::istringstream is(line);
-  while (std::getline(is, cell, ',')) cells.push_back(trim(cell));
-  if (!line.empty() && line.back() == ',') cells.push_back("");
-  return cells;
-}
 
 // A unit mistake, not a measurement: the message says which limit and what the column's unit is.
 std::string implausible(const std::string& where, const char* col, double x, const char* limit, const char* unit) {
@@ -90,16 +81,16 @@ MeasuredSeries read_measured_csv(const fs::path& file) {
   bool got_header = false;
   while (!got_header && std::getline(in, line)) {
     ++lineno;
-    got_header = !trim(line).empty();
+    got_header = !is_blank_csv_line(line);
   }
   FLOESIM_REQUIRE(got_header, f, ": empty file (expected a header with time_s,u_mps,v_mps,r_radps,thrust_n,"
                   "wind_speed_mps,wind_angle_deg and one row per sample)");
-  const std::vector<std::string> header = split_csv(line);
+  const std::vector<std::string> header = split_csv_line(line);
   std::map<std::string, size_t> index;
   for (size_t i = 0; i < header.size(); ++i) index.emplace(header[i], i);
   std::vector<std::string> missing;
   for (const Column& c : kColumns)
-    if (c.required && !index.count(c.name)) missing.push_back(c.name);
+    if (c.group == Group::required && !index.count(c.name)) missing.push_back(c.name);
   if (!missing.empty()) {
     std::string names;
     for (const std::string& m : missing) names += (names.empty() ? "" : ", ") + m;
@@ -112,6 +103,12 @@ MeasuredSeries read_measured_csv(const fs::path& file) {
                   " (header): give all three measured accelerations du_mps2, dv_mps2, dr_radps2 or none (then they "
                   "come from differentiating the velocities)");
   const bool with_acc = n_acc == 3;
+  const int n_known =
+      int(index.count("sim_ice_surge_n")) + int(index.count("sim_ice_sway_n")) + int(index.count("sim_ice_yaw_nm"));
+  FLOESIM_REQUIRE(n_known == 0 || n_known == 3, f, ": line ", lineno,
+                  " (header): give all three known ice-load columns sim_ice_surge_n, sim_ice_sway_n, sim_ice_yaw_nm "
+                  "or none");
+  const bool with_known = n_known == 3;
   // IMUs: imu1.., each with both columns; they replace du/dv/dr, so both at once would be ambiguous.
   size_t n_imu = 0;
   for (size_t k = 1; k <= 5; ++k) {
@@ -132,19 +129,17 @@ MeasuredSeries read_measured_csv(const fs::path& file) {
   std::vector<size_t> row_line;  // the file line of each sample, for the messages below
   while (std::getline(in, line)) {
     ++lineno;
-    if (trim(line).empty()) continue;
-    const std::vector<std::string> cells = split_csv(line);
+    if (is_blank_csv_line(line)) continue;
+    const std::vector<std::string> cells = split_csv_line(line);
     const std::string where = f + ": line " + std::to_string(lineno) + " (data row " +
                               std::to_string(m.time_s.size() + 1) + ")";
     FLOESIM_REQUIRE(cells.size() == header.size(), where, ": ", cells.size(), " cells, the header has ",
                     header.size());
     for (const Column& c : kColumns) {
-      if (!c.required && !with_acc) continue;
+      if ((c.group == Group::acceleration && !with_acc) || (c.group == Group::known_load && !with_known)) continue;
       const std::string& s = cells[index.at(c.name)];
-      char* end = nullptr;
-      const double x = s.empty() ? NAN : std::strtod(s.c_str(), &end);
-      const bool parsed = !s.empty() && end == s.c_str() + s.size();
-      FLOESIM_REQUIRE(parsed && std::isfinite(x), where, ", column ", c.name, ": '", s,
+      double x = 0;
+      FLOESIM_REQUIRE(parse_finite_number(s, x), where, ", column ", c.name, ": '", s,
                       "' is not a finite number (NaN, inf and empty cells are errors: cut the series or fill the "
                       "gap)");
       (m.*(c.member)).push_back(x);
@@ -172,9 +167,8 @@ MeasuredSeries read_measured_csv(const fs::path& file) {
       for (const char* axis : {"ax", "ay"}) {
         const std::string col = "imu" + std::to_string(k + 1) + "_" + axis + "_mps2";
         const std::string& c = cells[index.at(col)];
-        char* end = nullptr;
-        const double x = c.empty() ? NAN : std::strtod(c.c_str(), &end);
-        FLOESIM_REQUIRE(!c.empty() && end == c.c_str() + c.size() && std::isfinite(x), where, ", column ", col,
+        double x = 0;
+        FLOESIM_REQUIRE(parse_finite_number(c, x), where, ", column ", col,
                         ": '", c, "' is not a finite number");
         FLOESIM_REQUIRE(std::abs(x) <= kMaxAccelerationMps2,
                         implausible(where, col.c_str(), x, "|a| > 5 m/s^2; gravity not removed?", "m/s^2"));
@@ -253,6 +247,39 @@ Load3 wind_load(double speed_mps, double angle_deg, const IdentifyWindOptions& o
   return w;
 }
 
+namespace {
+
+// The identified load against the known one over the mean window (see KnownLoadComparison).
+KnownLoadComparison compare_with_known(const Identification& id) {
+  KnownLoadComparison c;
+  long double kx = 0, ky = 0, kn = 0;
+  const IdentifiedSeries& s = id.samples;
+  for (size_t i = 0; i < s.time_s.size(); ++i) {
+    if (s.time_s[i] < id.mean_t0_s || s.time_s[i] > id.mean_t1_s) continue;
+    kx += s.known[i].surge, ky += s.known[i].sway, kn += s.known[i].yaw;
+  }
+  const double n = double(id.mean_samples);
+  c.mean_known = {double(kx / n), double(ky / n), double(kn / n)};
+  c.surge_error_n = id.mean_ice.surge - c.mean_known.surge;
+  c.surge_error_relative = c.mean_known.surge != 0 ? c.surge_error_n / std::abs(c.mean_known.surge) : NAN;
+  const IdentifiedSeries& o = id.output;
+  double se = 0, m = 0, m2 = 0;
+  for (size_t k = 0; k < o.time_s.size(); ++k) {
+    if (o.time_s[k] < id.mean_t0_s || o.time_s[k] > id.mean_t1_s) continue;
+    const double d = o.ice[k].surge - o.known[k].surge;
+    se += d * d, m += o.known[k].surge, m2 += o.known[k].surge * o.known[k].surge;
+    ++c.intervals;
+  }
+  if (c.intervals > 0) {
+    const double ni = double(c.intervals);
+    c.surge_rms_n = std::sqrt(se / ni);
+    c.surge_sd_n = std::sqrt(std::max(0.0, m2 / ni - (m / ni) * (m / ni)));
+  }
+  return c;
+}
+
+}  // namespace
+
 Identification identify(const MeasuredSeries& m, const IdentifyOptions& o) {
   const size_t n = m.time_s.size();
   FLOESIM_REQUIRE(n >= 3, "identify: at least 3 samples are needed, got ", n);
@@ -327,6 +354,7 @@ Identification identify(const MeasuredSeries& m, const IdentifyOptions& o) {
     s.hydro.push_back(hydro);
     s.wind.push_back(wind);
     s.ice.push_back(ice);
+    if (m.has_known_ice()) s.known.push_back({m.known_ice_surge_n[i], m.known_ice_sway_n[i], m.known_ice_yaw_nm[i]});
   }
 
   // 3. Output rate: the arithmetic mean of the samples in each interval [t_0 + kT, t_0 + (k+1)T), k = 0..K-1, for
@@ -355,6 +383,7 @@ Identification identify(const MeasuredSeries& m, const IdentifyOptions& o) {
     out.hydro.push_back(avg3(s.hydro, members[k]));
     out.wind.push_back(avg3(s.wind, members[k]));
     out.ice.push_back(avg3(s.ice, members[k]));
+    if (m.has_known_ice()) out.known.push_back(avg3(s.known, members[k]));
     double u = 0;
     for (size_t i : members[k]) u += m.u_mps[i];
     out.u_mps.push_back(u / double(members[k].size()));
@@ -373,6 +402,10 @@ Identification identify(const MeasuredSeries& m, const IdentifyOptions& o) {
                   "] s holds no sample of the series (", m.time_s.front(), " to ", m.time_s.back(),
                   " s): move the window into the series");
   id.mean_ice = {double(sx / id.mean_samples), double(sy / id.mean_samples), double(sn / id.mean_samples)};
+  if (m.has_known_ice()) {
+    id.has_known = true;
+    id.known = compare_with_known(id);
+  }
   return id;
 }
 
@@ -382,13 +415,17 @@ std::string identified_csv(const Identification& id) {
   std::ostringstream os;
   os << std::setprecision(10);
   os << "time_s,ice_surge_n,ice_sway_n,ice_yaw_nm,u_mps,thrust_surge_n,hydro_surge_n,hydro_sway_n,hydro_yaw_nm,"
-        "wind_surge_n,wind_sway_n,wind_yaw_nm,inertia_surge_n,inertia_sway_n,inertia_yaw_nm\n";
+        "wind_surge_n,wind_sway_n,wind_yaw_nm,inertia_surge_n,inertia_sway_n,inertia_yaw_nm";
+  if (id.has_known) os << ",known_ice_surge_n,known_ice_sway_n,known_ice_yaw_nm";
+  os << '\n';
   const IdentifiedSeries& s = id.output;
   for (size_t k = 0; k < s.time_s.size(); ++k) {
     os << s.time_s[k] << ',' << s.ice[k].surge << ',' << s.ice[k].sway << ',' << s.ice[k].yaw << ',' << s.u_mps[k]
        << ',' << s.thrust[k].surge << ',' << s.hydro[k].surge << ',' << s.hydro[k].sway << ',' << s.hydro[k].yaw
        << ',' << s.wind[k].surge << ',' << s.wind[k].sway << ',' << s.wind[k].yaw << ',' << s.inertia[k].surge << ','
-       << s.inertia[k].sway << ',' << s.inertia[k].yaw << '\n';
+       << s.inertia[k].sway << ',' << s.inertia[k].yaw;
+    if (id.has_known) os << ',' << s.known[k].surge << ',' << s.known[k].sway << ',' << s.known[k].yaw;
+    os << '\n';
   }
   return os.str();
 }
@@ -425,6 +462,20 @@ std::string run_identify(const fs::path& measured_file, const fs::path& config_f
   j["sign_convention"] =
       "forces and moments on the ship, body axes x forward, y to port, z up; ice resisting the advance gives a "
       "negative surge load (resistance = -surge load)";
+  if (id.has_known) {
+    const KnownLoadComparison& k = id.known;
+    j["known_load"] = {
+        {"what", "the ice load given in the measured data's sim_ice_* columns (a simulated ship's)"},
+        {"mean_surge_ice_load_n", k.mean_known.surge},
+        {"mean_surge_ice_resistance_n", -k.mean_known.surge},
+        {"mean_sway_ice_load_n", k.mean_known.sway},
+        {"mean_yaw_ice_load_nm", k.mean_known.yaw},
+        {"surge_error_n", k.surge_error_n},
+        {"surge_error_percent", 100 * k.surge_error_relative},
+        {"output_rate_surge_rms_error_n", k.surge_rms_n},
+        {"output_rate_surge_known_sd_n", k.surge_sd_n},
+        {"output_intervals_compared", k.intervals}};
+  }
   j["settings"] = settings;
   j["provenance"] = make_provenance("floesim-identify", inputs, settings);
 
@@ -442,6 +493,11 @@ std::string run_identify(const fs::path& measured_file, const fs::path& config_f
       << id.acceleration_window_samples << " samples\n";
   rep << std::setprecision(1) << "mean surge ice load " << id.mean_ice.surge / 1e3 << " kN (resistance "
       << -id.mean_ice.surge / 1e3 << " kN) over " << id.mean_t0_s << " to " << id.mean_t1_s << " s\n";
+  if (id.has_known)
+    rep << std::setprecision(1) << "against the known load of the data: mean " << -id.known.mean_known.surge / 1e3
+        << " kN resistance, identified " << std::showpos << std::setprecision(3) << 100 * id.known.surge_error_relative
+        << std::noshowpos << " %; RMS error of the " << std::defaultfloat << o.filters.output_interval_s << std::fixed << " s series " << std::setprecision(1)
+        << id.known.surge_rms_n / 1e3 << " kN (known series sd " << id.known.surge_sd_n / 1e3 << " kN)\n";
   rep << "wrote " << (out_dir / "identified.csv").string() << " (" << id.output.time_s.size() << " rows) and "
       << (out_dir / "identified.json").string() << "\n";
   return rep.str();

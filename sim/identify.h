@@ -172,7 +172,11 @@ struct MeasuredSeries {
   std::vector<double> time_s, u_mps, v_mps, r_radps, thrust_n, wind_speed_mps, wind_angle_deg;
   std::vector<double> du_mps2, dv_mps2, dr_radps2;
   std::vector<std::vector<double>> imu_ax_mps2, imu_ay_mps2;  // per IMU (k = 1.. in order), per sample
+  // A known ice load (columns sim_ice_surge_n, sim_ice_sway_n, sim_ice_yaw_nm, which floesim-shipdata writes for a
+  // simulated ship): not used by the identification, only compared with its result. Empty when absent.
+  std::vector<double> known_ice_surge_n, known_ice_sway_n, known_ice_yaw_nm;
   bool has_accelerations() const { return !du_mps2.empty(); }
+  bool has_known_ice() const { return !known_ice_surge_n.empty(); }
 };
 
 // Reads and checks the measured CSV: header with the required columns (any order, extra ones ignored; all three
@@ -202,7 +206,19 @@ Load3 wind_load(double speed_mps, double angle_deg, const IdentifyWindOptions& o
 struct IdentifiedSeries {
   std::vector<double> time_s;
   std::vector<Load3> inertia, thrust, hydro, wind, ice;  // inertia = M nu_dot (+ C(nu) nu)
+  std::vector<Load3> known;   // the known ice load of the input, when it has one (else empty)
   std::vector<double> u_mps;  // averaged velocity (output series only)
+};
+
+// The identified ice load against a known one (a simulated ship's), over the mean window: the means of the
+// full-rate series, and the output-rate (filtered) series over the intervals whose centre lies in the window.
+struct KnownLoadComparison {
+  Load3 mean_known;               // arithmetic mean of the known full-rate load over the mean window
+  double surge_error_n = 0;       // identified mean surge load - known mean surge load
+  double surge_error_relative = 0;  // ... / |known mean surge load|
+  double surge_rms_n = 0;         // RMS of identified - known, output rate, surge
+  double surge_sd_n = 0;          // standard deviation of the known output-rate surge load (the scale of the RMS)
+  size_t intervals = 0;           // output intervals compared
 };
 struct Identification {
   IdentifiedSeries samples;  // at the input rate
@@ -214,6 +230,8 @@ struct Identification {
   double mean_t0_s = 0, mean_t1_s = 0;
   size_t mean_samples = 0;
   Load3 mean_ice;  // arithmetic mean of the full-rate ice load over [mean_t0_s, mean_t1_s]
+  bool has_known = false;          // the input had a known ice load
+  KnownLoadComparison known;       // ... and how the identified one compares with it
 };
 
 // Solves the model for the ice load. Errors if the series is shorter than one output interval or its step is

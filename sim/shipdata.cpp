@@ -5,6 +5,7 @@
 #include <random>
 #include <sstream>
 
+#include "pipeline/geometry2d.h"
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
 #include "pipeline/provenance.h"
@@ -16,8 +17,6 @@ namespace fs = std::filesystem;
 namespace floesim::sim {
 
 namespace {
-
-constexpr double kPiD = 3.14159265358979323846;
 
 double number_at(const nlohmann::json& j, const char* section, const char* key) {
   FLOESIM_REQUIRE(j.contains(section) && j[section].is_object() && j[section].contains(key) &&
@@ -99,7 +98,7 @@ ShipData make_ship_data(const Results& results, const nlohmann::json& summary, c
   const auto& ice = results.get("ice_load");
   const size_t n = t.size();
   FLOESIM_REQUIRE(n >= 2, "results.h5 has ", n, " steps: at least 2 are needed");
-  const double cdir = s.water.current_direction_deg * kPiD / 180, wdir = s.wind.direction_deg * kPiD / 180;
+  const double cdir = s.water.current_direction_deg * kPi / 180, wdir = s.wind.direction_deg * kPi / 180;
   const Vec3 current = s.water.current_speed_mps * Vec3(std::cos(cdir), std::sin(cdir), 0);
   const Vec3 wind = s.wind.speed_mps * Vec3(std::cos(wdir), std::sin(wdir), 0);
   d.wind = s.wind.speed_mps > 0;
@@ -115,7 +114,7 @@ ShipData make_ship_data(const Results& results, const nlohmann::json& summary, c
       // As vessel_wind: the air velocity relative to the vessel, body axes; gamma the angle it comes from.
       const Vec3 a = R.transpose() * wind - vb;
       ws[i] = std::hypot(a.x(), a.y());
-      wa[i] = ws[i] > 0 ? std::atan2(-a.y(), -a.x()) * 180 / kPiD : 0.0;
+      wa[i] = ws[i] > 0 ? std::atan2(-a.y(), -a.x()) * 180 / kPi : 0.0;
     }
   }
   // Backward differences at the simulation step (forward for the first row).

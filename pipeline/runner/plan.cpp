@@ -78,6 +78,7 @@ fs::path self_dir() {
 std::string run_folder(const std::string& stage) {
   static const std::map<std::string, std::string> folder = {{"synth", "image"},  {"digitise", "floes"},
                                                             {"hull", "hull"},    {"simulate", "sim"},
+                                                            {"shipdata", "shipdata"}, {"identify", "identify"},
                                                             {"render", "video"}, {"plot", "plots"},
                                                             {"report", "report"}};
   return folder.at(stage);
@@ -94,6 +95,7 @@ void absolute_case_files(Json& c, const fs::path& case_dir) {
   fix(at(c, "image"), "file");
   fix(at(c, "floes"), "file");
   fix(at(c, "hull"), "file");
+  fix(at(c, "identify"), "measured");
   if (Json* s = at(c, "simulate"))
     if (Json* v = at(*s, "vessel")) fix(at(*v, "propulsion"), "thrust_file");
 }
@@ -102,13 +104,13 @@ CasePlan plan_case(const Json& c, const std::string& where, const fs::path& case
                    const StageLayout& layout, bool render, bool report) {
   const std::string& cf = where;
   FLOESIM_REQUIRE(c.is_object(), cf, ": the top level must be an object");
-  const std::vector<std::string> known = {"description", "image", "digitise", "floes", "hull", "simulate", "render",
-                                          "plot", "report"};
+  const std::vector<std::string> known = {"description", "image", "digitise", "floes", "hull", "simulate", "identify",
+                                          "render", "plot", "report"};
   for (auto it = c.begin(); it != c.end(); ++it) {
     bool ok = false;
     for (auto& k : known) ok = ok || k == it.key();
     FLOESIM_REQUIRE(ok, cf, ": unknown key \"", it.key(),
-                    "\" (known: description, image, digitise, floes, hull, simulate, render, plot, report)");
+                    "\" (known: description, image, digitise, floes, hull, simulate, identify, render, plot, report)");
   }
   // Floes come from a photo (image + digitise) or directly from a floes GeoJSON the case owns ("floes": {"file"}).
   FLOESIM_REQUIRE(c.contains("image") != c.contains("floes"), cf,
@@ -249,6 +251,55 @@ CasePlan plan_case(const Json& c, const std::string& where, const fs::path& case
     plan.artefacts.push_back({"simulate", "sim/summary.json", "mean surge ice load and settings"});
   }
 
+  // --- identify: the ice load back-calculated from a ship's data, as full-scale loads are (PHYSICS.md §4.4) ---
+  // From the case's measured data ("measured": a CSV, "config": its identify options), or, with no "measured",
+  // from the simulated ship itself (the round trip): floesim-shipdata turns the transit into the data the ship
+  // would have recorded, with the sensor noise its "shipdata" options give, and the identify config of the
+  // simulated ship, which identify then uses.
+  fs::path identify_dir;
+  if (c.contains("identify")) {
+    const Json& id = require_object(c, "identify", cf);
+    for (auto it = id.begin(); it != id.end(); ++it)
+      FLOESIM_REQUIRE(it.key() == "measured" || it.key() == "config" || it.key() == "shipdata", cf,
+                      ": unknown key identify.", it.key(),
+                      " (known: measured, config: a ship's data and its identify options; shipdata: the sensor "
+                      "options of the round trip from the simulated ship)");
+    for (const char* k : {"config", "shipdata"})
+      FLOESIM_REQUIRE(!id.contains(k) || id[k].is_object(), cf, ": identify.", k, " must be an object");
+    PlannedStage* st = nullptr;
+    if (id.contains("measured")) {
+      FLOESIM_REQUIRE(!id.contains("shipdata"), cf,
+                      ": identify.shipdata has no effect with identify.measured (the data are the ship's, not made "
+                      "from the simulation): remove it");
+      const fs::path measured = case_input(id, "measured", "identify");
+      st = add("identify", "ice load identified from the measured ship data",
+               id.contains("config") ? id["config"] : Json::object(), {measured},
+               {"identified.csv", "identified.json"}, "floesim-identify");
+      st->args = {"--measured", measured.string(), "--config", st->config.string(), "--out", st->dir.string()};
+    } else {
+      FLOESIM_REQUIRE(!id.contains("config"), cf,
+                      ": identify.config is for a ship's measured data (identify.measured); the round trip "
+                      "identifies with the simulated ship's own config: remove it");
+      PlannedStage* sd = add("shipdata", "the simulated ship's data as a ship would record them",
+                             id.contains("shipdata") ? id["shipdata"] : Json::object(), {plan.results, plan.summary},
+                             {"measured.csv", "measured.json"}, "floesim-shipdata");
+      sd->args = {"--results", plan.results.string(), "--summary", plan.summary.string(), "--config",
+                  sd->config.string(), "--out", sd->outputs[0].string()};
+      plan.artefacts.push_back({"shipdata", "shipdata/measured.csv",
+                                "the simulated ship's data as recorded (velocities, accelerations, thrust, wind)"});
+      const fs::path measured = sd->outputs[0], ship_config = sd->outputs[1];
+      // Its own settings file stays empty: the config is the simulated ship's, which shipdata wrote.
+      st = add("identify", "ice load identified from the simulated ship's data", Json::object(),
+               {measured, ship_config}, {"identified.csv", "identified.json"}, "floesim-identify");
+      st->args = {"--measured", measured.string(), "--config", ship_config.string(), "--out", st->dir.string()};
+    }
+    identify_dir = st->dir;
+    plan.artefacts.push_back({"identify", "identify/identified.csv", "identified ice load at 2 Hz (and the known "
+                                                                     "load when the data carried one)"});
+    plan.artefacts.push_back({"identify", "identify/identified.json", "identified mean ice loads (and their error "
+                                                                      "against the known load)"});
+  }
+
   // --- render and plot (independent of each other) ---
   fs::path video, plot_png;
   {
@@ -266,9 +317,21 @@ CasePlan plan_case(const Json& c, const std::string& where, const fs::path& case
   {
     Json p = c.contains("plot") ? c["plot"] : Json::object();
     FLOESIM_REQUIRE(p.is_object(), cf, ": plot must be an object");
-    PlannedStage* st = add("plot", "surge ice load plots", p, {plan.results},
-                           {"surge_ice_load.png", "surge_ice_load.svg", "fracture_events.csv"}, "floesim-plot");
+    std::vector<fs::path> inputs = {plan.results};
+    std::vector<std::string> outputs = {"surge_ice_load.png", "surge_ice_load.svg", "fracture_events.csv"};
+    if (!identify_dir.empty()) {
+      inputs.push_back(identify_dir / "identified.csv");
+      inputs.push_back(identify_dir / "identified.json");
+      outputs.push_back("identified_load.png");
+    }
+    PlannedStage* st = add("plot", "surge ice load plots", p, inputs, outputs, "floesim-plot");
     st->args = {"--results", plan.results.string(), "--config", st->config.string(), "--out", st->dir.string()};
+    if (!identify_dir.empty()) {
+      st->args.push_back("--identified");
+      st->args.push_back(identify_dir.string());
+      plan.artefacts.push_back(
+          {"plot", "plots/identified_load.png", "identified against simulated surge ice load, same filter (PNG)"});
+    }
     plot_png = st->outputs[0];
     plan.artefacts.push_back({"plot", "plots/surge_ice_load.png", "surge ice load, moving average and mean (PNG)"});
     plan.artefacts.push_back({"plot", "plots/surge_ice_load.svg", "the same (SVG)"});
@@ -283,8 +346,9 @@ CasePlan plan_case(const Json& c, const std::string& where, const fs::path& case
     if (render && report) {
       // It reads the whole run folder; the summary, the plot and the video are what make it stale (every other
       // artefact it shows lies upstream of the summary).
-      PlannedStage* st = add("report", "self-contained HTML report", r, {plan.summary, plot_png, video},
-                             {"report.html"}, "floesim-report");
+      std::vector<fs::path> inputs = {plan.summary, plot_png, video};
+      if (!identify_dir.empty()) inputs.push_back(identify_dir / "identified.json");
+      PlannedStage* st = add("report", "self-contained HTML report", r, inputs, {"report.html"}, "floesim-report");
       st->args = {"--run", st->dir.parent_path().string(), "--config", st->config.string(), "--out",
                   st->outputs[0].string()};
       plan.artefacts.push_back({"report", "report/report.html", "the run on one page: case, loads, plots, field, "

@@ -27,14 +27,14 @@ struct StageTiming {
   double wall_s = 0;      // from ninja's log
 };
 
-// Reads RUN/.ninja_log: the last recorded wall time of each stage, and whether its first output is newer than
-// `since` (it ran in this invocation).
-std::vector<StageTiming> stage_timings(const std::filesystem::path& run_dir,
+// Reads RUN/.ninja_log: the last recorded wall time of each of the planned stages (by its first output), and
+// whether that output is newer than `since` (it ran in this invocation).
+std::vector<StageTiming> stage_timings(const std::filesystem::path& run_dir, const std::vector<PlannedStage>& stages,
                                        std::filesystem::file_time_type since);
 
 // Builds RUN/build.ninja and RUN/config/*.json from CASE/case.json (strictly validated at the top level).
-// Returns the artefacts the run produces (for the closing table).
-std::vector<Artefact> prepare_run(const RunOptions& o);
+// Returns the plan (its stages and the artefacts the run produces, for the closing tables).
+CasePlan prepare_run(const RunOptions& o);
 
 // prepare_run + ninja. Returns ninja's exit status (0 = all stages up to date or rebuilt).
 int run_case(const RunOptions& o);

@@ -272,3 +272,53 @@ TEST_F(TinyCase, FailedStageStopsAndLeavesNothingThatLooksComplete) {
   for (auto& e : fs::recursive_directory_iterator(run_))
     EXPECT_EQ(e.path().filename().string().rfind(".tmp-", 0), std::string::npos) << e.path() << " left behind";
 }
+
+// The round trip as stages of a run (case key "identify" without "measured"): the transit becomes the data the
+// ship would record, identify finds the ice load from them with the simulated ship's model, and the plot and the
+// report show it against the simulated load. The identified mean must match the simulation's own mean
+// (summary.json, every step) within the 2 %; changing the sensor noise reruns the round trip, not the
+// simulation. The tiny field over 40 s, so that the hull meets ice.
+TEST_F(TinyCase, RoundTripStagesIdentifyTheSimulatedLoad) {
+  ASSERT_EQ(first_.code, 0) << first_.text;
+  const fs::path case_dir = root_ / "round-trip", run = root_ / "round-trip-run";
+  fs::create_directories(case_dir);
+  Json c = case_json();
+  c["simulate"]["duration_s"] = 40.0;
+  c["simulate"]["output_interval_s"] = 2.0;
+  c["simulate"]["steady_start_s"] = 10.0;
+  c["identify"] = {{"shipdata", Json::object()}};
+  std::ofstream(case_dir / "case.json") << c.dump(2);
+  const RunOutput out = run_case(case_dir, run);
+  ASSERT_EQ(out.code, 0) << out.text;
+  const Json summary = load_json_file(run / "sim" / "summary.json");
+  const Json id = load_json_file(run / "identify" / "identified.json");
+  const double sim_kN = summary["mean_surge_ice_resistance_N"].get<double>() / 1e3;
+  ASSERT_GT(sim_kN, 10.0) << "the transit should meet ice";
+  EXPECT_NEAR(id["mean_surge_ice_resistance_n"].get<double>() / 1e3, sim_kN, 0.02 * sim_kN);
+  // The comparison identify made against the data's known load is the summary's mean over the same steps.
+  EXPECT_NEAR(id["known_load"]["mean_surge_ice_resistance_n"].get<double>() / 1e3, sim_kN, 1e-9 * sim_kN);
+  for (const char* f : {"shipdata/measured.csv", "shipdata/measured.json", "identify/identified.csv",
+                        "plots/identified_load.png", "report/report.html"})
+    EXPECT_TRUE(fs::exists(run / f)) << f << " is missing\n" << out.text;
+  std::ifstream page(run / "report" / "report.html");
+  std::stringstream html;
+  html << page.rdbuf();
+  EXPECT_NE(html.str().find("id=\"identified-kN\""), std::string::npos);
+  EXPECT_EQ(html.str().find("id=\"missing\""), std::string::npos) << "the report lists something missing";
+
+  // Sensor noise changed: the round trip reruns, the simulation does not.
+  const auto t_results = mtime(run / "sim" / "results.h5"), t_measured = mtime(run / "shipdata" / "measured.csv");
+  c["identify"]["shipdata"] = {{"noise", {{"surge_sd_mps2", 0.001}}}, {"seed", 3}};
+  std::ofstream(case_dir / "case.json") << c.dump(2);
+  const RunOutput again = run_case(case_dir, run);
+  ASSERT_EQ(again.code, 0) << again.text;
+  EXPECT_EQ(mtime(run / "sim" / "results.h5"), t_results);
+  EXPECT_NE(mtime(run / "shipdata" / "measured.csv"), t_measured);
+
+  // A ship's identify config without a ship's data is refused, naming the key, before anything runs.
+  c["identify"] = {{"config", Json::object()}};
+  std::ofstream(case_dir / "case.json") << c.dump(2);
+  const RunOutput bad = run_case(case_dir, run);
+  EXPECT_NE(bad.code, 0);
+  EXPECT_NE(bad.text.find("identify.config"), std::string::npos) << bad.text;
+}

@@ -12,6 +12,7 @@
 #include <sys/wait.h>
 
 #include "pipeline/error.h"
+#include "pipeline/geometry2d.h"
 #include "pipeline/results_io.h"
 #include "render/gather.h"
 #include "pipeline/signal.h"
@@ -23,8 +24,6 @@ using namespace floesim::render::testing;
 namespace fs = std::filesystem;
 
 namespace {
-
-const double kPi = 3.14159265358979323846;
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p);

@@ -12,6 +12,7 @@
 
 #include "pipeline/error.h"
 #include "sim/identify.h"
+#include "pipeline/geometry2d.h"
 #include "sim_fixtures.h"
 
 namespace floesim::sim {
@@ -21,7 +22,6 @@ namespace fs = std::filesystem;
 using testing::temp_dir;
 
 const fs::path kBin = FLOESIM_BIN_DIR;
-constexpr double kPi = 3.14159265358979323846;
 
 template <class F>
 void expect_error(F f, std::initializer_list<const char*> pieces) {

@@ -261,6 +261,16 @@ TEST(ShipData, Executables) {
   const Identification id = identify(d.measured, d.identify);
   // The CSV holds 15 significant digits: the same mean up to their round-off.
   EXPECT_NEAR(j["mean_surge_ice_load_n"].get<double>(), id.mean_ice.surge, 1e-6 * std::abs(id.mean_ice.surge));
+  // The CSV's truth columns: identify compares its result with them. The mean and the 0.5 s RMS error equal this
+  // test's own computation of both (round_trip: the simulated rows' mean, its own interval means).
+  const RoundTrip rt = round_trip({});
+  ASSERT_TRUE(j.contains("known_load")) << j.dump(2);
+  const nlohmann::json& k = j["known_load"];
+  EXPECT_NEAR(k["mean_surge_ice_load_n"].get<double>(), rt.sim_rows_mean, 1e-6 * std::abs(rt.sim_rows_mean));
+  EXPECT_NEAR(k["surge_error_percent"].get<double>(), 100 * (rt.id_mean - rt.sim_rows_mean) / std::abs(rt.sim_rows_mean),
+              1e-3);
+  EXPECT_NEAR(k["output_rate_surge_rms_error_n"].get<double>(), rt.rms, 1e-3 * rt.rms);
+  EXPECT_NEAR(k["output_rate_surge_known_sd_n"].get<double>(), rt.sim_sd, 1e-6 * rt.sim_sd);
 
   // A summary of another run: refused, nothing written.
   r.attributes["provenance"] = {{"config", {{"duration_s", 1}}}};
