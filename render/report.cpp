@@ -185,6 +185,7 @@ figcaption{font-size:.9em;color:#555}
 .error{border:2px solid #c00;background:#fee;padding:.5em 1em}
 pre{background:#f6f6f6;padding:.6em;overflow:auto;font-size:.85em}
 .note{color:#555;font-size:.9em}
+.wide{overflow-x:auto}
 )";
 
 // Marks the page: <html data-media="ok"> once every image has decoded and the video has decoded its first frame
@@ -210,6 +211,40 @@ const char* kMediaCheck = R"(
     v.addEventListener('error',function(){ if(seen) return; seen=true; bad.push('video'); done(); }); });
 })();
 )";
+
+// The page around `body`: title, the media-error box, the box of missing artefacts, the provenance of every input
+// the page read, the media check; written atomically. Returns its size in bytes.
+uintmax_t write_page(const fs::path& out, const std::string& title, const std::string& body, const Page& pg,
+                     const Json& resolved_config) {
+  const Json prov = make_provenance("floesim-report", pg.inputs, resolved_config);
+  std::ostringstream html;
+  html << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" << html_escape(title)
+       << "</title>\n<meta name=\"generator\" content=\"floesim-report " << version() << "\">\n<style>" << kStyle
+       << "</style>\n</head>\n<body>\n<h1>" << html_escape(title) << "</h1>\n"
+       << "<p class=\"error\" id=\"media-error\" hidden></p>\n";
+  if (!pg.missing.empty()) {
+    html << "<div class=\"missing\" id=\"missing\"><strong>Missing from this run (" << pg.missing.size()
+         << "):</strong><ul>\n";
+    for (const auto& m : pg.missing) html << "<li>" << html_escape(m) << "</li>\n";
+    html << "</ul></div>\n";
+  }
+  html << body << "<h2>How this report was made</h2>\n<details><summary>provenance</summary><pre>"
+       << html_escape(prov.dump(2)) << "</pre></details>\n<script>" << kMediaCheck << "</script>\n</body>\n</html>\n";
+  const std::string text = html.str();
+  if (out.has_parent_path()) ensure_directory(out.parent_path());
+  write_text_atomic(out, text);
+  return text.size();
+}
+
+// A case's description, "" if its file does not read (it may have changed since the run).
+std::string case_description(const fs::path& case_json) {
+  try {
+    const Json c = load_json_file(case_json);
+    if (c.contains("description") && c["description"].is_string()) return c["description"].get<std::string>();
+  } catch (const Error&) {
+  }
+  return "";
+}
 
 }  // namespace
 
@@ -465,32 +500,140 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
          << html_escape(s->dump(2)) << "</pre></details>\n";
 
   // 4. Provenance of the page, then the page: the missing box first.
-  const Json prov = make_provenance("floesim-report", pg.inputs, resolved_config);
   rs.missing = pg.missing;
-  std::ostringstream html;
-  html << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" << html_escape(title)
-       << "</title>\n<meta name=\"generator\" content=\"floesim-report " << version() << "\">\n<style>" << kStyle
-       << "</style>\n</head>\n<body>\n<h1>" << html_escape(title) << "</h1>\n"
-       << "<p class=\"error\" id=\"media-error\" hidden></p>\n";
-  if (!pg.missing.empty()) {
-    html << "<div class=\"missing\" id=\"missing\"><strong>Missing from this run (" << pg.missing.size()
-         << "):</strong><ul>\n";
-    for (const auto& m : pg.missing) html << "<li>" << html_escape(m) << "</li>\n";
-    html << "</ul></div>\n";
-  }
-  html << body.str() << "<h2>How this report was made</h2>\n<details><summary>provenance</summary><pre>"
-       << html_escape(prov.dump(2)) << "</pre></details>\n<script>" << kMediaCheck << "</script>\n</body>\n</html>\n";
-
-  const std::string text = html.str();
-  if (out.has_parent_path()) ensure_directory(out.parent_path());
-  write_text_atomic(out, text);
-  rs.bytes = text.size();
+  rs.bytes = write_page(out, title, body.str(), pg, resolved_config);
   return rs;
 }
 
 ReportSummary write_report(const fs::path& run_dir, const fs::path& config, const fs::path& out) {
   const ReportOptions o = config.empty() ? ReportOptions{} : read_report_options(config);
   return write_report(run_dir, o, out, options_to_json(o));
+}
+
+SweepReportSummary write_sweep_report(const fs::path& sweep_dir, const ReportOptions& o, const fs::path& out,
+                                      const Json& resolved_config) {
+  SweepReportSummary rs;
+  rs.out = out;
+  Page pg;
+  pg.run = sweep_dir;
+  FLOESIM_REQUIRE(fs::is_directory(sweep_dir), sweep_dir.string(),
+                  ": not a folder; give --sweep the output folder of `floesim sweep` (e.g. runs/<sweep>)");
+  FLOESIM_REQUIRE(fs::is_regular_file(sweep_dir / "sweep.json"), (sweep_dir / "sweep.json").string(),
+                  " is missing: the sweep has not been gathered (run `floesim sweep` to the end first); no report "
+                  "written");
+  const Json sw = pg.json("sweep.json", "gathered sweep");
+  FLOESIM_REQUIRE(sw.value("format", "") == "floesim-sweep-results/1", (sweep_dir / "sweep.json").string(),
+                  ": format is not floesim-sweep-results/1; regather with this version's floesim-gather");
+  const Json plan = fs::is_regular_file(sweep_dir / "plan.json") ? pg.json("plan.json", "sweep plan") : Json::object();
+  const std::string name = sw.value("name", sweep_dir.filename().string());
+  const std::string title = o.title.empty() ? "floesim sweep report: " + name : o.title;
+  const std::vector<ReferenceLoad> refs = o.all_references();
+
+  std::ostringstream body;
+  // The sweep: what it varies, over which case.
+  body << "<h2>Sweep</h2>\n<table>\n<tr><th>sweep folder</th><td>"
+       << html_escape(fs::absolute(sweep_dir).lexically_normal().string()) << "</td></tr>\n";
+  const std::string sweep_file = sw.value("sweep_file", "");
+  if (!sweep_file.empty()) {
+    body << "<tr><th>sweep file</th><td>" << html_escape(sweep_file) << "</td></tr>\n";
+    if (const std::string d = case_description(sweep_file); !d.empty())
+      body << "<tr><th>description</th><td>" << html_escape(d) << "</td></tr>\n";
+  }
+  if (const std::string base = plan.value("base_case", ""); !base.empty()) {
+    body << "<tr><th>base case</th><td>" << html_escape(base) << "</td></tr>\n";
+    if (const std::string d = case_description(fs::path(base) / "case.json"); !d.empty())
+      body << "<tr><th>base case description</th><td>" << html_escape(d) << "</td></tr>\n";
+  }
+  std::vector<std::string> axis_keys;
+  if (sw.contains("axes") && sw["axes"].is_array())
+    for (const Json& a : sw["axes"]) {
+      axis_keys.push_back(a.value("key", ""));
+      body << "<tr><th>axis " << html_escape(axis_keys.back()) << "</th><td>"
+           << html_escape(a.value("values", Json::array()).dump()) << "</td></tr>\n";
+    }
+  if (sw.contains("ensemble")) body << "<tr><th>ensemble</th><td>" << html_escape(sw["ensemble"].dump()) << "</td></tr>\n";
+  body << "</table>\n";
+
+  // The ensemble means, one row per grid point, each against the references.
+  body << "<h2>Mean surge ice resistance per grid point</h2>\n<table id=\"grid-points\">\n<tr>";
+  for (const std::string& k : axis_keys) body << "<th>" << html_escape(k) << "</th>";
+  body << "<th>members ok</th><th>mean, kN</th><th>standard deviation, kN</th><th>95 % interval, kN</th>";
+  for (const ReferenceLoad& r : refs) body << "<th>against " << html_escape(r.label) << " (" << kN(r.kN) << " kN), %</th>";
+  body << "</tr>\n";
+  if (sw.contains("grid_points") && sw["grid_points"].is_array())
+    for (const Json& g : sw["grid_points"]) {
+      ++rs.grid_points;
+      body << "<tr>";
+      for (const std::string& k : axis_keys)
+        body << "<td>" << scalar_text(g.contains("axes") ? g["axes"].value(k, Json()) : Json()) << "</td>";
+      const double mean = number_or_nan(g, {"mean_kN"}), ci = number_or_nan(g, {"ci95_half_width_kN"});
+      body << "<td class=\"n\">" << scalar_text(g.value("n_ok", Json())) << " / "
+           << scalar_text(g.value("n_members", Json())) << "</td><td class=\"n\">" << kN(mean)
+           << "</td><td class=\"n\">" << kN(number_or_nan(g, {"std_kN"})) << "</td><td class=\"n\">"
+           << (std::isfinite(ci) ? "&plusmn; " + kN(ci) : kN(ci)) << "</td>";
+      for (const ReferenceLoad& r : refs) {
+        const ReferenceComparison c = compare_to_reference(mean, r);
+        body << "<td class=\"n\">" << (std::isfinite(c.error_percent) ? fmt("%+.1f", c.error_percent) : "&ndash;");
+        if (std::isfinite(ci)) body << " &plusmn; " << fmt("%.1f", 100 * ci / r.kN);
+        body << "</td>";
+      }
+      body << "</tr>\n";
+    }
+  body << "</table>\n";
+  if (refs.empty())
+    body << "<p class=\"note\">No reference value given (the base case's <code>report</code> section: "
+            "<code>references</code>).</p>\n";
+
+  // The gathered plots, as the gather lists them.
+  body << "<h2>Plots</h2>\n";
+  size_t plots = 0;
+  if (sw.contains("files") && sw["files"].is_array())
+    for (const Json& f : sw["files"]) {
+      const std::string file = f.is_string() ? f.get<std::string>() : "";
+      if (fs::path(file).extension() != ".png") continue;
+      if (!pg.have(file, "gathered plot")) continue;
+      body << "<figure>" << pg.img(sweep_dir / file, "plot " + file, file) << "<figcaption>"
+           << html_escape(file) << "</figcaption></figure>\n";
+      ++plots;
+    }
+  if (plots == 0) pg.missing.push_back("*.png (the gather's plots)");
+
+  // Every member, with the gather's columns (the error text goes to the list of failures below).
+  body << "<h2>Members</h2>\n<div class=\"wide\"><table id=\"members\">\n<tr>";
+  std::vector<std::string> columns;
+  if (sw.contains("columns") && sw["columns"].is_array())
+    for (const Json& c : sw["columns"])
+      if (c.is_string() && c.get<std::string>() != "error") columns.push_back(c.get<std::string>());
+  for (const std::string& c : columns) body << "<th>" << html_escape(c) << "</th>";
+  body << "</tr>\n";
+  std::ostringstream failures;
+  if (sw.contains("members") && sw["members"].is_array())
+    for (const Json& m : sw["members"]) {
+      ++rs.members;
+      const bool ok = m.value("status", "") == "ok";
+      body << "<tr>";
+      for (const std::string& c : columns) {
+        const Json v = m.value(c, Json());
+        body << "<td" << (v.is_number() ? " class=\"n\"" : "") << ">" << scalar_text(v) << "</td>";
+      }
+      body << "</tr>\n";
+      if (!ok) {
+        ++rs.failed;
+        failures << "<li><strong>" << html_escape(m.value("member", "?")) << "</strong>: <pre>"
+                 << html_escape(m.value("error", "")) << "</pre></li>\n";
+      }
+    }
+  body << "</table></div>\n";
+  if (rs.failed > 0)
+    body << "<div class=\"missing\" id=\"failed-members\"><strong>" << rs.failed
+         << " member(s) failed</strong> and are left out of the means:<ul>\n" << failures.str() << "</ul></div>\n";
+  if (sw.contains("units") && sw["units"].is_object())
+    body << "<details><summary>what the columns mean (sweep.json units)</summary><table>\n" << scalar_rows(sw["units"])
+         << "</table></details>\n";
+
+  rs.missing = pg.missing;
+  rs.bytes = write_page(out, title, body.str(), pg, resolved_config);
+  return rs;
 }
 
 }  // namespace floesim::render

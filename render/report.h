@@ -90,4 +90,20 @@ ReportSummary write_report(const std::filesystem::path& run_dir, const ReportOpt
 ReportSummary write_report(const std::filesystem::path& run_dir, const std::filesystem::path& config,
                            const std::filesystem::path& out);
 
+// ---- A sweep's report (floesim-report --sweep) ----
+
+struct SweepReportSummary {
+  std::filesystem::path out;
+  uintmax_t bytes = 0;
+  size_t grid_points = 0, members = 0, failed = 0;
+  std::vector<std::string> missing;  // artefacts the page lacks, relative to the sweep folder
+};
+
+// One self-contained page for a sweep folder as `floesim sweep` leaves it (the gather's sweep.json and plots,
+// plan.json): the sweep and its base case, the ensemble mean of every grid point with its 95 % interval and its
+// error against each reference value of `o`, the gathered plots, every member's row, and the failed members with
+// their errors. Error (nothing written) if the folder has no readable sweep.json (the gather has not run).
+SweepReportSummary write_sweep_report(const std::filesystem::path& sweep_dir, const ReportOptions& o,
+                                      const std::filesystem::path& out, const Json& resolved_config);
+
 }  // namespace floesim::render

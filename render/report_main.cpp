@@ -9,9 +9,10 @@
 int main(int argc, char** argv) {
   CLI::App app{"Write one self-contained HTML report (images and video inlined) for a run folder",
                "floesim-report"};
-  std::string run, config, out;
+  std::string run, sweep, config, out;
   bool check_config = false;
   app.add_option("--run", run, "run folder (the --out of `floesim run`)");
+  app.add_option("--sweep", sweep, "or a sweep folder (the --out of `floesim sweep`, gathered): the sweep's report");
   app.add_option("--config", config, "report options (JSON; see --help-config); default: no reference value");
   app.add_flag("--check-config", check_config, "read and check --config (strictly), write nothing");
   app.add_option("--out", out, "the HTML file to write");
@@ -25,7 +26,17 @@ int main(int argc, char** argv) {
       floesim::render::read_report_options(config);
       return;
     }
-    if (run.empty() || out.empty()) throw floesim::Error("--run and --out are required (see --help)");
+    if (run.empty() == sweep.empty() || out.empty())
+      throw floesim::Error("give --out and one of --run (a run folder) or --sweep (a sweep folder) (see --help)");
+    if (!sweep.empty()) {
+      const floesim::render::ReportOptions o =
+          config.empty() ? floesim::render::ReportOptions{} : floesim::render::read_report_options(config);
+      const auto s = floesim::render::write_sweep_report(sweep, o, out, floesim::options_to_json(o));
+      std::cout << "wrote " << out << " (" << s.bytes / 1000 << " kB): " << s.grid_points << " grid point(s), "
+                << s.members << " member(s), " << s.failed << " failed\n";
+      for (const auto& m : s.missing) std::cout << "  missing: " << m << "\n";
+      return;
+    }
     const auto s = floesim::render::write_report(run, config, out);
     const double mean_kN = s.mean_kN == 0 ? 0.0 : s.mean_kN;  // -0 (no contact at all) prints as 0
     std::cout << "wrote " << out << " (" << s.bytes / 1000 << " kB): mean ice resistance " << mean_kN << " kN";

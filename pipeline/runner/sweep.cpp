@@ -290,13 +290,34 @@ int run_ninja(const fs::path& run, int jobs, const std::vector<Member>& members,
   return code;
 }
 
-// The gather stage: RUN/sweep.csv, sweep.json and plots from the members' results.
+// The gather stage: RUN/sweep.csv, sweep.json and plots from the members' results; then the sweep's report,
+// RUN/report.html, with the base case's report settings (RUN/report_config.json).
+std::vector<std::vector<std::string>> gather_commands(const fs::path& bin, const fs::path& run) {
+  return {{(bin / "floesim-gather").string(), "--plan", (run / "plan.json").string(), "--out", run.string()},
+          {(bin / "floesim-report").string(), "--sweep", run.string(), "--config",
+           (run / "report_config.json").string(), "--out", (run / "report.html").string()}};
+}
+
 int gather(const fs::path& bin, const fs::path& run) {
-  std::cout.flush();
-  const Output r = run_capture({(bin / "floesim-gather").string(), "--plan", (run / "plan.json").string(), "--out",
-                                run.string()});
-  std::cout << r.text;
-  return r.code;
+  for (const auto& cmd : gather_commands(bin, run)) {
+    std::cout.flush();
+    const Output r = run_capture(cmd);
+    std::cout << r.text;
+    if (r.code != 0) return r.code;
+  }
+  return 0;
+}
+
+// The base case's report settings (its "report" section; the references the sweep's means are compared with),
+// checked by floesim-report before anything runs.
+void write_report_config(const Sweep& s, const Json& base, const fs::path& bin, const fs::path& run) {
+  const Json cfg = base.contains("report") ? base["report"] : Json::object();
+  ensure_directory(run);
+  write_if_changed(run / "report_config.json", cfg.dump(2) + "\n");
+  const Output r = run_capture({(bin / "floesim-report").string(), "--check-config", "--config",
+                                (run / "report_config.json").string()});
+  FLOESIM_REQUIRE(r.code == 0, (s.base_dir / "case.json").string(), ": its \"report\" section is refused:\n  ",
+                  r.text);
 }
 
 // --- SLURM: one job array per level of the stage graph, each level after the one before (afterany: a failed
@@ -389,9 +410,12 @@ int submit_slurm(const Sweep& s, const fs::path& run, const fs::path& bin, const
     std::cout << "submitted level " << l << ": job array " << after << " (" << tasks.size() << " stage(s))\n";
   }
   const fs::path g = run / "slurm" / "gather.sh";
-  write_text_atomic(g, "#!/bin/bash\n# floesim sweep " + s.name + ": gather the members' results.\nexec " +
-                           shell_quote((bin / "floesim-gather").string()) + " --plan " +
-                           shell_quote((run / "plan.json").string()) + " --out " + shell_quote(run.string()) + "\n");
+  std::string gather_sh = "#!/bin/bash\n# floesim sweep " + s.name + ": gather the members' results, then the report.\nset -e\n";
+  for (const auto& cmd : gather_commands(bin, run)) {
+    for (size_t i = 0; i < cmd.size(); ++i) gather_sh += (i ? " " : "") + shell_quote(cmd[i]);
+    gather_sh += "\n";
+  }
+  write_text_atomic(g, gather_sh);
   fs::permissions(g, fs::perms::owner_exec, fs::perm_options::add);
   std::cout << "logs: " << (run / "slurm" / "logs").string() << "; stage logs: <stage folder>/log.txt\n";
   if (!wait) {
@@ -637,6 +661,7 @@ int run_sweep(const SweepOptions& o) {
   const fs::path bin = o.bin_dir.empty() ? self_dir() : fs::absolute(o.bin_dir);
   const SweepPlan p = plan_members(s, members, run, bin);
   check_stage_settings(s, members, p);
+  write_report_config(s, base, bin, run);
 
   write_sweep_files(s, members, p, run);
   std::vector<std::string> descriptions;

@@ -143,6 +143,14 @@ TEST_F(TinySweep, SharedStagesRunOnceAndEveryMemberIsGathered) {
   EXPECT_NEAR(std::stod(rows[3].at("simulate.vessel.y_m")), 82.001, 1e-12);
   EXPECT_TRUE(fs::exists(run_ / "sweep.json"));
   EXPECT_TRUE(fs::exists(run_ / "members" / "g001-e01" / "sim" / "summary.json"));  // a member is a run folder
+  // The sweep's report: every grid point and member on one page, the gathered plot embedded, nothing missing.
+  const std::string html = read_text(run_ / "report.html");
+  EXPECT_NE(html.find("id=\"grid-points\""), std::string::npos);
+  for (const char* m : {">g000-e00<", ">g000-e01<", ">g001-e00<", ">g001-e01<"})
+    EXPECT_NE(html.find(m), std::string::npos) << m;
+  EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
+  EXPECT_EQ(html.find("id=\"missing\""), std::string::npos);
+  EXPECT_EQ(html.find("id=\"failed-members\""), std::string::npos);
 }
 
 // The member's case.json run alone with floesim run gives the summary the sweep gathered, number for number.
@@ -214,6 +222,12 @@ TEST_F(TinySweep, FailedMemberDoesNotStopTheOthers) {
   EXPECT_EQ(rows[0].at("status"), "failed");
   EXPECT_NE(rows[0].at("error").find("bad.csv"), std::string::npos) << rows[0].at("error");
   EXPECT_EQ(rows[1].at("status"), "ok");
+  // The report names the failed member and its error.
+  const std::string html = read_text(run / "report.html");
+  const size_t box = html.find("id=\"failed-members\"");
+  ASSERT_NE(box, std::string::npos);
+  EXPECT_NE(html.find("g000-e00", box), std::string::npos);
+  EXPECT_NE(html.find("bad.csv", box), std::string::npos);
   fs::remove(base_ / "good.csv");
   fs::remove(base_ / "bad.csv");
 }
@@ -272,6 +286,7 @@ TEST_F(TinySweep, SlurmRunIsByteIdenticalToTheLocalRun) {
     for (const auto& f : fs::directory_iterator(e.path()))
       if (f.path().filename() != "config.json") fs::remove(f.path());
   fs::remove(run / "sweep.csv");
+  fs::remove(run / "report.html");
   const RunOutput r = shell("SLURM_CONF='" + conf + "' '" + (kBin / "floesim").string() + "' sweep '" +
                                 sweep_.string() + "' --out '" + run.string() + "' --slurm --wait",
                             root_ / "slurm_sweep.log");
@@ -295,6 +310,7 @@ TEST_F(TinySweep, SlurmRunIsByteIdenticalToTheLocalRun) {
     return out;
   };
   EXPECT_EQ(without_wall(read_csv(run / "sweep.csv")), without_wall(read_csv(root_ / "local_sweep.csv")));
+  EXPECT_TRUE(fs::exists(run / "report.html")) << "the cluster's gather job writes the report too";
 }
 
 }  // namespace
