@@ -126,7 +126,8 @@ double number_or_nan(const Json& j, std::initializer_list<const char*> path) {
 }
 
 struct Page {
-  fs::path run;
+  fs::path run;              // the folder reported on
+  std::string kind = "run";  // what it is, for the box of missing artefacts: "run" or "sweep"
   std::vector<std::string> missing;
   std::vector<NamedInput> inputs;  // every artefact read, for the provenance
 
@@ -223,7 +224,7 @@ uintmax_t write_page(const fs::path& out, const std::string& title, const std::s
        << "</style>\n</head>\n<body>\n<h1>" << html_escape(title) << "</h1>\n"
        << "<p class=\"error\" id=\"media-error\" hidden></p>\n";
   if (!pg.missing.empty()) {
-    html << "<div class=\"missing\" id=\"missing\"><strong>Missing from this run (" << pg.missing.size()
+    html << "<div class=\"missing\" id=\"missing\"><strong>Missing from this " << pg.kind << " (" << pg.missing.size()
          << "):</strong><ul>\n";
     for (const auto& m : pg.missing) html << "<li>" << html_escape(m) << "</li>\n";
     html << "</ul></div>\n";
@@ -516,6 +517,7 @@ SweepReportSummary write_sweep_report(const fs::path& sweep_dir, const ReportOpt
   rs.out = out;
   Page pg;
   pg.run = sweep_dir;
+  pg.kind = "sweep";
   FLOESIM_REQUIRE(fs::is_directory(sweep_dir), sweep_dir.string(),
                   ": not a folder; give --sweep the output folder of `floesim sweep` (e.g. runs/<sweep>)");
   FLOESIM_REQUIRE(fs::is_regular_file(sweep_dir / "sweep.json"), (sweep_dir / "sweep.json").string(),
