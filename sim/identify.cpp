@@ -494,9 +494,10 @@ std::string run_identify(const fs::path& measured_file, const fs::path& config_f
   rep << std::setprecision(1) << "mean surge ice load " << id.mean_ice.surge / 1e3 << " kN (resistance "
       << -id.mean_ice.surge / 1e3 << " kN) over " << id.mean_t0_s << " to " << id.mean_t1_s << " s\n";
   if (id.has_known)
-    rep << std::setprecision(1) << "against the known load of the data: mean " << -id.known.mean_known.surge / 1e3
-        << " kN resistance, identified " << std::showpos << std::setprecision(3) << 100 * id.known.surge_error_relative
-        << std::noshowpos << " %; RMS error of the " << std::defaultfloat << o.filters.output_interval_s << std::fixed << " s series " << std::setprecision(1)
+    rep << std::setprecision(1) << "against the known load of the data: its mean resistance "
+        << -id.known.mean_known.surge / 1e3 << " kN, the identified one " << std::showpos << std::setprecision(3)
+        << -100 * id.known.surge_error_relative << std::noshowpos << " %; RMS error of the " << std::defaultfloat
+        << o.filters.output_interval_s << std::fixed << " s series " << std::setprecision(1)
         << id.known.surge_rms_n / 1e3 << " kN (known series sd " << id.known.surge_sd_n / 1e3 << " kN)\n";
   rep << "wrote " << (out_dir / "identified.csv").string() << " (" << id.output.time_s.size() << " rows) and "
       << (out_dir / "identified.json").string() << "\n";
