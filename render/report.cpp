@@ -10,6 +10,7 @@
 
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
+#include "pipeline/units.h"
 #include "pipeline/provenance.h"
 
 namespace floesim::render {
@@ -83,12 +84,10 @@ std::string fmt(const char* f, double a) {
   return b;
 }
 
-// Loads in kN as the plot stage prints them: whole kN from 100 kN up, three significant digits below.
-std::string kN(double x) {
-  if (!std::isfinite(x)) return "&ndash;";
-  x += 0.0;  // -0 reads as 0
-  if (std::abs(x) < 0.0005) x = 0;  // and so does what rounds to it
-  return std::abs(x) >= 100 ? fmt("%.0f", x) : fmt("%.3g", x);
+// A load given in kN, as text in the display unit u (pipeline/units.h: N for a tank model, kN for a ship).
+std::string load_in(double x_kN, const ForceUnit& u) {
+  if (!std::isfinite(x_kN)) return "&ndash;";
+  return load_number(1000.0 * x_kN / u.newtons);
 }
 
 // A JSON scalar as table text: numbers to 4 significant digits (integers whole), strings escaped.
@@ -279,8 +278,11 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
        << "</td></tr>\n<tr><th>mean vessel speed</th><td>"
        << scalar_text(summary.value("mean_vessel_speed_mps", Json())) << " m/s</td></tr>\n</table>\n";
 
-  // Mean loads.
-  body << "<h2>Mean loads</h2>\n<table>\n<tr><th>quantity</th><th>kN</th></tr>\n"
+  // Mean loads, in the unit that suits their size (the same choice as the plot's).
+  const ForceUnit unit = force_unit_for(
+      1000.0 * std::max(std::abs(rs.mean_kN), std::isfinite(rs.moving_average_max_kN) ? std::abs(rs.moving_average_max_kN) : 0.0));
+  auto kN = [&](double x_kN) { return load_in(x_kN, unit); };
+  body << "<h2>Mean loads</h2>\n<table>\n<tr><th>quantity</th><th>" << unit.name << "</th></tr>\n"
        << "<tr><th>mean surge ice resistance (steady part)</th><td class=\"n\" id=\"mean-kN\">" << kN(rs.mean_kN)
        << "</td></tr>\n<tr><th>standard deviation of the surge ice load</th><td class=\"n\">" << kN(rs.std_kN)
        << "</td></tr>\n<tr><th>largest moving average of the resistance"
@@ -292,11 +294,11 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
     body << "<p class=\"note\">No reference value given (report config: <code>reference_kN</code>, "
             "<code>reference_label</code> or <code>references</code>).</p>\n";
   } else {
-    body << "<table id=\"references\">\n<tr><th>reference</th><th>kN</th><th>simulated &minus; reference, "
-            "kN</th><th>error, %</th></tr>\n";
+    body << "<table id=\"references\">\n<tr><th>reference</th><th>" << unit.name
+         << "</th><th>simulated &minus; reference, " << unit.name << "</th><th>error, %</th></tr>\n";
     for (const auto& c : rs.references)
       body << "<tr><th>" << html_escape(c.label) << "</th><td class=\"n\">" << kN(c.reference_kN)
-           << "</td><td class=\"n\">" << fmt("%+.1f", c.error_kN) << "</td><td class=\"n\">"
+           << "</td><td class=\"n\">" << fmt("%+.1f", 1000.0 * c.error_kN / unit.newtons) << "</td><td class=\"n\">"
            << fmt("%+.1f", c.error_percent) << "</td></tr>\n";
     body << "</table>\n";
   }
