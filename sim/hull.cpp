@@ -28,6 +28,12 @@ namespace {
 
 double deg(double d) { return d * kPi / 180.0; }
 
+std::string percent(double f) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%+.2f %%", 100.0 * f);
+  return buf;
+}
+
 // 0 -> 0, 1 -> 1 with zero slope at both ends (for blending hull parameters along x without kinks).
 double smooth(double s) {
   s = std::clamp(s, 0.0, 1.0);
@@ -678,11 +684,6 @@ Sliced slice_convex(const TriMesh& m, int n, double target, double merge) {
   return out;
 }
 
-std::string percent(double f) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%+.2f %%", 100.0 * f);
-  return buf;
-}
 
 }  // namespace
 
@@ -951,9 +952,15 @@ void require_floating(const HullModel& hull, const std::string& where) {
   FLOESIM_REQUIRE(b.hi.z() > 0, where, ": waterline_z_m = ", fmt_num(p.waterline_z_m),
                   " puts the whole hull under water (its highest point is ", fmt_num(-b.hi.z()),
                   " m below the waterline): a ship must pierce the surface", fix);
+  // A waterline at the keel (a few micrometres of keel below it) or at the deck is a placement error too: a ship
+  // displaces a good part of its volume (half or so), not nothing and not all of it.
   const double v = submerged_part(hull.surface.vertices, hull.surface.triangles, 0.0).volume;
-  FLOESIM_REQUIRE(v > 1e-9 * hull.parts_volume_m3, where, ": waterline_z_m = ", fmt_num(p.waterline_z_m),
-                  " leaves the hull a displacement of zero (", fmt_num(v), " m^3 below the waterline)", fix);
+  const double f = v / hull.parts_volume_m3;
+  FLOESIM_REQUIRE(f >= 0.01, where, ": waterline_z_m = ", fmt_num(p.waterline_z_m),
+                  " leaves the hull a displacement of (almost) zero (", fmt_num(v), " m^3 below the waterline, ",
+                  percent(f), " of its volume)", fix);
+  FLOESIM_REQUIRE(f <= 0.99, where, ": waterline_z_m = ", fmt_num(p.waterline_z_m), " puts (almost) the whole hull "
+                  "under water (", percent(f), " of its volume below the waterline)", fix);
 }
 
 namespace {
@@ -988,8 +995,25 @@ std::string write_imported_hull(const HullImportOptions& o, const fs::path& out_
   FLOESIM_REQUIRE(fs::exists(mesh_file), where, ": file names ", mesh_file.string(), ", which does not exist");
 
   // 1. Load, place, decompose; refuse a hull that does not float.
-  const HullModel m = load_hull(mesh_file, o.load, o.placement);
+  HullModel m = load_hull(mesh_file, o.load, o.placement);
   require_floating(m, where);
+  // The parts go to an OBJ that the simulator reads with assimp in single precision. Rounded to float, a part's
+  // sliver faces would tilt and the part would no longer pass as convex. So, as for the generated hull, each part
+  // is snapped to a binary grid that floats hold exactly (the float spacing at the hull's largest coordinate) and
+  // is rebuilt as the convex hull of its snapped vertices: what is written is read back bit for bit, and convex.
+  {
+    const Bounds all(m.surface.vertices);
+    const double max_abs = std::max(all.lo.cwiseAbs().maxCoeff(), all.hi.cwiseAbs().maxCoeff());
+    const double g = std::ldexp(1.0, static_cast<int>(std::ceil(std::log2(max_abs))) - 23);
+    double v = 0;
+    for (TriMesh& part : m.parts) {
+      for (Vec3& p : part.vertices) p = (p / g).array().round().matrix() * g;
+      part = convex_hull(part.vertices);
+      v += mass_properties(part).volume;
+    }
+    m.parts_volume_m3 = v;
+    m.surface = merge(m.parts);
+  }
 
   // 2. What it displaces, by the convex parts (what the simulator floats) and by the mesh itself (the reference).
   const double rho = o.water_density_kg_m3;
@@ -1022,11 +1046,10 @@ std::string write_imported_hull(const HullImportOptions& o, const fs::path& out_
        << " kg/m^3\n";
 
   nlohmann::json side;
-  side["provenance"] = make_provenance(
-      "floesim-hull",
-      config_file.empty() ? std::vector<NamedInput>{{"mesh", mesh_file}}
-                          : std::vector<NamedInput>{{"mesh", mesh_file}, {"config", config_file}},
-      options_to_json(o));
+  std::vector<NamedInput> inputs;
+  inputs.push_back({"mesh", mesh_file});
+  if (!config_file.empty()) inputs.push_back({"config", config_file});
+  side["provenance"] = make_provenance("floesim-hull", inputs, options_to_json(o));
   side["hull_file"] = out_obj.filename().string();
   side["source_file"] = mesh_file.string();
   side["frame"] = "x forward, y to port, z up; calm waterline z = 0; origin at the placement's origin_m; metres";
