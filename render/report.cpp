@@ -362,6 +362,9 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
   if (fs::is_regular_file(run_dir / "hull/hull.json")) {
     const Json h = pg.json("hull/hull.json", "hull sidecar");
     if (const Json* hy = find(h, {"hydrostatics"})) body << scalar_rows(*hy, "hydrostatics.");
+    // A user's mesh: how it was placed and where it floats (floesim-hull's report).
+    if (const Json* pl = find(h, {"placement"})) body << scalar_rows(*pl, "placement.");
+    if (const Json* wl = find(h, {"waterline"})) body << scalar_rows(*wl, "waterline.");
     body << scalar_rows(h);
   } else if (fs::exists(run_dir / "config/hull.json")) {
     pg.missing.push_back("hull/hull.json (hull particulars)");

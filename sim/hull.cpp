@@ -1076,7 +1076,12 @@ std::string write_imported_hull(const HullImportOptions& o, const fs::path& out_
                        {"draught_mid_wl_m", draught_mid},
                        {"draught_max_m", h.draught_m}};
   side["hydrostatics"] = hydrostatics_json(h, rho);
-  side["loader_report"] = m.report;
+  {  // what the loader did, one line per entry (placement, meshes, total)
+    nlohmann::json lines = nlohmann::json::array();
+    std::istringstream rep(m.report);
+    for (std::string line; std::getline(rep, line);) lines.push_back(line);
+    side["loader_report"] = lines;
+  }
 
   fs::path sidecar = out_obj;
   sidecar.replace_extension(".json");
