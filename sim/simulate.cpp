@@ -500,6 +500,13 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   }
   const FloeField field = read_floes(floes_file);
   const HullModel hull = load_hull(hull_file, o.hull);
+  try {  // the stage floats the hull as the file has it: one entirely above or below the water is a placement error
+    require_floating(hull, hull_file.string());
+  } catch (const Error& e) {
+    throw Error(std::string(e.what()) + ". floesim-simulate takes the hull frame as the file has it (bow +x, "
+                "waterline z = 0): place a CAD mesh with the hull options (case \"hull\": {\"file\", \"waterline_z_m\", "
+                "\"bow_direction\", \"scale\"}, or floesim-hull) first");
+  }
   const Model model = build_model(field, &hull, o);
 
   std::ostringstream out;
