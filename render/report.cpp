@@ -278,9 +278,11 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
        << "</td></tr>\n<tr><th>mean vessel speed</th><td>"
        << scalar_text(summary.value("mean_vessel_speed_mps", Json())) << " m/s</td></tr>\n</table>\n";
 
-  // Mean loads, in the unit that suits their size (the same choice as the plot's).
-  const ForceUnit unit = force_unit_for(
-      1000.0 * std::max(std::abs(rs.mean_kN), std::isfinite(rs.moving_average_max_kN) ? std::abs(rs.moving_average_max_kN) : 0.0));
+  // Mean loads, in the unit that suits their size and the references' (N for a tank model, kN for a ship).
+  double typical_kN = std::max(std::abs(rs.mean_kN), std::isfinite(rs.moving_average_max_kN)
+                                                         ? std::abs(rs.moving_average_max_kN) : 0.0);
+  for (const auto& c : rs.references) typical_kN = std::max(typical_kN, std::abs(c.reference_kN));
+  const ForceUnit unit = force_unit_for(1000.0 * typical_kN);
   auto kN = [&](double x_kN) { return load_in(x_kN, unit); };
   body << "<h2>Mean loads</h2>\n<table>\n<tr><th>quantity</th><th>" << unit.name << "</th></tr>\n"
        << "<tr><th>mean surge ice resistance (steady part)</th><td class=\"n\" id=\"mean-kN\">" << kN(rs.mean_kN)
