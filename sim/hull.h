@@ -87,7 +87,7 @@ struct HullPlacement {
   template <class V>
   void visit(V& v) {
     v.field("scale", scale, "-", "multiplies the file's coordinates (file units -> metres)", positive());
-    v.field("bow_direction", bow_direction, "-", "where the bow points in the file: +x | -x | +y | -y",
+    v.field("bow_direction", bow_direction, "-", "where the bow points in the file: +x, -x, +y or -y",
             one_of({"+x", "-x", "+y", "-y"}));
     v.field("waterline_z_m", waterline_z_m, "m",
             "height of the calm waterline in the file's own frame and units (e.g. the draught if the keel is at z = 0)",
