@@ -39,6 +39,9 @@ std::string fmt(const char* f, double a) {
   return b;
 }
 
+// A load in kN as text, in kN (pipeline/units.h); the load plot itself picks the unit that suits its loads.
+[[maybe_unused]] std::string kN(double x) { return load_number(x); }
+
 // NaN has no JSON spelling: null.
 nlohmann::json json_number(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
 

@@ -89,6 +89,8 @@ std::string load_in(double x_kN, const ForceUnit& u) {
   if (!std::isfinite(x_kN)) return "&ndash;";
   return load_number(1000.0 * x_kN / u.newtons);
 }
+// A load in kN as text, in kN.
+[[maybe_unused]] std::string kN(double x) { return load_in(x, {"kN", 1e3}); }
 
 // A JSON scalar as table text: numbers to 4 significant digits (integers whole), strings escaped.
 std::string scalar_text(const Json& v) {
@@ -283,15 +285,15 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
                                                          ? std::abs(rs.moving_average_max_kN) : 0.0);
   for (const auto& c : rs.references) typical_kN = std::max(typical_kN, std::abs(c.reference_kN));
   const ForceUnit unit = force_unit_for(1000.0 * typical_kN);
-  auto kN = [&](double x_kN) { return load_in(x_kN, unit); };
+  auto in_unit = [&](double x_kN) { return load_in(x_kN, unit); };
   body << "<h2>Mean loads</h2>\n<table>\n<tr><th>quantity</th><th>" << unit.name << "</th></tr>\n"
-       << "<tr><th>mean surge ice resistance (steady part)</th><td class=\"n\" id=\"mean-kN\">" << kN(rs.mean_kN)
-       << "</td></tr>\n<tr><th>standard deviation of the surge ice load</th><td class=\"n\">" << kN(rs.std_kN)
+       << "<tr><th>mean surge ice resistance (steady part)</th><td class=\"n\" id=\"mean-kN\">" << in_unit(rs.mean_kN)
+       << "</td></tr>\n<tr><th>standard deviation of the surge ice load</th><td class=\"n\">" << in_unit(rs.std_kN)
        << "</td></tr>\n<tr><th>largest moving average of the resistance"
        << (std::isfinite(rs.moving_average_window_s) && rs.moving_average_window_s > 0
                ? " (" + fmt("%g", rs.moving_average_window_s) + " s window)"
                : std::string())
-       << "</th><td class=\"n\">" << kN(rs.moving_average_max_kN) << "</td></tr>\n</table>\n";
+       << "</th><td class=\"n\">" << in_unit(rs.moving_average_max_kN) << "</td></tr>\n</table>\n";
   if (rs.references.empty()) {
     body << "<p class=\"note\">No reference value given (report config: <code>reference_kN</code>, "
             "<code>reference_label</code> or <code>references</code>).</p>\n";
@@ -299,7 +301,7 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
     body << "<table id=\"references\">\n<tr><th>reference</th><th>" << unit.name
          << "</th><th>simulated &minus; reference, " << unit.name << "</th><th>error, %</th></tr>\n";
     for (const auto& c : rs.references)
-      body << "<tr><th>" << html_escape(c.label) << "</th><td class=\"n\">" << kN(c.reference_kN)
+      body << "<tr><th>" << html_escape(c.label) << "</th><td class=\"n\">" << in_unit(c.reference_kN)
            << "</td><td class=\"n\">" << fmt("%+.1f", 1000.0 * c.error_kN / unit.newtons) << "</td><td class=\"n\">"
            << fmt("%+.1f", c.error_percent) << "</td></tr>\n";
     body << "</table>\n";
