@@ -130,8 +130,9 @@ struct HullModel {
 HullModel load_hull(const std::filesystem::path& file, const HullLoadOptions& o = {},
                     const HullPlacement& placement = {});
 
-// Refuses (Error naming `where` and the key to fix) a hull that, in the hull frame, lies entirely above or below the
-// calm waterline z = 0 or displaces nothing there.
+// Refuses (Error naming `where`, the key to fix and the mesh's z range in the file) a hull that, in the hull frame,
+// lies entirely above or below the calm waterline z = 0, or displaces less than 1 % or more than 99 % of its volume
+// there (a waterline at the keel or at the deck).
 void require_floating(const HullModel& hull, const std::string& where);
 
 // The floesim-hull stage for a user's mesh: the hull section of a case ("file" beside the placement and the
