@@ -13,6 +13,7 @@
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
 #include "pipeline/provenance.h"
+#include "pipeline/units.h"
 #include "render/gnuplot.h"
 #include "render/plot.h"
 
@@ -479,10 +480,21 @@ struct PlotFiles {
   }
 };
 
-std::string ci_text(const ConfidenceInterval& ci) {
+std::string ci_text(const ConfidenceInterval& ci, double scale = 1.0) {
   if (ci.n == 0) return "no member ok";
-  if (ci.n == 1) return fmt("%.4g", ci.mean) + " (one member: no interval)";
-  return fmt("%.4g", ci.mean) + " ± " + fmt("%.3g", ci.half_width);
+  if (ci.n == 1) return fmt("%.4g", scale * ci.mean) + " (one member: no interval)";
+  return fmt("%.4g", scale * ci.mean) + " ± " + fmt("%.3g", scale * ci.half_width);
+}
+
+// The plots' load unit (pipeline/units.h: N for a sweep of tank models, kN for ships) from the members' means, in
+// kN; and the factor from kN to it.
+ForceUnit plot_unit(const GatherResult& g, double* kN_to_unit) {
+  double typical_kN = 0;
+  for (const MemberResult& m : g.members)
+    if (m.ok && std::isfinite(m.mean_resistance_kN)) typical_kN = std::max(typical_kN, std::abs(m.mean_resistance_kN));
+  const ForceUnit u = force_unit_for(1000.0 * typical_kN);
+  *kN_to_unit = 1000.0 / u.newtons;
+  return u;
 }
 
 // Mean resistance against axis k: a line per combination of the other axes' values, 95 % CI error bars, the
@@ -510,6 +522,8 @@ void draw_axis_plot(const SweepPlan& plan, const GatherResult& g, size_t k, Plot
   // 2. Data: per line, a block of (x, mean, low, high) sorted by x, then a block of its members (x, mean). A grid
   // point without an interval (one ok member) has its bar collapsed onto the mean; one without ok members is left
   // out.
+  double to_unit = 1;
+  const ForceUnit unit = plot_unit(g, &to_unit);
   std::ostringstream data, plot;
   int block = 0;
   for (size_t i = 0; i < lines.size(); ++i) {
@@ -522,14 +536,14 @@ void draw_axis_plot(const SweepPlan& plan, const GatherResult& g, size_t k, Plot
     if (block > 0) data << "\n\n";
     for (const GridPointResult* p : pts) {
       const double hw = p->ci.n >= 2 ? p->ci.half_width : 0.0;
-      data << fmt("%.10g", x_of(p->axes[ax.key])) << ' ' << fmt("%.10g", p->ci.mean) << ' '
-           << fmt("%.10g", p->ci.mean - hw) << ' ' << fmt("%.10g", p->ci.mean + hw) << '\n';
+      data << fmt("%.10g", x_of(p->axes[ax.key])) << ' ' << fmt("%.10g", to_unit * p->ci.mean) << ' '
+           << fmt("%.10g", to_unit * (p->ci.mean - hw)) << ' ' << fmt("%.10g", to_unit * (p->ci.mean + hw)) << '\n';
     }
     data << "\n\n";
     for (const GridPointResult* p : pts)
       for (const MemberResult& m : g.members)
         if (m.ok && m.grid_point == p->index)
-          data << fmt("%.10g", x_of(p->axes[ax.key])) << ' ' << fmt("%.10g", m.mean_resistance_kN) << '\n';
+          data << fmt("%.10g", x_of(p->axes[ax.key])) << ' ' << fmt("%.10g", to_unit * m.mean_resistance_kN) << '\n';
     plot << (block == 0 ? "plot data" : ", \\\n  data") << " index " << block
          << " using 1:2:3:4 with yerrorlines lc rgb '" << colour(i) << "' lw 2 pt 7 ps 1.2 title "
          << gnuplot_quoted(labels[i]) << " noenhanced, \\\n  data index " << block + 1
@@ -550,7 +564,7 @@ void draw_axis_plot(const SweepPlan& plan, const GatherResult& g, size_t k, Plot
   std::ostringstream body;
   body << "set title " << gnuplot_quoted(plan.name + ": ice resistance against " + ax.key) << " noenhanced font ',14'\n"
        << "set xlabel " << gnuplot_quoted(ax.key) << " noenhanced\n"
-       << "set ylabel 'Mean ice resistance (kN): ensemble mean and 95 % confidence interval'\n"
+       << "set ylabel 'Mean ice resistance (" << unit.name << "): ensemble mean and 95 % confidence interval'\n"
        << "set xtics (" << tics << ") noenhanced\n"
        << "set xrange [" << fmt("%.10g", lo - pad) << ":" << fmt("%.10g", hi + pad) << "]\n"
        << "set yrange [*:*]\n"
@@ -561,24 +575,26 @@ void draw_axis_plot(const SweepPlan& plan, const GatherResult& g, size_t k, Plot
 // A pure ensemble: each member's mean resistance, and the ensemble mean with its 95 % interval as a band.
 void draw_ensemble_plot(const SweepPlan& plan, const GatherResult& g, PlotFiles& f) {
   const ConfidenceInterval& ci = g.grid_points.front().ci;
+  double to_unit = 1;
+  const ForceUnit unit = plot_unit(g, &to_unit);
   double x0 = 1e300, x1 = -1e300;
   std::ostringstream data;
   for (const MemberResult& m : g.members)
     if (m.ok) {
       const double x = static_cast<double>(m.ensemble_index);
       x0 = std::min(x0, x), x1 = std::max(x1, x);
-      data << fmt("%.10g", x) << ' ' << fmt("%.10g", m.mean_resistance_kN) << '\n';
+      data << fmt("%.10g", x) << ' ' << fmt("%.10g", to_unit * m.mean_resistance_kN) << '\n';
     }
   const double hw = ci.n >= 2 ? ci.half_width : 0.0;
   data << "\n\n";
   for (double x : {x0 - 0.5, x1 + 0.5})
-    data << fmt("%.10g", x) << ' ' << fmt("%.10g", ci.mean) << ' ' << fmt("%.10g", ci.mean - hw) << ' '
-         << fmt("%.10g", ci.mean + hw) << '\n';
+    data << fmt("%.10g", x) << ' ' << fmt("%.10g", to_unit * ci.mean) << ' ' << fmt("%.10g", to_unit * (ci.mean - hw)) << ' '
+         << fmt("%.10g", to_unit * (ci.mean + hw)) << '\n';
   std::ostringstream body;
   body << "set title " << gnuplot_quoted(plan.name + ": mean ice resistance of each ensemble member")
        << " noenhanced font ',14'\n"
        << "set xlabel 'Ensemble member (index)'\n"
-       << "set ylabel 'Mean ice resistance (kN)'\n"
+       << "set ylabel 'Mean ice resistance (" << unit.name << ")'\n"
        << "set xrange [" << fmt("%.10g", x0 - 0.7) << ":" << fmt("%.10g", x1 + 0.7) << "]\n"
        << (x1 - x0 <= 30 ? "set xtics 1\n" : "");
   body << "plot ";
@@ -587,7 +603,7 @@ void draw_ensemble_plot(const SweepPlan& plan, const GatherResult& g, PlotFiles&
          << gnuplot_quoted("95 % interval of the ensemble mean (Student t, " + std::to_string(ci.n) + " members)")
          << ", \\\n  ";
   body << "data index 1 using 1:2 with lines lc rgb '#d1232a' lw 2.5 dt (8,4) title "
-       << gnuplot_quoted("ensemble mean: " + ci_text(ci) + " kN") << " noenhanced, \\\n"
+       << gnuplot_quoted("ensemble mean: " + ci_text(ci, to_unit) + " " + unit.name) << " noenhanced, \\\n"
        << "  data index 0 using 1:2 with points lc rgb '#1f77b4' pt 7 ps 1.3 title 'members'";
   f.draw(body.str(), data.str());
 }
@@ -595,9 +611,13 @@ void draw_ensemble_plot(const SweepPlan& plan, const GatherResult& g, PlotFiles&
 // The running mean of one member from the steady start, with the final mean +- 2 batch-means standard errors:
 // if the curve is still leaving the band near the end, the run was too short for its mean.
 void draw_running_mean(const MemberResult& m, const SteadyResistance& s, PlotFiles& f) {
-  const std::vector<double> rm = running_mean(s.resistance_kN);
+  // In the unit that suits the member's mean (N for a tank model, kN for a ship).
+  const ForceUnit unit = force_unit_for(1000.0 * m.series.mean_kN);
+  const double to_unit = 1000.0 / unit.newtons;
+  std::vector<double> rm = running_mean(s.resistance_kN);
+  for (double& v : rm) v *= to_unit;
   const size_t n = rm.size();
-  const double mean = m.series.mean_kN, se = m.series.batch_means_se_kN;
+  const double mean = to_unit * m.series.mean_kN, se = to_unit * m.series.batch_means_se_kN;
   const bool band = std::isfinite(se);
   // For the drawing only: a few thousand points show a running mean (it is smooth once past its first samples).
   const size_t stride = std::max<size_t>(1, n / 4000);
@@ -619,7 +639,7 @@ void draw_running_mean(const MemberResult& m, const SteadyResistance& s, PlotFil
   std::ostringstream body;
   body << "set title " << gnuplot_quoted("Running mean of the ice resistance: " + m.id) << " noenhanced font ',14'\n"
        << "set xlabel 'Time (s)'\n"
-       << "set ylabel 'Running mean of the ice resistance −F_x (kN)'\n"
+       << "set ylabel 'Running mean of the ice resistance −F_x (" << unit.name << ")'\n"
        << "set xrange [" << fmt("%.10g", s.time_s.front()) << ":"
        << fmt("%.10g", std::max(s.time_s.back(), s.time_s.front() + s.time_step_s)) << "]\n"
        << "set yrange [" << fmt("%.10g", y0 - pad) << ":" << fmt("%.10g", y1 + pad) << "]\n";
@@ -630,10 +650,10 @@ void draw_running_mean(const MemberResult& m, const SteadyResistance& s, PlotFil
   if (band)
     body << "data index 1 using 1:3:4 with filledcurves lc rgb '#c6dbef' fs solid 0.6 noborder title "
          << gnuplot_quoted("final mean ± 2 standard errors (batch means, " + std::to_string(m.series.batches) +
-                           " batches): " + fmt("%.4g", mean) + " ± " + fmt("%.3g", 2 * se) + " kN")
+                           " batches): " + fmt("%.4g", mean) + " ± " + fmt("%.3g", 2 * se) + " " + unit.name)
          << " noenhanced, \\\n  ";
   body << "data index 1 using 1:2 with lines lc rgb '#d1232a' lw 2 dt (8,4) title "
-       << gnuplot_quoted("final mean: " + fmt("%.4g", mean) + " kN") << " noenhanced, \\\n"
+       << gnuplot_quoted("final mean: " + fmt("%.4g", mean) + " " + unit.name) << " noenhanced, \\\n"
        << "  data index 0 using 1:2 with lines lc rgb '#101010' lw 2 title "
        << gnuplot_quoted("running mean from the steady start, t ≥ " + fmt("%g", s.steady_start_s) + " s")
        << " noenhanced";

@@ -12,6 +12,7 @@
 #include "pipeline/provenance.h"
 #include "render/gnuplot.h"
 #include "pipeline/signal.h"
+#include "pipeline/units.h"
 
 namespace floesim::render {
 
@@ -39,8 +40,8 @@ std::string fmt(const char* f, double a) {
   return b;
 }
 
-// Loads are read by people in kN: whole kN from 100 kN up, three significant digits below.
-std::string kN(double x) { return std::abs(x) >= 100 ? fmt("%.0f", x) : fmt("%.3g", x); }
+// A load in kN as text, in kN (pipeline/units.h); the load plot itself picks the unit that suits its loads.
+[[maybe_unused]] std::string kN(double x) { return load_number(x); }
 
 // NaN has no JSON spelling: null.
 nlohmann::json json_number(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
@@ -182,19 +183,31 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
     FLOESIM_REQUIRE(os.flush(), events_csv.path().string(), ": write failed (disk full?)");
   }
 
-  // 6. Plot data (decimated to ~2 points per pixel column) and the script.
+  // 6. Plot data (decimated to ~2 points per pixel column) and the script, in the unit that suits the loads' size
+  // (N for a tank model, kN for a ship): chosen from the larger of the mean and the moving average's peak.
+  const double ma_abs_max = std::max(std::abs(*std::max_element(ma.begin() + static_cast<long>(f0), ma.begin() + static_cast<long>(f1))),
+                                     std::abs(*std::min_element(ma.begin() + static_cast<long>(f0), ma.begin() + static_cast<long>(f1))));
+  const ForceUnit unit = force_unit_for(1000.0 * std::max(std::abs(s.mean_kN), ma_abs_max));
+  s.display_unit = unit;
+  const double to_unit = 1000.0 / unit.newtons;  // kN -> the display unit
+  auto in_unit = [&](const std::vector<double>& x) {
+    std::vector<double> y(x);
+    for (double& v : y) v *= to_unit;
+    return y;
+  };
+  auto load = [&](double x_kN) { return load_number(x_kN * to_unit) + " " + unit.name; };
   const size_t bins = static_cast<size_t>(o.width_px);
   {
     std::ofstream os(data.tmp());
-    write_decimated(os, t, res, bins);
+    write_decimated(os, t, in_unit(res), bins);
     os << "\n\n";
     const std::vector<double> tm(t.begin() + static_cast<long>(f0), t.begin() + static_cast<long>(f1)),
         mm(ma.begin() + static_cast<long>(f0), ma.begin() + static_cast<long>(f1));
-    write_decimated(os, tm, mm, bins);
+    write_decimated(os, tm, in_unit(mm), bins);
     os << "\n\n";
     const double t_mean0 = std::max(s.steady_start_s, t.front());
-    os << fmt("%.9g", t_mean0) << ' ' << fmt("%.9g", s.mean_kN) << '\n'
-       << fmt("%.9g", t.back()) << ' ' << fmt("%.9g", s.mean_kN) << '\n';
+    os << fmt("%.9g", t_mean0) << ' ' << fmt("%.9g", s.mean_kN * to_unit) << '\n'
+       << fmt("%.9g", t.back()) << ' ' << fmt("%.9g", s.mean_kN * to_unit) << '\n';
     // Event times only: the script places the markers along the bottom of the plot area.
     for (const auto* times : {&split_t, &bend_t}) {
       if (times->empty()) continue;  // an empty block would be an empty plot element (a gnuplot error)
@@ -214,6 +227,7 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
   double y_lo = std::min({0.0, ma_min, std::max(raw_min, -0.2 * y_hi)});
   y_lo -= 0.03 * (y_hi - y_lo);
   if (!o.y_max_kN.is_number()) y_hi += 0.05 * (y_hi - y_lo);
+  const double y_lo_u = y_lo * to_unit, y_hi_u = y_hi * to_unit;  // the axis, in the display unit
   // Start the axis at 0 when the series starts within the first 5 % (it starts at the first step's end).
   const double x_lo = t.front() > 0 && t.front() < 0.05 * t.back() ? 0.0 : t.front();
   {
@@ -226,7 +240,7 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
        << "set output " << quoted(png.tmp().string()) << "\n";
     if (!o.title.empty()) gp << "set title " << quoted(o.title) << " noenhanced font ',14'\n";
     gp << "set xlabel 'Time (s)'\n"
-       << "set ylabel 'Ice resistance  −F_x  (kN)'\n"
+       << "set ylabel 'Ice resistance  −F_x  (" << unit.name << ")'\n"
        << "set border lc rgb '#404040'\n"
        << "set bmargin " << (marked ? 8 : 6) << "\n"
        << "set grid xtics ytics mxtics lc rgb '#d9d9d9' lw 1 dt 1\n"
@@ -234,16 +248,16 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
        << "set key outside below center horizontal maxrows " << (marked ? 2 : 1) << " samplen 2.5 width -6\n"
        << "set style textbox opaque fillcolor rgb 'white' border lc rgb '#b0b0b0' margins 4,3\n"
        << "set xrange [" << fmt("%.9g", x_lo) << ":" << fmt("%.9g", t.back()) << "]\n"
-       << "set yrange [" << fmt("%.9g", y_lo) << ":" << fmt("%.9g", y_hi) << "]\n"
+       << "set yrange [" << fmt("%.9g", y_lo_u) << ":" << fmt("%.9g", y_hi_u) << "]\n"
        << "set format y '%.0f'\n";
-    if (y_hi - y_lo < 10) gp << "set format y '%g'\n";
+    if (y_hi_u - y_lo_u < 10) gp << "set format y '%g'\n";
     if (clipped)
-      gp << "set label 1 " << quoted("raw signal spans " + kN(raw_min) + " to " + kN(s.raw_max_kN) + " kN (cut off here)")
+      gp << "set label 1 " << quoted("raw signal spans " + load(raw_min) + " to " + load(s.raw_max_kN) + " (cut off here)")
          << " at graph 0.99, graph 0.96 right boxed noenhanced font ',9' tc rgb '#505050' front\n";
     const std::string mean_title =
         (s.steady_start_s > t.front() ? "mean for t ≥ " + fmt("%g", s.steady_start_s) + " s: "
                                       : std::string("mean: ")) +
-        kN(s.mean_kN) + " kN";
+        load(s.mean_kN);
     gp << "plot " << quoted(data.tmp().string())
        << " index 0 using 1:2 with lines lc rgb '#a9b8c6' lw 0.8 title "
        << quoted("ice resistance, every time step (Δt = " + fmt("%g", s.time_step_s) + " s)") << " noenhanced, \\\n"
@@ -254,7 +268,7 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
        << " noenhanced";
     // Fracture markers in the margin below the lowest data (y_lo lies 3 % under it), in the video's colours:
     // amber triangles for splitting, blue diamonds for bending and radial.
-    const std::string y_mark = fmt("%.9g", y_lo + 0.012 * (y_hi - y_lo));
+    const std::string y_mark = fmt("%.9g", y_lo_u + 0.012 * (y_hi_u - y_lo_u));
     auto events_title = [](const char* what, size_t n) {
       return std::string(what) + " at the vessel: " + std::to_string(n) + (n == 1 ? " event" : " events");
     };
@@ -286,6 +300,7 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
       {"series", "ice_load column 0 (Fx, surge, body x)"},
       {"quantity", "ice resistance = -Fx"},
       {"unit", "kN"},
+      {"plot_unit", s.display_unit.name},  // the unit of the drawing (N for a tank model, kN for a ship)
       {"contact_model", s.contact_model},
       {"time_step_s", s.time_step_s},
       {"moving_average",

@@ -13,6 +13,7 @@
 
 #include "pipeline/options.h"
 #include "pipeline/results_io.h"
+#include "pipeline/units.h"
 
 namespace floesim::render {
 
@@ -57,6 +58,7 @@ struct SurgeLoadSummary {
   double moving_average_std_kN = 0;  // of the moving average over the steady part, full windows only (NaN if none)
   double moving_average_max_kN = 0;
   double raw_max_kN = 0;           // over the whole run
+  ForceUnit display_unit{"kN", 1e3};  // the unit the plot and the printed summary use (force_unit_for the loads)
   size_t fracture_events = 0;                // all of /fracture (in fracture_events.csv)
   size_t vessel_splitting_events = 0;        // at the vessel, marked on the plot
   size_t vessel_bending_radial_events = 0;   // at the vessel, marked on the plot

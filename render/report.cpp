@@ -10,6 +10,7 @@
 
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
+#include "pipeline/units.h"
 #include "pipeline/provenance.h"
 
 namespace floesim::render {
@@ -83,13 +84,13 @@ std::string fmt(const char* f, double a) {
   return b;
 }
 
-// Loads in kN as the plot stage prints them: whole kN from 100 kN up, three significant digits below.
-std::string kN(double x) {
-  if (!std::isfinite(x)) return "&ndash;";
-  x += 0.0;  // -0 reads as 0
-  if (std::abs(x) < 0.0005) x = 0;  // and so does what rounds to it
-  return std::abs(x) >= 100 ? fmt("%.0f", x) : fmt("%.3g", x);
+// A load given in kN, as text in the display unit u (pipeline/units.h: N for a tank model, kN for a ship).
+std::string load_in(double x_kN, const ForceUnit& u) {
+  if (!std::isfinite(x_kN)) return "&ndash;";
+  return load_number(1000.0 * x_kN / u.newtons);
 }
+// A load in kN as text, in kN.
+[[maybe_unused]] std::string kN(double x) { return load_in(x, {"kN", 1e3}); }
 
 // A JSON scalar as table text: numbers to 4 significant digits (integers whole), strings escaped.
 std::string scalar_text(const Json& v) {
@@ -315,24 +316,29 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
        << "</td></tr>\n<tr><th>mean vessel speed</th><td>"
        << scalar_text(summary.value("mean_vessel_speed_mps", Json())) << " m/s</td></tr>\n</table>\n";
 
-  // Mean loads.
-  body << "<h2>Mean loads</h2>\n<table>\n<tr><th>quantity</th><th>kN</th></tr>\n"
-       << "<tr><th>mean surge ice resistance (steady part)</th><td class=\"n\" id=\"mean-kN\">" << kN(rs.mean_kN)
-       << "</td></tr>\n<tr><th>standard deviation of the surge ice load</th><td class=\"n\">" << kN(rs.std_kN)
+  // Mean loads, in the unit that suits their size and the references' (N for a tank model, kN for a ship).
+  double typical_kN = std::max(std::abs(rs.mean_kN), std::isfinite(rs.moving_average_max_kN)
+                                                         ? std::abs(rs.moving_average_max_kN) : 0.0);
+  for (const auto& c : rs.references) typical_kN = std::max(typical_kN, std::abs(c.reference_kN));
+  const ForceUnit unit = force_unit_for(1000.0 * typical_kN);
+  auto in_unit = [&](double x_kN) { return load_in(x_kN, unit); };
+  body << "<h2>Mean loads</h2>\n<table>\n<tr><th>quantity</th><th>" << unit.name << "</th></tr>\n"
+       << "<tr><th>mean surge ice resistance (steady part)</th><td class=\"n\" id=\"mean-kN\">" << in_unit(rs.mean_kN)
+       << "</td></tr>\n<tr><th>standard deviation of the surge ice load</th><td class=\"n\">" << in_unit(rs.std_kN)
        << "</td></tr>\n<tr><th>largest moving average of the resistance"
        << (std::isfinite(rs.moving_average_window_s) && rs.moving_average_window_s > 0
                ? " (" + fmt("%g", rs.moving_average_window_s) + " s window)"
                : std::string())
-       << "</th><td class=\"n\">" << kN(rs.moving_average_max_kN) << "</td></tr>\n</table>\n";
+       << "</th><td class=\"n\">" << in_unit(rs.moving_average_max_kN) << "</td></tr>\n</table>\n";
   if (rs.references.empty()) {
     body << "<p class=\"note\">No reference value given (report config: <code>reference_kN</code>, "
             "<code>reference_label</code> or <code>references</code>).</p>\n";
   } else {
-    body << "<table id=\"references\">\n<tr><th>reference</th><th>kN</th><th>simulated &minus; reference, "
-            "kN</th><th>error, %</th></tr>\n";
+    body << "<table id=\"references\">\n<tr><th>reference</th><th>" << unit.name
+         << "</th><th>simulated &minus; reference, " << unit.name << "</th><th>error, %</th></tr>\n";
     for (const auto& c : rs.references)
-      body << "<tr><th>" << html_escape(c.label) << "</th><td class=\"n\">" << kN(c.reference_kN)
-           << "</td><td class=\"n\">" << fmt("%+.1f", c.error_kN) << "</td><td class=\"n\">"
+      body << "<tr><th>" << html_escape(c.label) << "</th><td class=\"n\">" << in_unit(c.reference_kN)
+           << "</td><td class=\"n\">" << fmt("%+.1f", 1000.0 * c.error_kN / unit.newtons) << "</td><td class=\"n\">"
            << fmt("%+.1f", c.error_percent) << "</td></tr>\n";
     body << "</table>\n";
   }
@@ -442,6 +448,9 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
   if (fs::is_regular_file(run_dir / "hull/hull.json")) {
     const Json h = pg.json("hull/hull.json", "hull sidecar");
     if (const Json* hy = find(h, {"hydrostatics"})) body << scalar_rows(*hy, "hydrostatics.");
+    // A user's mesh: how it was placed and where it floats (floesim-hull's report).
+    if (const Json* pl = find(h, {"placement"})) body << scalar_rows(*pl, "placement.");
+    if (const Json* wl = find(h, {"waterline"})) body << scalar_rows(*wl, "waterline.");
     body << scalar_rows(h);
   } else if (fs::exists(run_dir / "config/hull.json")) {
     pg.missing.push_back("hull/hull.json (hull particulars)");

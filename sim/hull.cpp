@@ -28,6 +28,12 @@ namespace {
 
 double deg(double d) { return d * kPi / 180.0; }
 
+std::string percent(double f) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%+.2f %%", 100.0 * f);
+  return buf;
+}
+
 // 0 -> 0, 1 -> 1 with zero slope at both ends (for blending hull parameters along x without kinks).
 double smooth(double s) {
   s = std::clamp(s, 0.0, 1.0);
@@ -435,6 +441,25 @@ Hydrostatics hydrostatics(const std::vector<TriMesh>& parts, double rho_w, doubl
   return h;
 }
 
+namespace {
+// The hydrostatics block of a hull sidecar (generated and imported hulls alike).
+nlohmann::json hydrostatics_json(const Hydrostatics& h, double rho_w) {
+  return {{"rho_w_kg_m3", rho_w},
+          {"volume_m3", h.volume_m3},
+          {"displacement_t", h.displacement_t},
+          {"waterplane_area_m2", h.waterplane_area_m2},
+          {"lcb_m", h.lcb_m},
+          {"kb_m", h.kb_m},
+          {"wetted_surface_m2", h.wetted_surface_m2},
+          {"length_wl_m", h.length_wl_m},
+          {"beam_wl_m", h.beam_wl_m},
+          {"draught_m", h.draught_m},
+          {"block_coefficient", h.block_coefficient},
+          {"centre_of_buoyancy_m", {h.centre_of_buoyancy.x(), h.centre_of_buoyancy.y(), h.centre_of_buoyancy.z()}}};
+}
+
+}  // namespace
+
 std::string write_generated_hull(const HullGeneratorOptions& o, const fs::path& out_obj, const fs::path& config_file) {
   const std::vector<TriMesh> parts = generate_hull(o);
   constexpr double rho_w = 1025.0;
@@ -466,19 +491,7 @@ std::string write_generated_hull(const HullGeneratorOptions& o, const fs::path& 
   side["vertices"] = nv;
   side["triangles"] = nt;
   side["extent_m"] = {{"x", {b.lo.x(), b.hi.x()}}, {"y", {b.lo.y(), b.hi.y()}}, {"z", {b.lo.z(), b.hi.z()}}};
-  side["hydrostatics"] = {{"rho_w_kg_m3", rho_w},
-                          {"volume_m3", h.volume_m3},
-                          {"displacement_t", h.displacement_t},
-                          {"waterplane_area_m2", h.waterplane_area_m2},
-                          {"lcb_m", h.lcb_m},
-                          {"kb_m", h.kb_m},
-                          {"wetted_surface_m2", h.wetted_surface_m2},
-                          {"length_wl_m", h.length_wl_m},
-                          {"beam_wl_m", h.beam_wl_m},
-                          {"draught_m", h.draught_m},
-                          {"block_coefficient", h.block_coefficient},
-                          {"centre_of_buoyancy_m", {h.centre_of_buoyancy.x(), h.centre_of_buoyancy.y(),
-                                                    h.centre_of_buoyancy.z()}}};
+  side["hydrostatics"] = hydrostatics_json(h, rho_w);
 
   fs::path sidecar = out_obj;
   sidecar.replace_extension(".json");
@@ -671,11 +684,6 @@ Sliced slice_convex(const TriMesh& m, int n, double target, double merge) {
   return out;
 }
 
-std::string percent(double f) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%+.2f %%", 100.0 * f);
-  return buf;
-}
 
 }  // namespace
 
@@ -684,13 +692,17 @@ constexpr double kSectionExcessTarget = 0.02;
 // Neighbouring sections are merged into one part while the hull of both adds less than this fraction.
 constexpr double kMergeExcess = 0.001;
 
-HullModel load_hull(const fs::path& file, const HullLoadOptions& o) {
+HullModel load_hull(const fs::path& file, const HullLoadOptions& o, const HullPlacement& placement) {
   const std::string where = file.string();
   FLOESIM_REQUIRE(fs::exists(file), where, ": hull file not found");
   FLOESIM_REQUIRE(fs::is_regular_file(file), where, ": not a regular file");
   FLOESIM_REQUIRE(o.non_convex == "slice" || o.non_convex == "refuse", where,
                   ": non_convex must be \"slice\" or \"refuse\", got \"", o.non_convex, "\"");
   FLOESIM_REQUIRE(o.slices >= 2, where, ": slices must be >= 2, got ", o.slices);
+  FLOESIM_REQUIRE(placement.scale > 0 && std::isfinite(placement.scale), where, ": scale must be > 0, got ",
+                  placement.scale);
+  FLOESIM_REQUIRE(placement.origin_m.size() == 2, where, ": origin_m must be [x, y]");
+  place_point(placement, Vec3::Zero());  // checks bow_direction
 
   Assimp::Importer importer;
   // Our world is z-up like most CAD exports. assimp would turn a Collada file declaring Z_UP into its own y-up
@@ -746,7 +758,18 @@ HullModel load_hull(const fs::path& file, const HullLoadOptions& o) {
   walk(scene->mRootNode, Eigen::Matrix4d::Identity());
   FLOESIM_REQUIRE(!instances.empty(), where, ": the file's node tree references no meshes");
 
+  // The placement, before anything else: welding, slicing along x and the hydrostatics all work in the hull frame.
+  // Equal file positions stay equal (one deterministic map), so welding is unchanged. A proper rotation keeps the
+  // triangles' orientation.
+  double file_max_abs = 0;  // largest file coordinate: sets the rounding of single-precision input
+  for (Instance& in : instances)
+    for (Vec3& p : in.v) {
+      if (p.allFinite()) file_max_abs = std::max(file_max_abs, p.cwiseAbs().maxCoeff());
+      p = place_point(placement, p);
+    }
+
   std::ostringstream report;
+  report << "placement: " << describe_placement(placement) << "\n";
   // Closed meshes are bodies of their own. Meshes that are open on their own (an OBJ whose hull, deck and transom
   // are separate groups, as in the KCS and DTMB 5415 benchmark files) are welded together and accepted as one body
   // if together they close; otherwise the file is refused: buoyancy needs a watertight hull.
@@ -830,12 +853,13 @@ HullModel load_hull(const fs::path& file, const HullLoadOptions& o) {
       body.notes += "triangles faced inwards: flipped; ";
     }
     model.mesh_volume_m3 += mp.volume;
+    model.mesh = merge({model.mesh, body.mesh});
     std::ostringstream line;
     line << "mesh '" << body.name << "': closed, " << body.mesh.triangles.size() << " triangles, volume "
          << fmt_num(mp.volume) << " m^3; " << body.notes;
     // Tolerance relative to the mesh: assimp stores single-precision coordinates (relative error ~6e-8).
     const double max_abs = std::max(bb.lo.cwiseAbs().maxCoeff(), bb.hi.cwiseAbs().maxCoeff());
-    const double tol = 1e-6 * std::max(size, max_abs);
+    const double tol = 1e-6 * std::max({size, max_abs, file_max_abs * placement.scale});
     if (is_convex(body.mesh, tol)) {
       line << "convex: kept as 1 part";
       model.parts.push_back(std::move(body.mesh));
@@ -871,12 +895,223 @@ HullModel load_hull(const fs::path& file, const HullLoadOptions& o) {
     report << line.str() << "\n";
   }
   model.surface = merge(model.parts);
+  model.placement = placement;
   report << "total: " << model.parts.size() << " convex part" << (model.parts.size() == 1 ? "" : "s")
          << ", mesh volume " << fmt_num(model.mesh_volume_m3)
          << " m^3, parts volume " << fmt_num(model.parts_volume_m3) << " m^3 ("
          << percent((model.parts_volume_m3 - model.mesh_volume_m3) / model.mesh_volume_m3) << ")\n";
   model.report = report.str();
   return model;
+}
+
+
+// ---- placement of a mesh from CAD --------------------------------------------------------------------------------
+
+Vec3 place_point(const HullPlacement& p, const Vec3& q) {
+  const double ox = p.origin_m.size() == 2 ? p.origin_m[0] : 0.0, oy = p.origin_m.size() == 2 ? p.origin_m[1] : 0.0;
+  const double x = q.x() - ox, y = q.y() - oy, z = q.z() - p.waterline_z_m;
+  // The turn about z taking the bow to +x (a proper rotation: port stays to port, normals stay outward).
+  Vec3 r;
+  if (p.bow_direction == "+x") r = {x, y, z};
+  else if (p.bow_direction == "-x") r = {-x, -y, z};
+  else if (p.bow_direction == "+y") r = {y, -x, z};
+  else if (p.bow_direction == "-y") r = {-y, x, z};
+  else throw Error("bow_direction must be one of +x, -x, +y, -y, got \"" + p.bow_direction + "\"");
+  return p.scale * r;
+}
+
+namespace {
+double bow_turn_deg(const std::string& bow) {
+  return bow == "-x" ? 180.0 : bow == "+y" ? -90.0 : bow == "-y" ? 90.0 : 0.0;
+}
+}  // namespace
+
+std::string describe_placement(const HullPlacement& p) {
+  std::ostringstream s;
+  s << "scale " << fmt_num(p.scale) << "; bow towards " << p.bow_direction;
+  if (p.bow_direction == "+x") s << " (no turn)";
+  else s << ", turned " << fmt_num(bow_turn_deg(p.bow_direction)) << " deg about z to +x";
+  const double ox = p.origin_m.size() == 2 ? p.origin_m[0] : 0.0, oy = p.origin_m.size() == 2 ? p.origin_m[1] : 0.0;
+  s << "; calm waterline at file z = " << fmt_num(p.waterline_z_m) << " -> z = 0";
+  s << "; file (x, y) = (" << fmt_num(ox) << ", " << fmt_num(oy) << ") -> origin";
+  return s.str();
+}
+
+void require_floating(const HullModel& hull, const std::string& where) {
+  FLOESIM_REQUIRE(!hull.surface.vertices.empty(), where, ": the hull has no parts");
+  const Bounds b(hull.surface.vertices);
+  const HullPlacement& p = hull.placement;
+  // The hull's z range in the file's own frame and units, for the message.
+  const double f_lo = b.lo.z() / p.scale + p.waterline_z_m, f_hi = b.hi.z() / p.scale + p.waterline_z_m;
+  const std::string fix = "; set waterline_z_m to the height of the calm waterline in the mesh's own frame, "
+                          "between its keel and deck (file z from " + fmt_num(f_lo) + " to " + fmt_num(f_hi) +
+                          "; e.g. keel + draught for a mesh with its keel at z = 0)";
+  FLOESIM_REQUIRE(b.lo.z() < 0, where, ": waterline_z_m = ", fmt_num(p.waterline_z_m),
+                  " puts the whole hull above the water (its lowest point is ", fmt_num(b.lo.z()),
+                  " m above the waterline): it would displace nothing", fix);
+  FLOESIM_REQUIRE(b.hi.z() > 0, where, ": waterline_z_m = ", fmt_num(p.waterline_z_m),
+                  " puts the whole hull under water (its highest point is ", fmt_num(-b.hi.z()),
+                  " m below the waterline): a ship must pierce the surface", fix);
+  // A waterline at the keel (a few micrometres of keel below it) or at the deck is a placement error too: a ship
+  // displaces a good part of its volume (half or so), not nothing and not all of it.
+  const double v = submerged_part(hull.surface.vertices, hull.surface.triangles, 0.0).volume;
+  const double f = v / hull.parts_volume_m3;
+  FLOESIM_REQUIRE(f >= 0.01, where, ": waterline_z_m = ", fmt_num(p.waterline_z_m),
+                  " leaves the hull a displacement of (almost) zero (", fmt_num(v), " m^3 below the waterline, ",
+                  percent(f), " of its volume)", fix);
+  FLOESIM_REQUIRE(f <= 0.99, where, ": waterline_z_m = ", fmt_num(p.waterline_z_m), " puts (almost) the whole hull "
+                  "under water (", percent(f), " of its volume below the waterline)", fix);
+}
+
+namespace {
+
+// Lowest z of the mesh's section at x (where triangle edges cross the plane x = const); +inf if none.
+double lowest_z_at(const TriMesh& m, double x) {
+  double lo = std::numeric_limits<double>::infinity();
+  for (const auto& t : m.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 &a = m.vertices[t[k]], &b = m.vertices[t[(k + 1) % 3]];
+      if ((a.x() - x) * (b.x() - x) > 0 || a.x() == b.x()) continue;
+      lo = std::min(lo, a.z() + (b.z() - a.z()) * ((x - a.x()) / (b.x() - a.x())));
+    }
+  return lo;
+}
+
+// Mass in the unit that reads best: kg for a model, t for a ship.
+std::string mass_text(double kg) { return kg < 1e4 ? fmt_num(kg, 4) + " kg" : fmt_num(kg / 1000.0, 5) + " t"; }
+
+}  // namespace
+
+std::string write_imported_hull(const HullImportOptions& o, const fs::path& out_obj, const fs::path& config_file) {
+  const std::string where = config_file.empty() ? std::string("hull options") : config_file.string();
+  {  // the options' own checks, also when the struct was filled in code rather than read from JSON
+    const Json none = Json::object();
+    OptionReader r(none, where, "");
+    const_cast<HullImportOptions&>(o).visit(r);
+    r.finish();
+  }
+  fs::path mesh_file = o.file;
+  if (mesh_file.is_relative() && !config_file.empty()) mesh_file = config_file.parent_path() / mesh_file;
+  FLOESIM_REQUIRE(fs::exists(mesh_file), where, ": file names ", mesh_file.string(), ", which does not exist");
+
+  // 1. Load, place, decompose; refuse a hull that does not float.
+  HullModel m = load_hull(mesh_file, o.load, o.placement);
+  require_floating(m, where);
+  // The parts go to an OBJ that the simulator reads with assimp in single precision. Rounded to float, a part's
+  // sliver faces would tilt and the part would no longer pass as convex. So, as for the generated hull, each part
+  // is snapped to a binary grid that floats hold exactly (the float spacing at the hull's largest coordinate) and
+  // is rebuilt as the convex hull of its snapped vertices: what is written is read back bit for bit, and convex.
+  {
+    const Bounds all(m.surface.vertices);
+    const double max_abs = std::max(all.lo.cwiseAbs().maxCoeff(), all.hi.cwiseAbs().maxCoeff());
+    const double g = std::ldexp(1.0, static_cast<int>(std::ceil(std::log2(max_abs))) - 23);
+    double v = 0;
+    for (TriMesh& part : m.parts) {
+      for (Vec3& p : part.vertices) p = (p / g).array().round().matrix() * g;
+      part = convex_hull(part.vertices);
+      v += mass_properties(part).volume;
+    }
+    m.parts_volume_m3 = v;
+    m.surface = merge(m.parts);
+  }
+
+  // 2. What it displaces, by the convex parts (what the simulator floats) and by the mesh itself (the reference).
+  const double rho = o.water_density_kg_m3;
+  const Hydrostatics h = hydrostatics(m.parts, rho, 0.0);
+  const double v_mesh = submerged_part(m.mesh.vertices, m.mesh.triangles, 0.0).volume;
+  const double volume_error = (m.parts_volume_m3 - m.mesh_volume_m3) / m.mesh_volume_m3;
+  const double displacement_error = (h.volume_m3 - v_mesh) / v_mesh;
+  const Bounds b(m.surface.vertices);
+  // The draught at mid-waterline-length (the keel line there: a sonar dome or skeg does not count) and the deepest.
+  double x_wl_lo = std::numeric_limits<double>::infinity(), x_wl_hi = -x_wl_lo;
+  for (const auto& t : m.surface.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 &a = m.surface.vertices[t[k]], &c = m.surface.vertices[t[(k + 1) % 3]];
+      if (a.z() * c.z() > 0 || a.z() == c.z()) continue;
+      const double x = a.x() + (c.x() - a.x()) * (-a.z() / (c.z() - a.z()));
+      x_wl_lo = std::min(x_wl_lo, x), x_wl_hi = std::max(x_wl_hi, x);
+    }
+  const double x_mid = 0.5 * (x_wl_lo + x_wl_hi);
+  const double draught_mid = -lowest_z_at(m.surface, x_mid);
+  size_t nv = 0, nt = 0;
+  for (const TriMesh& p : m.parts) nv += p.vertices.size(), nt += p.triangles.size();
+
+  std::ostringstream head;
+  head << "floesim hull from " << mesh_file.filename().string() << ", " << m.parts.size() << " convex parts\n"
+       << "written by floesim-hull " << version() << "; frame: x forward, y to port, z up, metres; calm waterline"
+       << " z = 0\n"
+       << "placement: " << describe_placement(o.placement) << "\n"
+       << "volume below z = 0: " << fmt_num(h.volume_m3) << " m^3 (mesh " << fmt_num(v_mesh) << " m^3, "
+       << percent(displacement_error) << "); displacement " << mass_text(rho * h.volume_m3) << " at rho_w = " << rho
+       << " kg/m^3\n";
+
+  nlohmann::json side;
+  std::vector<NamedInput> inputs;
+  inputs.push_back({"mesh", mesh_file});
+  if (!config_file.empty()) inputs.push_back({"config", config_file});
+  side["provenance"] = make_provenance("floesim-hull", inputs, options_to_json(o));
+  side["hull_file"] = out_obj.filename().string();
+  side["source_file"] = mesh_file.string();
+  side["frame"] = "x forward, y to port, z up; calm waterline z = 0; origin at the placement's origin_m; metres";
+  side["placement"] = {{"scale", o.placement.scale},
+                       {"bow_direction", o.placement.bow_direction},
+                       {"turn_about_z_deg", bow_turn_deg(o.placement.bow_direction)},
+                       {"waterline_z_m", o.placement.waterline_z_m},
+                       {"origin_m", o.placement.origin_m},
+                       {"description", describe_placement(o.placement)}};
+  side["parts"] = m.parts.size();
+  side["vertices"] = nv;
+  side["triangles"] = nt;
+  side["extent_m"] = {{"x", {b.lo.x(), b.hi.x()}}, {"y", {b.lo.y(), b.hi.y()}}, {"z", {b.lo.z(), b.hi.z()}}};
+  side["mesh_volume_m3"] = m.mesh_volume_m3;
+  side["parts_volume_m3"] = m.parts_volume_m3;
+  side["volume_error"] = volume_error;
+  side["mesh_displaced_volume_m3"] = v_mesh;
+  side["displaced_volume_error"] = displacement_error;
+  side["displacement_kg"] = rho * h.volume_m3;
+  side["waterline"] = {{"z_in_file", o.placement.waterline_z_m},
+                       {"length_wl_m", h.length_wl_m},
+                       {"beam_wl_m", h.beam_wl_m},
+                       {"x_wl_m", {x_wl_lo, x_wl_hi}},
+                       {"draught_mid_wl_m", draught_mid},
+                       {"draught_max_m", h.draught_m}};
+  side["hydrostatics"] = hydrostatics_json(h, rho);
+  {  // what the loader did, one line per entry (placement, meshes, total)
+    nlohmann::json lines = nlohmann::json::array();
+    std::istringstream rep(m.report);
+    for (std::string line; std::getline(rep, line);) lines.push_back(line);
+    side["loader_report"] = lines;
+  }
+
+  fs::path sidecar = out_obj;
+  sidecar.replace_extension(".json");
+  FLOESIM_REQUIRE(sidecar != out_obj, out_obj.string(), ": the hull file must not end in .json (the sidecar does)");
+  ensure_directory(out_obj.parent_path());
+  write_obj(out_obj, m.parts, head.str());
+  write_text_atomic(sidecar, side.dump(2) + "\n");
+
+  std::ostringstream sum;
+  sum << "hull: " << mesh_file.filename().string() << " -> " << m.parts.size() << " convex parts, " << nv
+      << " vertices, " << nt << " triangles -> " << out_obj.string() << " (+ " << sidecar.filename().string() << ")\n"
+      << "  placement            " << describe_placement(o.placement) << "\n"
+      << "  extent x " << fmt_num(b.lo.x()) << " .. " << fmt_num(b.hi.x()) << " m, y " << fmt_num(b.lo.y()) << " .. "
+      << fmt_num(b.hi.y()) << " m, z " << fmt_num(b.lo.z()) << " .. " << fmt_num(b.hi.z()) << " m\n"
+      << "  volume               mesh " << fmt_num(m.mesh_volume_m3) << " m^3, convex parts "
+      << fmt_num(m.parts_volume_m3) << " m^3 (" << percent(volume_error) << ")\n"
+      << "  volume below z = 0   mesh " << fmt_num(v_mesh) << " m^3, convex parts " << fmt_num(h.volume_m3)
+      << " m^3 (" << percent(displacement_error) << ")\n"
+      << "  displacement         " << mass_text(rho * h.volume_m3) << " (rho_w " << rho << " kg/m^3)\n"
+      << "  waterline            file z = " << fmt_num(o.placement.waterline_z_m) << "; L x B "
+      << fmt_num(h.length_wl_m) << " x " << fmt_num(h.beam_wl_m) << " m, x " << fmt_num(x_wl_lo) << " .. "
+      << fmt_num(x_wl_hi) << " m\n"
+      << "  draught              " << fmt_num(draught_mid) << " m at mid waterline length, " << fmt_num(h.draught_m)
+      << " m at the deepest point\n"
+      << "  waterplane area      " << fmt_num(h.waterplane_area_m2) << " m^2, LCB " << fmt_num(h.lcb_m) << " m, KB "
+      << fmt_num(h.kb_m) << " m, wetted surface " << fmt_num(h.wetted_surface_m2) << " m^2\n"
+      << "loader:\n";
+  std::istringstream rep(m.report);
+  for (std::string line; std::getline(rep, line);) sum << "  " << line << "\n";
+  return sum.str();
 }
 
 }  // namespace floesim::sim

@@ -1,5 +1,6 @@
 // The vessel's hull: a parametric icebreaker generator (written as OBJ) and the loader any user hull goes through.
 #pragma once
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -74,12 +75,47 @@ struct HullLoadOptions {
   }
 };
 
+// Where a mesh from CAD lies in its own frame, and so how it is brought into the hull frame the simulator uses (x
+// forward, y to port, z up, calm waterline at z = 0): a point p of the file goes to
+//   scale * R_bow * (p - [origin_m[0], origin_m[1], waterline_z_m]),
+// with R_bow the turn about z that takes bow_direction to +x. Lengths are in the file's own units and frame.
+struct HullPlacement {
+  double scale = 1.0;                        // file units -> metres (0.001 for a file in mm; 1/31.6 full -> model)
+  std::string bow_direction = "+x";          // where the bow points in the file: +x | -x | +y | -y
+  double waterline_z_m = 0.0;                // z of the calm waterline in the file's frame (file units, before scale)
+  std::vector<double> origin_m = {0.0, 0.0};  // [x, y] in the file's frame that becomes the hull frame's origin
+  template <class V>
+  void visit(V& v) {
+    v.field("scale", scale, "-", "multiplies the file's coordinates (file units -> metres)", positive());
+    v.field("bow_direction", bow_direction, "-", "where the bow points in the file: +x, -x, +y or -y",
+            one_of({"+x", "-x", "+y", "-y"}));
+    v.field("waterline_z_m", waterline_z_m, "m",
+            "height of the calm waterline in the file's own frame and units (e.g. the draught if the keel is at z = 0)",
+            Check<double>([](const double& z) -> std::string { return std::isfinite(z) ? "" : "must be finite"; }));
+    v.field("origin_m", origin_m, "m",
+            "[x, y] of the file's frame that becomes the hull frame's origin (e.g. midship on the centreline)",
+            Check<std::vector<double>>([](const std::vector<double>& p) -> std::string {
+              if (p.size() != 2) return "must be [x, y] (2 numbers)";
+              for (double x : p)
+                if (!std::isfinite(x)) return "must be finite numbers";
+              return "";
+            }));
+  }
+};
+
+// The placement as a map of points: file frame -> hull frame, and one line saying what it does.
+Vec3 place_point(const HullPlacement& p, const Vec3& file_point);
+std::string describe_placement(const HullPlacement& p);
+
 struct HullModel {
-  std::vector<TriMesh> parts;   // convex parts, in the OBJ's frame (metres)
+  std::vector<TriMesh> parts;   // convex parts, in the hull frame (the file's frame after the placement; metres)
   TriMesh surface;              // all parts merged: used for buoyancy clipping and rendering
-  double mesh_volume_m3 = 0;    // volume enclosed by the input meshes (as read)
+  TriMesh mesh;                 // the input meshes as read (welded, oriented, placed), merged: the reference
+  double mesh_volume_m3 = 0;    // volume enclosed by the input meshes (as read, after scaling)
   double parts_volume_m3 = 0;   // volume of the convex parts
-  std::string report;           // what the loader did, one line per mesh (convex kept / sliced into N, volume error)
+  HullPlacement placement;      // how the file was placed
+  std::string report;           // what the loader did: the placement, then one line per mesh (convex kept / sliced
+                                // into N, volume error)
 };
 
 // Loads any mesh file assimp reads (OBJ first of all); each mesh is one part. Convex meshes are kept as they are;
@@ -90,6 +126,39 @@ struct HullModel {
 // become one body; anything still open is an Error. Slicing cuts along x; a section whose hull would add more than
 // 2 % of its volume (bulb, skeg, flare) is also cut horizontally into up to 8 layers, and neighbouring uncut
 // sections are merged while that adds < 0.1 %. Convexity is judged to 1e-6 of the mesh size.
-HullModel load_hull(const std::filesystem::path& file, const HullLoadOptions& o = {});
+// The placement is applied to the vertices as read, before anything else (so slicing runs along the placed x).
+HullModel load_hull(const std::filesystem::path& file, const HullLoadOptions& o = {},
+                    const HullPlacement& placement = {});
+
+// Refuses (Error naming `where`, the key to fix and the mesh's z range in the file) a hull that, in the hull frame,
+// lies entirely above or below the calm waterline z = 0, or displaces less than 1 % or more than 99 % of its volume
+// there (a waterline at the keel or at the deck).
+void require_floating(const HullModel& hull, const std::string& where);
+
+// The floesim-hull stage for a user's mesh: the hull section of a case ("file" beside the placement and the
+// decomposition options).
+struct HullImportOptions {
+  std::string file;                    // the mesh (OBJ or anything assimp reads); relative to the config file
+  HullPlacement placement;             // read from the same level: scale, bow_direction, waterline_z_m, origin_m
+  HullLoadOptions load;                // read from the same level: non_convex, slices, max_volume_error
+  double water_density_kg_m3 = 1025.0;  // for the displacement reported (the simulation uses its own water density)
+  template <class V>
+  void visit(V& v) {
+    v.field("file", file, "-", "the hull mesh (OBJ or anything assimp reads); relative to this file's folder",
+            Check<std::string>([](const std::string& f) -> std::string { return f.empty() ? "must name a file" : ""; }));
+    placement.visit(v);
+    load.visit(v);
+    v.field("water_density_kg_m3", water_density_kg_m3, "kg/m^3", "water density for the displacement reported",
+            positive());
+  }
+};
+
+// Loads, places and decomposes o.file, refuses a hull that does not float (require_floating), writes the convex
+// parts to out_obj (one object per part, hull frame) and its sidecar (out_obj with extension .json: placement,
+// parts, volume error, displacement and waterline, provenance) atomically and returns the summary printed on stdout.
+// Nothing is written if the hull is refused. config_file (may be empty) is recorded in the provenance and names
+// the keys in errors; a relative o.file is taken relative to its folder.
+std::string write_imported_hull(const HullImportOptions& o, const std::filesystem::path& out_obj,
+                                const std::filesystem::path& config_file);
 
 }  // namespace floesim::sim

@@ -12,6 +12,7 @@
 #include "pipeline/error.h"
 #include "pipeline/floes_io.h"
 #include "pipeline/provenance.h"
+#include "pipeline/units.h"
 #include "sim/fracture_laws.h"
 #include "sim/world.h"
 
@@ -499,6 +500,13 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   }
   const FloeField field = read_floes(floes_file);
   const HullModel hull = load_hull(hull_file, o.hull);
+  try {  // the stage floats the hull as the file has it: one entirely above or below the water is a placement error
+    require_floating(hull, hull_file.string());
+  } catch (const Error& e) {
+    throw Error(std::string(e.what()) + ". floesim-simulate takes the hull frame as the file has it (bow +x, "
+                "waterline z = 0): place a CAD mesh with the hull options (case \"hull\": {\"file\", \"waterline_z_m\", "
+                "\"bow_direction\", \"scale\"}, or floesim-hull) first");
+  }
   const Model model = build_model(field, &hull, o);
 
   std::ostringstream out;
@@ -506,7 +514,10 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
       << model.removed_floe_ids.size()
       << " removed: they overlapped the vessel's initial footprint";
   if (model.small_overlaps) out << "; " << model.small_overlaps << " small floe-floe overlaps left to the solver";
-  out << "), vessel " << model.vessel_info.mass_kg / 1e3 << " t, L_wl " << model.vessel_info.length_wl_m
+  out << "), vessel ";
+  if (model.vessel_info.mass_kg < 1e4) out << std::lround(model.vessel_info.mass_kg) << " kg";  // a tank model
+  else out << model.vessel_info.mass_kg / 1e3 << " t";
+  out << ", L_wl " << model.vessel_info.length_wl_m
       << " m, GM_T " << model.vessel_info.gm_transverse_m << " m\n";
   std::cout << out.str() << std::flush;
 
@@ -540,8 +551,13 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
     rep << " " << (i < kStageCount ? stage_name(i) : "record") << " " << std::setprecision(3)
         << 1e3 * stats.stage_s[i] / stats.steps;
   rep << "\n" << std::setprecision(1);
-  rep << "mean surge ice load " << summary["mean_surge_ice_load_N"].get<double>() / 1e3 << " kN (resistance "
-      << summary["mean_surge_ice_resistance_N"].get<double>() / 1e3 << " kN) from t = " << o.steady_start_s
+  {  // in the unit that suits the loads' size: N for a tank model, kN for a ship
+    const double load_n = summary["mean_surge_ice_load_N"].get<double>();
+    const ForceUnit u = force_unit_for(load_n);
+    rep << "mean surge ice load " << load_text(load_n, u) << " (resistance "
+        << load_text(summary["mean_surge_ice_resistance_N"].get<double>(), u) << ")";
+  }
+  rep << " from t = " << o.steady_start_s
       << " s, mean speed " << std::setprecision(3) << summary["mean_vessel_speed_mps"].get<double>() << " m/s\n";
   const nlohmann::json& fr = summary["fracture"];
   if (fr["enabled"].get<bool>())

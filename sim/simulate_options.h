@@ -118,7 +118,8 @@ struct PropulsionOptions {
 };
 
 // One propeller of the vessel: its share of the propulsion thrust makes a jet (PHYSICS.md §3.5) that the floes' drag
-// sees. Positions in the hull file's frame (x forward, y to port, z up, waterline z = 0, the hull's own origin).
+// sees. Positions in the hull frame (x forward, y to port, z up, waterline z = 0, the hull's own origin): the hull
+// file's frame after the case's hull placement (bow_direction, waterline_z_m, origin_m, scale).
 struct PropellerOptions {
   std::vector<double> position_m;         // [x, y, z] of the propeller disc's centre, hull frame
   std::vector<double> axis = {1, 0, 0};   // direction of the thrust it gives (body axes); the jet flows opposite
@@ -127,7 +128,8 @@ struct PropellerOptions {
   template <class V>
   void visit(V& v) {
     v.field("position_m", position_m, "m",
-            "[x, y, z] of the propeller disc's centre in the hull file's frame (waterline z = 0); must be under water",
+            "[x, y, z] of the propeller disc's centre in the hull frame (after the hull placement; waterline z = 0); "
+            "must be under water",
             Check<std::vector<double>>([](const std::vector<double>& p) -> std::string {
               if (p.size() != 3) return "must be [x, y, z] (3 numbers)";
               for (double x : p)

@@ -216,16 +216,28 @@ CasePlan plan_case(const Json& c, const std::string& where, const fs::path& case
   fs::path hull_obj;
   {
     const Json& h = require_object(c, "hull", cf);
-    FLOESIM_REQUIRE(h.contains("generate") != h.contains("file") && h.size() == 1, cf,
-                    ": hull needs exactly one key: \"file\" (an OBJ or any mesh assimp reads) or \"generate\" "
-                    "(options for floesim-hull)");
+    FLOESIM_REQUIRE(h.contains("generate") != h.contains("file"), cf,
+                    ": hull needs exactly one of \"file\" (an OBJ or any mesh assimp reads, with its placement "
+                    "options beside it) or \"generate\" (options for floesim-hull's parametric icebreaker)");
+    FLOESIM_REQUIRE(!h.contains("generate") || h.size() == 1, cf,
+                    ": hull.generate takes no keys beside it (the placement options go with \"file\")");
     if (h.contains("generate")) {
       PlannedStage* st = add("hull", "parametric icebreaker hull", h["generate"], {}, {"hull.obj"}, "floesim-hull");
       hull_obj = st->outputs[0];
       st->args = {"--config", st->config.string(), "--out", hull_obj.string()};
       plan.artefacts.push_back({"hull", "hull/hull.obj", "hull as convex parts, m (OBJ)"});
     } else {
-      hull_obj = case_input(h, "file", "hull");
+      // The user's mesh: floesim-hull places it (scale, bow_direction, waterline_z_m, origin_m), cuts it into
+      // convex parts, reports what it did in hull.json and refuses a hull that does not float. Its settings are the
+      // case's hull section as it stands (the file's path made absolute), checked by the stage itself.
+      Json settings = h;
+      const fs::path mesh = case_input(h, "file", "hull");
+      settings["file"] = mesh.string();
+      PlannedStage* st = add("hull", "user's hull mesh placed and cut into convex parts", settings, {mesh},
+                             {"hull.obj"}, "floesim-hull");
+      hull_obj = st->outputs[0];
+      st->args = {"--config", st->config.string(), "--out", hull_obj.string()};
+      plan.artefacts.push_back({"hull", "hull/hull.obj", "hull as convex parts in the hull frame, m (OBJ)"});
     }
   }
 

@@ -2,6 +2,7 @@
 
 #include "pipeline/error.h"
 #include "pipeline/signal.h"
+#include "pipeline/units.h"
 
 using namespace floesim;
 
@@ -95,4 +96,19 @@ TEST(Signal, UniformStepChecksTheTimeColumn) {
   EXPECT_THROW(uniform_step({0.0}, "t"), Error);
   EXPECT_THROW(uniform_step({0.0, 0.1, 0.3}, "t"), Error);
   EXPECT_THROW(uniform_step({0.3, 0.2, 0.1}, "t"), Error);
+}
+
+// Loads read in the unit that suits their size (pipeline/units.h): a tank model's in N, a ship's in kN.
+TEST(Units, ForceUnitSuitsTheMagnitude) {
+  EXPECT_STREQ(force_unit_for(0.175).name, "N");      // a 7 m model in small floes
+  EXPECT_STREQ(force_unit_for(-37.4).name, "N");
+  EXPECT_STREQ(force_unit_for(999.0).name, "N");
+  EXPECT_STREQ(force_unit_for(1000.0).name, "kN");
+  EXPECT_STREQ(force_unit_for(1.038e6).name, "kN");   // Oden's 1038 kN stays in kN, as its references are given
+  EXPECT_STREQ(force_unit_for(2.5e7).name, "MN");
+  EXPECT_STREQ(force_unit_for(std::nan("")).name, "N");
+  EXPECT_EQ(load_text(37.4, force_unit_for(37.4)), "37.4 N");
+  EXPECT_EQ(load_text(1.038e6, force_unit_for(1.038e6)), "1038 kN");
+  EXPECT_EQ(load_text(0.7, {"kN", 1e3}), "0.0007 kN");  // what the issue complained of: hence the choice above
+  EXPECT_EQ(load_number(-0.0001), "0");
 }

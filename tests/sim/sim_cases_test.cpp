@@ -105,6 +105,59 @@ TEST(SimCases, FloesGivenDirectlySkipImageAndDigitise) {
   fs::remove_all(root);
 }
 
+// "hull": {"file": ..., placement options}: a hull stage (floesim-hull on the case's hull section, the file made
+// absolute) places and cuts the mesh; simulate reads its hull.obj. floesim-hull --check-config validates the
+// options strictly, naming the key.
+TEST(SimCases, HullFileWithPlacementPlansAHullStageThatChecksItsOptions) {
+  const fs::path root = temp_root();
+  const fs::path dir = kSource / "cases" / "single-floe-offcentre";
+  const fs::path c = root / "mesh_case";
+  fs::create_directories(c);
+  std::ofstream(c / "floes.geojson") << read_text(dir / "floes.geojson");
+  std::ofstream(c / "box.obj") << "o box\nv 0 0 0\nv 4 0 0\nv 0 1 0\nv 4 1 0\nv 0 0 1\nv 4 0 1\nv 0 1 1\nv 4 1 1\n"
+                                  "f 1 3 4\nf 1 4 2\nf 5 6 8\nf 5 8 7\nf 1 2 6\nf 1 6 5\nf 3 7 8\nf 3 8 4\n"
+                                  "f 1 5 7\nf 1 7 3\nf 2 4 8\nf 2 8 6\n";
+  std::ofstream(c / "case.json") << R"({"floes": {"file": "floes.geojson"},
+    "hull": {"file": "box.obj", "bow_direction": "-x", "waterline_z_m": 0.4, "scale": 2}})";
+  const RunOutput r = dry_run(c, root / "run");
+  ASSERT_EQ(r.code, 0) << r.text;
+  const fs::path cfg = root / "run" / "config" / "hull.json";
+  ASSERT_TRUE(fs::exists(cfg));
+  const Json h = load_json_file(cfg);
+  EXPECT_EQ(h["file"].get<std::string>(), (c / "box.obj").lexically_normal().string());
+  EXPECT_EQ(h["bow_direction"].get<std::string>(), "-x");
+  const std::string ninja = read_text(root / "run" / "build.ninja");
+  EXPECT_NE(ninja.find("floesim-hull"), std::string::npos);
+  EXPECT_NE(ninja.find("hull.obj"), std::string::npos);
+
+  auto check_config = [&](const Json& j) {
+    const fs::path f = root / "hull_check.json";
+    std::ofstream(f) << j.dump();
+    const fs::path log = root / "hull_check.log";
+    const std::string cmd = "'" + (kBin / "floesim-hull").string() + "' --check-config --config '" + f.string() +
+                            "' > '" + log.string() + "' 2>&1";
+    const int status = std::system(cmd.c_str());
+    return RunOutput{WIFEXITED(status) ? WEXITSTATUS(status) : 1, read_text(log)};
+  };
+  EXPECT_EQ(check_config(h).code, 0) << check_config(h).text;
+  Json bad = h;
+  bad["bow_direction"] = "forward";
+  RunOutput b = check_config(bad);
+  EXPECT_NE(b.code, 0);
+  EXPECT_NE(b.text.find("bow_direction"), std::string::npos) << b.text;
+  bad = h;
+  bad["scale"] = -1;
+  b = check_config(bad);
+  EXPECT_NE(b.code, 0);
+  EXPECT_NE(b.text.find("scale must be > 0"), std::string::npos) << b.text;
+  bad = h;
+  bad["waterline_m"] = 0.3;  // a typo: unknown keys are errors
+  b = check_config(bad);
+  EXPECT_NE(b.code, 0);
+  EXPECT_NE(b.text.find("waterline_m"), std::string::npos) << b.text;
+  fs::remove_all(root);
+}
+
 // The single-floe case (the seed's Fig. 8, coupled global splitting and local bending in an off-centre collision):
 // a 20 m square floe, struck 4 m off its centre by the flat spoon bow, is too short for the wedge that the ~15 m wide
 // load would bend, so it splits globally along the force line through the contact point, at C_s K_IC h sqrt(L) with

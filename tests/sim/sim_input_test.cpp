@@ -156,6 +156,11 @@ TEST(SimInput, BadInputsNameFileAndItemAndWriteNothing) {
                                      "f 1 3 2\nf 1 4 3\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\n"
                                      "f 4 1 5\nf 4 5 8\n";
   run("floes.geojson", "open.obj", "sim.json", {"open.obj", "not closed"});
+  // A closed hull lying entirely above the water (keel at z = 0, as some CAD exports): refused, naming the fix.
+  std::ofstream(dir / "dry.obj") << "o box\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n"
+                                    "f 1 3 4\nf 1 4 2\nf 5 6 8\nf 5 8 7\nf 1 2 6\nf 1 6 5\nf 3 7 8\nf 3 8 4\n"
+                                    "f 1 5 7\nf 1 7 3\nf 2 4 8\nf 2 8 6\n";
+  run("floes.geojson", "dry.obj", "sim.json", {"dry.obj", "above the water", "waterline_z_m"});
   // A floe polygon that intersects itself (a bow tie), in the file: named by file and feature.
   std::ofstream(dir / "bowtie.geojson")
       << R"({"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {"id": 3, "thickness_m": 1},
