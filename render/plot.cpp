@@ -40,9 +40,6 @@ std::string fmt(const char* f, double a) {
   return b;
 }
 
-// A load in kN as text, in kN (pipeline/units.h); the load plot itself picks the unit that suits its loads.
-[[maybe_unused]] std::string kN(double x) { return load_number(x); }
-
 // NaN has no JSON spelling: null.
 nlohmann::json json_number(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
 
@@ -356,13 +353,19 @@ IdentifiedPlotSummary plot_identified_load(const fs::path& identify_dir, const P
   s.mean_identified_kN = id["mean_surge_ice_resistance_n"].get<double>() / 1000;
   if (s.known) s.mean_known_kN = id["known_load"].value("mean_surge_ice_resistance_n", NAN) / 1000;
   const double w0 = id["mean_window_s"][0].get<double>(), w1 = id["mean_window_s"][1].get<double>();
-  auto resistance_kN = [](const std::vector<double>& surge_n) {
+  // Drawn in the unit that suits the loads' size (N for a tank model, kN for a ship), as the load plot is.
+  double typical_n = 1000.0 * std::abs(s.mean_identified_kN);
+  for (double x : c.column("ice_surge_n")) typical_n = std::max(typical_n, std::abs(x));
+  const ForceUnit unit = force_unit_for(typical_n);
+  const double to_unit = 1000.0 / unit.newtons;  // kN -> the display unit
+  auto resistance = [&](const std::vector<double>& surge_n) {
     std::vector<double> r(surge_n.size());
-    for (size_t i = 0; i < r.size(); ++i) r[i] = -surge_n[i] / 1000;
+    for (size_t i = 0; i < r.size(); ++i) r[i] = -surge_n[i] / unit.newtons;
     return r;
   };
-  const std::vector<double> ident = resistance_kN(c.column("ice_surge_n"));
-  const std::vector<double> known = s.known ? resistance_kN(c.column("known_ice_surge_n")) : std::vector<double>();
+  const std::vector<double> ident = resistance(c.column("ice_surge_n"));
+  const std::vector<double> known = s.known ? resistance(c.column("known_ice_surge_n")) : std::vector<double>();
+  auto load = [&](double x_kN) { return load_number(x_kN * to_unit) + " " + unit.name; };
   const double step = t[1] - t[0];
 
   // 2. Data and script; gnuplot draws both images.
@@ -376,16 +379,16 @@ IdentifiedPlotSummary plot_identified_load(const fs::path& identify_dir, const P
       os << fmt("%.9g", t[i]) << ' ' << fmt("%.9g", ident[i]) << ' '
          << (s.known ? fmt("%.9g", known[i]) : std::string("NaN")) << '\n';
     os << "\n\n"
-       << fmt("%.9g", std::max(w0, t.front())) << ' ' << fmt("%.9g", s.mean_identified_kN) << ' '
-       << fmt("%.9g", s.mean_known_kN) << '\n'
-       << fmt("%.9g", std::min(w1, t.back())) << ' ' << fmt("%.9g", s.mean_identified_kN) << ' '
-       << fmt("%.9g", s.mean_known_kN) << '\n';
+       << fmt("%.9g", std::max(w0, t.front())) << ' ' << fmt("%.9g", s.mean_identified_kN * to_unit) << ' '
+       << fmt("%.9g", s.mean_known_kN * to_unit) << '\n'
+       << fmt("%.9g", std::min(w1, t.back())) << ' ' << fmt("%.9g", s.mean_identified_kN * to_unit) << ' '
+       << fmt("%.9g", s.mean_known_kN * to_unit) << '\n';
     FLOESIM_REQUIRE(os.flush(), data.tmp().string(), ": write failed (disk full?)");
   }
   double lo = 0, hi = 0;
   for (double x : ident) lo = std::min(lo, x), hi = std::max(hi, x);
   for (double x : known) lo = std::min(lo, x), hi = std::max(hi, x);
-  if (o.y_max_kN.is_number()) hi = o.y_max_kN.get<double>();
+  if (o.y_max_kN.is_number()) hi = o.y_max_kN.get<double>() * to_unit;
   const double pad = 0.05 * std::max(hi - lo, 1e-3);
   {
     std::ostringstream gp;
@@ -394,7 +397,7 @@ IdentifiedPlotSummary plot_identified_load(const fs::path& identify_dir, const P
        << " enhanced font 'DejaVu Sans,11' linewidth 1.0\n"
        << "set output " << quoted(png.tmp().string()) << "\n"
        << "set title " << quoted("Surge ice load identified from the ship's data") << " noenhanced font ',14'\n"
-       << "set xlabel 'Time (s)'\nset ylabel 'Ice resistance  −F_x  (kN)'\n"
+       << "set xlabel 'Time (s)'\nset ylabel 'Ice resistance  −F_x  (" << unit.name << ")'\n"
        << "set border lc rgb '#404040'\nset grid xtics ytics lc rgb '#d9d9d9' lw 1 dt 1\n"
        << "set key outside below center horizontal maxrows 2 samplen 2.5 width 2\n"
        << "set xrange [" << fmt("%.9g", t.front()) << ":" << fmt("%.9g", t.back()) << "]\n"
@@ -406,10 +409,10 @@ IdentifiedPlotSummary plot_identified_load(const fs::path& identify_dir, const P
       gp << ", \\\n  '' index 0 using 1:3 with lines lc rgb '#101010' lw 1.2 title "
          << quoted("simulated, the same " + rate) << " noenhanced";
     gp << ", \\\n  '' index 1 using 1:2 with lines lc rgb '#2f7fc1' lw 2.5 dt (8,4) title "
-       << quoted("identified mean: " + kN(s.mean_identified_kN) + " kN") << " noenhanced";
+       << quoted("identified mean: " + load(s.mean_identified_kN)) << " noenhanced";
     if (s.known)
       gp << ", \\\n  '' index 1 using 1:3 with lines lc rgb '#d1232a' lw 2.5 dt (8,4) title "
-         << quoted("simulated mean: " + kN(s.mean_known_kN) + " kN") << " noenhanced";
+         << quoted("simulated mean: " + load(s.mean_known_kN)) << " noenhanced";
     gp << "\nset terminal svg size " << o.width_px << "," << o.height_px
        << " dynamic enhanced font 'DejaVu Sans,11' background rgb 'white'\n"
        << "set output " << quoted(svg.tmp().string()) << "\nreplot\nunset output\n";

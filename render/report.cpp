@@ -89,8 +89,6 @@ std::string load_in(double x_kN, const ForceUnit& u) {
   if (!std::isfinite(x_kN)) return "&ndash;";
   return load_number(1000.0 * x_kN / u.newtons);
 }
-// A load in kN as text, in kN.
-[[maybe_unused]] std::string kN(double x) { return load_in(x, {"kN", 1e3}); }
 
 // A JSON scalar as table text: numbers to 4 significant digits (integers whole), strings escaped.
 std::string scalar_text(const Json& v) {
@@ -376,22 +374,26 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
       const std::string window = w && w->is_array() && w->size() == 2
                                      ? fmt("%g", (*w)[0].get<double>()) + " to " + fmt("%g", (*w)[1].get<double>()) + " s"
                                      : std::string("?");
-      body << "<table id=\"identified\">\n<tr><th>quantity</th><th>kN</th></tr>\n"
+      // The unit of the mean loads above (N for a tank model, kN for a ship).
+      const ForceUnit unit = force_unit_for(1000.0 * std::max(std::abs(rs.mean_kN), std::abs(rs.identified_kN)));
+      auto in_unit = [&](double x_kN) { return load_in(x_kN, unit); };
+      body << "<table id=\"identified\">\n<tr><th>quantity</th><th>" << unit.name << "</th></tr>\n"
            << "<tr><th>identified mean surge ice resistance (" << window << ")</th><td class=\"n\" "
-           << "id=\"identified-kN\">" << kN(rs.identified_kN) << "</td></tr>\n";
+           << "id=\"identified-kN\">" << in_unit(rs.identified_kN) << "</td></tr>\n";
       if (const Json* k = find(ij, {"known_load"})) {
         rs.identified_known_kN = number_or_nan(*k, {"mean_surge_ice_resistance_n"}) / 1000;
         rs.identified_error_percent = -number_or_nan(*k, {"surge_error_percent"});
-        body << "<tr><th>the simulated load over the same window</th><td class=\"n\">" << kN(rs.identified_known_kN)
-             << "</td></tr>\n<tr><th>identified &minus; simulated</th><td class=\"n\">"
-             << fmt("%+.1f", rs.identified_kN - rs.identified_known_kN) << " (" << fmt("%+.2f", rs.identified_error_percent)
+        body << "<tr><th>the simulated load over the same window</th><td class=\"n\">"
+             << in_unit(rs.identified_known_kN) << "</td></tr>\n<tr><th>identified &minus; simulated</th><td "
+             << "class=\"n\">" << fmt("%+.1f", 1000.0 * (rs.identified_kN - rs.identified_known_kN) / unit.newtons)
+             << " (" << fmt("%+.2f", rs.identified_error_percent)
              << " %)</td></tr>\n<tr><th>RMS error of the filtered series (standard deviation of the simulated "
                 "one)</th><td class=\"n\">"
-             << kN(number_or_nan(*k, {"output_rate_surge_rms_error_n"}) / 1000) << " ("
-             << kN(number_or_nan(*k, {"output_rate_surge_known_sd_n"}) / 1000) << ")</td></tr>\n";
+             << in_unit(number_or_nan(*k, {"output_rate_surge_rms_error_n"}) / 1000) << " ("
+             << in_unit(number_or_nan(*k, {"output_rate_surge_known_sd_n"}) / 1000) << ")</td></tr>\n";
       } else {
         body << "<tr><th>simulated &minus; identified</th><td class=\"n\">"
-             << fmt("%+.1f", rs.mean_kN - rs.identified_kN) << " ("
+             << fmt("%+.1f", 1000.0 * (rs.mean_kN - rs.identified_kN) / unit.newtons) << " ("
              << fmt("%+.1f", 100 * (rs.mean_kN - rs.identified_kN) / rs.identified_kN) << " %)</td></tr>\n";
       }
       body << "</table>\n";
@@ -568,8 +570,17 @@ SweepReportSummary write_sweep_report(const fs::path& sweep_dir, const ReportOpt
   // The ensemble means, one row per grid point, each against the references.
   body << "<h2>Mean surge ice resistance per grid point</h2>\n<table id=\"grid-points\">\n<tr>";
   for (const std::string& k : axis_keys) body << "<th>" << html_escape(k) << "</th>";
-  body << "<th>members ok</th><th>mean, kN</th><th>standard deviation, kN</th><th>95 % interval, kN</th>";
-  for (const ReferenceLoad& r : refs) body << "<th>against " << html_escape(r.label) << " (" << kN(r.kN) << " kN), %</th>";
+  // One unit for the table, from the largest mean (N for a tank model, kN for a ship).
+  double typical_kN = 0;
+  if (sw.contains("grid_points") && sw["grid_points"].is_array())
+    for (const Json& g : sw["grid_points"])
+      if (const double m = number_or_nan(g, {"mean_kN"}); std::isfinite(m)) typical_kN = std::max(typical_kN, std::abs(m));
+  const ForceUnit unit = force_unit_for(1000.0 * typical_kN);
+  auto in_unit = [&](double x_kN) { return load_in(x_kN, unit); };
+  body << "<th>members ok</th><th>mean, " << unit.name << "</th><th>standard deviation, " << unit.name
+       << "</th><th>95 % interval, " << unit.name << "</th>";
+  for (const ReferenceLoad& r : refs)
+    body << "<th>against " << html_escape(r.label) << " (" << load_text(1000.0 * r.kN, unit) << "), %</th>";
   body << "</tr>\n";
   if (sw.contains("grid_points") && sw["grid_points"].is_array())
     for (const Json& g : sw["grid_points"]) {
@@ -579,9 +590,9 @@ SweepReportSummary write_sweep_report(const fs::path& sweep_dir, const ReportOpt
         body << "<td>" << scalar_text(g.contains("axes") ? g["axes"].value(k, Json()) : Json()) << "</td>";
       const double mean = number_or_nan(g, {"mean_kN"}), ci = number_or_nan(g, {"ci95_half_width_kN"});
       body << "<td class=\"n\">" << scalar_text(g.value("n_ok", Json())) << " / "
-           << scalar_text(g.value("n_members", Json())) << "</td><td class=\"n\">" << kN(mean)
-           << "</td><td class=\"n\">" << kN(number_or_nan(g, {"std_kN"})) << "</td><td class=\"n\">"
-           << (std::isfinite(ci) ? "&plusmn; " + kN(ci) : kN(ci)) << "</td>";
+           << scalar_text(g.value("n_members", Json())) << "</td><td class=\"n\">" << in_unit(mean)
+           << "</td><td class=\"n\">" << in_unit(number_or_nan(g, {"std_kN"})) << "</td><td class=\"n\">"
+           << (std::isfinite(ci) ? "&plusmn; " + in_unit(ci) : in_unit(ci)) << "</td>";
       for (const ReferenceLoad& r : refs) {
         const ReferenceComparison c = compare_to_reference(mean, r);
         body << "<td class=\"n\">" << (std::isfinite(c.error_percent) ? fmt("%+.1f", c.error_percent) : "&ndash;");
