@@ -20,7 +20,7 @@ namespace floesim::render {
   X(DisableClientState) X(VertexPointer) X(NormalPointer) X(ColorPointer) X(DrawArrays) X(Color4f)           \
   X(Lightfv) X(LightModelfv) X(LightModeli) X(ColorMaterial) X(ShadeModel) X(Fogi) X(Fogf) X(Fogfv)          \
   X(LineWidth) X(ReadPixels) X(PixelStorei) X(Finish) X(GetError) X(GetString) X(DepthFunc) X(DepthMask)     \
-  X(Hint) X(ClipPlane)
+  X(Hint) X(ClipPlane) X(BlendFunc)
 
 struct GlApi {
 #define FLOESIM_GL_DECLARE(name) decltype(&::gl##name) name = nullptr;
