@@ -58,6 +58,7 @@ LoadStripChart::LoadStripChart(const Results& r, const RenderOptions& o, const s
 
   // 2. Time: the series and the frames (the first frame may be at t = 0, before the first step ends).
   scale_.t_first = std::min(t.front(), r.frames() ? r.frame_time_s.front() : t.front());
+  if (scale_.t_first > 0 && scale_.t_first < 0.05 * t.back()) scale_.t_first = 0;  // the axis from 0, as the plot
   scale_.t_last = std::max(t.back(), r.frames() ? r.frame_time_s.back() : t.back());
   const double run = std::max(scale_.t_last - scale_.t_first, 1e-9);
   scale_.span_s = o.strip_span_s > 0 ? std::min(o.strip_span_s, run) : run;
