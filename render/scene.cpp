@@ -183,7 +183,7 @@ struct SceneRenderer::Impl {
   // Per-frame batches of the visible floes in camera-relative world coordinates (reused between frames).
   std::vector<float> batch_pos, edge_pos;
   std::vector<uint8_t> batch_col;
-  cv::Mat big, small, bgr;  // read-back buffers, reused between frames
+  cv::Mat big, small;  // the GL frame (aliases the context's buffer) and its downsampled copy
   std::vector<float> water_grid;                  // unit square [-1, 1]^2 at z = 0 as triangles
 
   Impl(const Results& res, const RenderOptions& opt, const std::string& src)
@@ -787,15 +787,14 @@ void SceneRenderer::render(size_t frame, cv::Mat& out) {
   FLOESIM_REQUIRE(frame < impl_->r.frames(), "internal: frame ", frame, " of ", impl_->r.frames());
   impl_->draw(frame);
   Impl& m = *impl_;
-  m.ctx.read_rgba_bottom_up(m.big);
-  // Downsample first (box filter over the supersamples), then convert and flip the small image only.
+  m.ctx.frame_rgba_top_down(m.big);
+  // Downsample first (box filter over the supersamples), then convert the small image only.
   const cv::Mat* small = &m.big;
   if (m.o.supersample > 1) {
     cv::resize(m.big, m.small, cv::Size(m.o.width_px, m.o.height_px), 0, 0, cv::INTER_AREA);
     small = &m.small;
   }
-  cv::cvtColor(*small, m.bgr, cv::COLOR_RGBA2BGR);
-  cv::flip(m.bgr, out, 0);  // GL's first row is the bottom one
+  cv::cvtColor(*small, out, cv::COLOR_RGBA2BGR);
   m.separate_halves(out);
   if (m.strip) m.strip->draw(out, m.r.frame_time_s[frame]);
   if (m.o.overlay) m.overlay(frame, out);
