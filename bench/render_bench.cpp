@@ -18,6 +18,7 @@
 #include "pipeline/atomic_file.h"
 #include "pipeline/results_io.h"
 #include "render/scene.h"
+#include "render/strip_chart.h"
 #include "render/video.h"
 #include "pipeline/geometry2d.h"
 
@@ -157,6 +158,15 @@ int main(int argc, char** argv) {
     }
   write_results(dir / "bench_results.h5", r);
 
+  {
+    // The strip chart alone (its share of every view's time below): drawn into a grey frame at every frame time.
+    const render::LoadStripChart strip(r, o, "bench");
+    cv::Mat img(o.height_px, o.width_px, CV_8UC3, cv::Scalar(90, 90, 90));
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int k = 0; k < frames; ++k) strip.draw(img, r.frame_time_s[static_cast<size_t>(k)]);
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("strip chart alone: %.2f ms/frame (%zu steps of series)\n", 1000 * s / frames, r.steps());
+  }
   for (const char* view : {"chase", "top", "side", "split"}) {
     o.view = view;
     const auto t0 = std::chrono::steady_clock::now();

@@ -31,6 +31,8 @@ double nice_step(double range, int ticks) {
 
 double scale_px(const cv::Mat& img) { return img.rows / 720.0; }
 
+const cv::Scalar kLabel(235, 235, 235), kGrid(95, 95, 95);
+
 }  // namespace
 
 int strip_chart_top(const RenderOptions& o, int height_px) {
@@ -99,56 +101,64 @@ LoadStripChart::LoadStripChart(const Results& r, const RenderOptions& o, const s
     average_.push_back({t[j - 1], average[j - 1]});
     i = j;
   }
+  build_layer();
 }
 
 double LoadStripChart::window_start(double t_s) const {
-  if (scale_.span_s >= scale_.t_last - scale_.t_first) return scale_.t_first;
+  if (whole_run()) return scale_.t_first;
   return std::clamp(t_s - 0.8 * scale_.span_s, scale_.t_first, scale_.t_last - scale_.span_s);
 }
 
-void LoadStripChart::draw(cv::Mat& img, double t_s) const {
+// The chart is drawn in layers: what does not move (the load axis, the frame, the title; over the whole run also the
+// time axis and the curves) once into a cached layer that each frame copies over the darkened band, the rest per
+// frame. A frame of the whole run then costs the darkening, one masked copy and the cursor.
+void LoadStripChart::draw_load_axis(cv::Mat& img) const {
   const double s = scale_px(img);
-  const int font = cv::FONT_HERSHEY_SIMPLEX;
-  const int thick = std::max(1, int(std::lround(1.2 * s)));
-  const double text = 0.45 * s;
-  const cv::Scalar label(235, 235, 235), grid(95, 95, 95);
-
-  // Band: the scene darkened (a translucent panel).
-  const int top = strip_chart_top(o_, img.rows);
-  cv::Mat band = img(cv::Rect(0, top, img.cols, img.rows - top));
-  band *= 0.3;
+  const int font = cv::FONT_HERSHEY_SIMPLEX, thick = std::max(1, int(std::lround(1.2 * s)));
   const cv::Rect a = strip_chart_plot_area(o_, img.cols, img.rows);
-  const double t0 = window_start(t_s), span = scale_.span_s;
+  const double ys = nice_step(scale_.y_hi - scale_.y_lo, 4);
+  for (double v = std::ceil(scale_.y_lo / ys) * ys; v <= scale_.y_hi + 1e-9 * ys; v += ys) {
+    const int y = int(std::lround(a.y + a.height - (v - scale_.y_lo) / (scale_.y_hi - scale_.y_lo) * a.height));
+    cv::line(img, {a.x, y}, {a.x + a.width, y}, kGrid, 1);
+    const std::string l = fmt("%g", std::abs(v) < 1e-9 * ys ? 0.0 : v);
+    int base = 0;
+    const cv::Size sz = cv::getTextSize(l, font, 0.45 * s, thick, &base);
+    cv::putText(img, l, {a.x - sz.width - int(8 * s), y + sz.height / 2}, font, 0.45 * s, kLabel, thick, cv::LINE_AA);
+  }
+  cv::rectangle(img, a, kGrid, 1);
+  // Title and legend above the plot.
+  const int yt = strip_chart_top(o_, img.rows) + int(22 * s);
+  int x = a.x;
+  const auto say = [&](const std::string& l, const cv::Scalar& c) {
+    int base = 0;
+    cv::putText(img, l, {x, yt}, font, 0.5 * s, c, thick, cv::LINE_AA);
+    x += cv::getTextSize(l, font, 0.5 * s, thick, &base).width + int(18 * s);
+  };
+  say("surge ice load (" + scale_.unit + ")", kLabel);
+  say("each step", kStripRawBgr);
+  say("moving average " + fmt("%g s", scale_.window_s), kStripAverageBgr);
+}
+
+void LoadStripChart::draw_time_axis_and_curves(cv::Mat& img, double t0) const {
+  const double s = scale_px(img), span = scale_.span_s;
+  const int font = cv::FONT_HERSHEY_SIMPLEX, thick = std::max(1, int(std::lround(1.2 * s)));
+  const cv::Rect a = strip_chart_plot_area(o_, img.cols, img.rows);
   const auto px_x = [&](double t) { return a.x + (t - t0) / span * a.width; };
   const auto px_y = [&](double kN) {
     const double v = kN * scale_.per_kN;
     const double y = a.y + a.height - (v - scale_.y_lo) / (scale_.y_hi - scale_.y_lo) * a.height;
     return std::clamp(y, double(a.y), double(a.y + a.height));  // spikes beyond the axis are cut at its edge
   };
-
-  // Load axis: grid lines and labels at round values.
-  const double ys = nice_step(scale_.y_hi - scale_.y_lo, 4);
-  for (double v = std::ceil(scale_.y_lo / ys) * ys; v <= scale_.y_hi + 1e-9 * ys; v += ys) {
-    const int y = int(std::lround(a.y + a.height - (v - scale_.y_lo) / (scale_.y_hi - scale_.y_lo) * a.height));
-    cv::line(img, {a.x, y}, {a.x + a.width, y}, grid, 1);
-    const std::string l = fmt("%g", std::abs(v) < 1e-9 * ys ? 0.0 : v);
-    int base = 0;
-    const cv::Size sz = cv::getTextSize(l, font, text, thick, &base);
-    cv::putText(img, l, {a.x - sz.width - int(8 * s), y + sz.height / 2}, font, text, label, thick, cv::LINE_AA);
-  }
-  // Time axis.
   const double xs = nice_step(span, 8);
   for (double tt = std::ceil(t0 / xs) * xs; tt <= t0 + span + 1e-9 * xs; tt += xs) {
     const int x = int(std::lround(px_x(tt)));
-    cv::line(img, {x, a.y + a.height}, {x, a.y + a.height + int(5 * s)}, label, 1);
-    const std::string l = fmt("%g", tt) + (tt + xs > t0 + span + 1e-9 * xs ? " s" : "");
+    cv::line(img, {x, a.y + a.height}, {x, a.y + a.height + int(5 * s)}, kLabel, 1);
+    const std::string l = fmt("%g", std::abs(tt) < 1e-9 * xs ? 0.0 : tt) + (tt + xs > t0 + span + 1e-9 * xs ? " s" : "");
     int base = 0;
-    const cv::Size sz = cv::getTextSize(l, font, text, thick, &base);
+    const cv::Size sz = cv::getTextSize(l, font, 0.45 * s, thick, &base);
     cv::putText(img, l, {std::min(x - sz.width / 2, img.cols - sz.width - 2), a.y + a.height + int(22 * s)}, font,
-                text, label, thick, cv::LINE_AA);
+                0.45 * s, kLabel, thick, cv::LINE_AA);
   }
-  cv::rectangle(img, a, grid, 1);
-
   // The series inside the window (one bin before and after, so the lines reach the edges).
   const auto points = [&](const std::vector<std::pair<double, double>>& v, std::vector<cv::Point>& out) {
     out.clear();
@@ -165,22 +175,37 @@ void LoadStripChart::draw(cv::Mat& img, double t_s) const {
   if (!p.empty()) cv::polylines(img, p, false, kStripRawBgr, 1, cv::LINE_8);
   points(average_, p);
   if (!p.empty()) cv::polylines(img, p, false, kStripAverageBgr, std::max(2, int(std::lround(2 * s))), cv::LINE_AA);
+}
 
+bool LoadStripChart::whole_run() const { return scale_.span_s >= scale_.t_last - scale_.t_first; }
+
+void LoadStripChart::build_layer() {
+  cv::Mat full(o_.height_px, o_.width_px, CV_8UC3, cv::Scalar::all(0));
+  draw_load_axis(full);
+  if (whole_run()) draw_time_axis_and_curves(full, scale_.t_first);
+  const int top = strip_chart_top(o_, o_.height_px);
+  layer_ = full(cv::Rect(0, top, o_.width_px, o_.height_px - top)).clone();
+  cv::Mat grey;
+  cv::cvtColor(layer_, grey, cv::COLOR_BGR2GRAY);
+  layer_mask_ = grey > 0;
+}
+
+void LoadStripChart::draw(cv::Mat& img, double t_s) const {
+  FLOESIM_REQUIRE(img.cols == o_.width_px && img.rows == o_.height_px && img.type() == CV_8UC3,
+                  "internal: strip chart for ", o_.width_px, " x ", o_.height_px, " drawn into ", img.cols, " x ",
+                  img.rows);
+  // Band: the scene darkened (a translucent panel), then the cached layer, then what moves.
+  const int top = strip_chart_top(o_, img.rows);
+  cv::Mat band = img(cv::Rect(0, top, img.cols, img.rows - top));
+  band *= 0.3;
+  layer_.copyTo(band, layer_mask_);
+  const double t0 = window_start(t_s);
+  if (!whole_run()) draw_time_axis_and_curves(img, t0);
   // Cursor at the frame's time.
-  const int xc = int(std::lround(px_x(t_s)));
-  cv::line(img, {xc, a.y}, {xc, a.y + a.height}, kStripCursorBgr, std::max(1, int(std::lround(2 * s))), cv::LINE_8);
-
-  // Title and legend above the plot.
-  const int yt = top + int(22 * s);
-  int x = a.x;
-  const auto say = [&](const std::string& l, const cv::Scalar& c) {
-    int base = 0;
-    cv::putText(img, l, {x, yt}, font, 0.5 * s, c, thick, cv::LINE_AA);
-    x += cv::getTextSize(l, font, 0.5 * s, thick, &base).width + int(18 * s);
-  };
-  say("surge ice load (" + scale_.unit + ")", label);
-  say("each step", kStripRawBgr);
-  say("moving average " + fmt("%g s", scale_.window_s), kStripAverageBgr);
+  const cv::Rect a = strip_chart_plot_area(o_, img.cols, img.rows);
+  const int xc = int(std::lround(a.x + (t_s - t0) / scale_.span_s * a.width));
+  cv::line(img, {xc, a.y}, {xc, a.y + a.height}, kStripCursorBgr, std::max(1, int(std::lround(2 * scale_px(img)))),
+           cv::LINE_8);
 }
 
 }  // namespace floesim::render

@@ -48,9 +48,15 @@ class LoadStripChart {
   double window_start(double t_s) const;
 
  private:
+  bool whole_run() const;
+  void draw_load_axis(cv::Mat& img) const;                            // grid, labels, frame, title, legend
+  void draw_time_axis_and_curves(cv::Mat& img, double t0) const;     // for the window from t0
+  void build_layer();
+
   RenderOptions o_;
   StripChartScale scale_;
   std::vector<std::pair<double, double>> raw_, average_;  // binned (time s, load kN), in time order
+  cv::Mat layer_, layer_mask_;  // what does not move, drawn once (band rows only) and where it drew
 };
 
 }  // namespace floesim::render
