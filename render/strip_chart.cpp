@@ -153,7 +153,8 @@ void LoadStripChart::draw_time_axis_and_curves(cv::Mat& img, double t0) const {
   for (double tt = std::ceil(t0 / xs) * xs; tt <= t0 + span + 1e-9 * xs; tt += xs) {
     const int x = int(std::lround(px_x(tt)));
     cv::line(img, {x, a.y + a.height}, {x, a.y + a.height + int(5 * s)}, kLabel, 1);
-    const std::string l = fmt("%g", std::abs(tt) < 1e-9 * xs ? 0.0 : tt) + (tt + xs > t0 + span + 1e-9 * xs ? " s" : "");
+    const bool last = tt + xs > t0 + span + 1e-9 * xs;  // the unit goes on the last label
+    const std::string l = fmt("%g", std::abs(tt) < 1e-9 * xs ? 0.0 : tt) + (last ? " s" : "");
     int base = 0;
     const cv::Size sz = cv::getTextSize(l, font, 0.45 * s, thick, &base);
     cv::putText(img, l, {std::min(x - sz.width / 2, img.cols - sz.width - 2), a.y + a.height + int(22 * s)}, font,
