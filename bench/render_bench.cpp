@@ -1,9 +1,10 @@
 // Render benchmark: a synthetic transit through ~1000 floes (10-30 vertex outlines, non-convex, drifting and
-// turning) with a ship-shaped hull, rendered to MP4 in both views; prints ms per frame.
+// turning) with a ship-shaped hull, rendered to MP4 in every view (chase, top, side, split chase + top) with the
+// load strip chart and the floes pushed by the hull coloured as in contact; prints ms per frame.
 //
 //   render_bench OUT_DIR [frames=200] [floes=1000] [width=1280] [height=720] [supersample=2]
 //
-// Writes OUT_DIR/bench_results.h5, OUT_DIR/chase.mp4, OUT_DIR/top.mp4 and a still of the middle frame of each.
+// Writes OUT_DIR/bench_results.h5, OUT_DIR/<view>.mp4 and a still of the middle frame of each.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -17,6 +18,7 @@
 #include "pipeline/atomic_file.h"
 #include "pipeline/results_io.h"
 #include "render/scene.h"
+#include "render/strip_chart.h"
 #include "render/video.h"
 #include "pipeline/geometry2d.h"
 
@@ -127,10 +129,13 @@ int main(int argc, char** argv) {
     r.state_body_id.push_back(0);
     r.state_position_m.insert(r.state_position_m.end(), {vx, vy, 0.0});
     r.state_quaternion.insert(r.state_quaternion.end(), {std::cos(yaw / 2), 0, 0, std::sin(yaw / 2)});
+    r.state_in_contact.push_back(0);
     for (int f = 0; f < n_floes; ++f) {
       double x = fl[f].x + fl[f].drift_x * t, y = fl[f].y + fl[f].drift_y * t;
       const double dx = x - vx, dy = y - vy;
-      if (dx > -60 && dx < 60 && std::abs(dy) < 25) y += (dy >= 0 ? 1 : -1) * (25 - std::abs(dy));
+      const bool pushed = dx > -60 && dx < 60 && std::abs(dy) < 25;
+      if (pushed) y += (dy >= 0 ? 1 : -1) * (25 - std::abs(dy));
+      r.state_in_contact.push_back(pushed ? 1 : 0);
       const double a = fl[f].yaw + fl[f].spin * t;
       r.state_body_id.push_back(f + 1);
       r.state_position_m.insert(r.state_position_m.end(), {x, y, 0.1});
@@ -138,22 +143,36 @@ int main(int argc, char** argv) {
     }
     r.frame_offset.push_back(static_cast<int64_t>(r.state_body_id.size()));
   }
-  // Series: one row per frame is enough for the renderer (it reads frames and geometry).
-  for (int k = 0; k < frames; ++k)
+  // Series: ten steps per frame (the strip chart bins them), a surge ice load of ~400 kN with a slow swell and
+  // rare single-step spikes, as rigid contacts give.
+  const int steps_per_frame = 10;
+  for (int k = 0; k < frames * steps_per_frame; ++k)
     for (const auto& f : series_fields()) {
       std::vector<double> row(f.cols, 0.0);
-      if (std::string(f.name) == "time_s") row[0] = k * dt_frame;
+      const double t = k * dt_frame / steps_per_frame;
+      if (std::string(f.name) == "time_s") row[0] = t;
+      if (std::string(f.name) == "ice_load")
+        row[0] = -(4e5 + 1.5e5 * std::sin(0.2 * t) + 2e5 * (u(rng) - 0.5) + (u(rng) < 0.01 ? 2e6 : 0.0));
       auto& v = r.series[f.name];
       v.insert(v.end(), row.begin(), row.end());
     }
   write_results(dir / "bench_results.h5", r);
 
-  for (const char* view : {"chase", "top"}) {
+  {
+    // The strip chart alone (its share of every view's time below): drawn into a grey frame at every frame time.
+    const render::LoadStripChart strip(r, o, "bench");
+    cv::Mat img(o.height_px, o.width_px, CV_8UC3, cv::Scalar(90, 90, 90));
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int k = 0; k < frames; ++k) strip.draw(img, r.frame_time_s[static_cast<size_t>(k)]);
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("strip chart alone: %.2f ms/frame (%zu steps of series)\n", 1000 * s / frames, r.steps());
+  }
+  for (const char* view : {"chase", "top", "side", "split"}) {
     o.view = view;
     const auto t0 = std::chrono::steady_clock::now();
     const auto st = render::render_video(r, o, dir / (std::string(view) + ".mp4"), nlohmann::json::object(), "bench");
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("%-5s %dx%d ss%d, %d floes, %zu frames: %.1f ms/frame render + %.1f ms/frame encode "
+    std::printf("%-6s %dx%d ss%d, %d floes, %zu frames: %.1f ms/frame render + %.1f ms/frame encode "
                 "(%.1f ms/frame wall incl. setup); %.0f floes drawn, %.0f culled per frame; %s\n",
                 view, o.width_px, o.height_px, o.supersample, n_floes, st.frames, st.render_ms_per_frame,
                 st.encode_ms_per_frame, 1000 * wall / st.frames, st.floes_drawn_per_frame,

@@ -104,6 +104,8 @@ hid_t h5type();
 template <>
 hid_t h5type<double>() { return H5T_NATIVE_DOUBLE; }
 template <>
+hid_t h5type<int8_t>() { return H5T_NATIVE_INT8; }
+template <>
 hid_t h5type<int32_t>() { return H5T_NATIVE_INT32; }
 template <>
 hid_t h5type<int64_t>() { return H5T_NATIVE_INT64; }
@@ -150,8 +152,9 @@ std::vector<T> read_ds(hid_t file_id, const std::string& name, size_t cols, cons
 }
 
 // The layout this version writes (floesim-results/N); it still reads every earlier one so that old artefacts still
-// plot and render: /1 had no fracture (no /fracture, no lineage), /2 no solver series beyond sweeps and residual.
-constexpr int kLayoutVersion = 3;
+// plot and render: /1 had no fracture (no /fracture, no lineage), /2 no solver series beyond sweeps and residual,
+// /3 no /states/in_contact.
+constexpr int kLayoutVersion = 4;
 constexpr const char* kLayoutPrefix = "floesim-results/";
 std::string layout_name(int version) { return kLayoutPrefix + std::to_string(version); }
 
@@ -282,7 +285,8 @@ void write_results(const std::filesystem::path& path, const Results& r) {
   }
   FLOESIM_REQUIRE(r.frame_offset.size() == r.frame_time_s.size() + 1, file, ": internal: frame offsets");
   FLOESIM_REQUIRE(r.state_position_m.size() == 3 * r.state_body_id.size() &&
-                      r.state_quaternion.size() == 4 * r.state_body_id.size(),
+                      r.state_quaternion.size() == 4 * r.state_body_id.size() &&
+                      r.state_in_contact.size() == r.state_body_id.size(),
                   file, ": internal: state arrays disagree");
   FLOESIM_REQUIRE(r.floe_vertex_offset.size() == r.floe_id.size() + 1, file, ": internal: floe vertex offsets");
   const std::string fracture = fracture_problem(r);
@@ -309,6 +313,7 @@ void write_results(const std::filesystem::path& path, const Results& r) {
     write_ds(fid, "/states/body_id", r.state_body_id, 1, file);
     write_ds(fid, "/states/position_m", r.state_position_m, 3, file);
     write_ds(fid, "/states/quaternion_wxyz", r.state_quaternion, 4, file);
+    write_ds(fid, "/states/in_contact", r.state_in_contact, 1, file);
     write_ds(fid, "/geometry/floe_id", r.floe_id, 1, file);
     write_ds(fid, "/geometry/floe_thickness_m", r.floe_thickness_m, 1, file);
     write_ds(fid, "/geometry/floe_vertex_offset", r.floe_vertex_offset, 1, file);
@@ -372,7 +377,12 @@ Results read_results(const std::filesystem::path& path, bool with_states) {
     r.state_body_id = read_ds<int32_t>(fid, "/states/body_id", 1, file);
     r.state_position_m = read_ds<double>(fid, "/states/position_m", 3, file);
     r.state_quaternion = read_ds<double>(fid, "/states/quaternion_wxyz", 4, file);
+    // Contact with the vessel was not recorded before layout /4: no floe is shown in contact.
+    r.state_in_contact = version >= 4 ? read_ds<int8_t>(fid, "/states/in_contact", 1, file)
+                                      : std::vector<int8_t>(r.state_body_id.size(), 0);
     FLOESIM_REQUIRE(r.state_position_m.size() == 3 * r.state_body_id.size() &&
+                        r.state_quaternion.size() == 4 * r.state_body_id.size() &&
+                        r.state_in_contact.size() == r.state_body_id.size() &&
                         static_cast<size_t>(r.frame_offset.back()) == r.state_body_id.size(),
                     file, ": /states arrays disagree with /frames/offset");
   }

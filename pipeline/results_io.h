@@ -7,6 +7,8 @@
 //   /states/body_id        [R]            int32     0 = vessel, k >= 1 = floe id k (bodies may appear later)
 //   /states/position_m     [R x 3]        float64   centre of mass, world frame (x right, y up, z up from water)
 //   /states/quaternion_wxyz[R x 4]        float64   body-to-world rotation
+//   /states/in_contact     [R]            int8      1: a floe pressed against the vessel in the step that ends at
+//                                                   this frame (a vessel contact carried a normal impulse), else 0
 //   /geometry/floe_id            [n]      int32
 //   /geometry/floe_thickness_m   [n]      float64
 //   /geometry/floe_vertex_offset [n+1]    int64     outline of floe k: rows offset[k] .. offset[k+1]-1
@@ -32,10 +34,11 @@
 //   /fracture/brash_mass_kg      [E]      float64   mass of pieces below the minimum size, removed (counted here)
 //   /fracture/child_offset       [E+1]    int64     pieces of event k: child_id[offset[k] .. offset[k+1]-1]
 //   /fracture/child_id           [C]      int32     floe ids of the pieces that became bodies
-//   Layout "floesim-results/3" (this one) added the solver series (relax sweeps and residual, subspace solves,
-//   capped steps, contact-law violations); "/2" added /fracture and the lineage datasets. "/1" and "/2" files are
-//   still read: a series a file lacks is filled as FieldSpec::since says (input floes only, no events; solver
-//   figures NaN: not recorded).
+//   Layout "floesim-results/4" (this one) added /states/in_contact; "/3" added the solver series (relax sweeps and
+//   residual, subspace solves, capped steps, contact-law violations); "/2" added /fracture and the lineage
+//   datasets. "/1" to "/3" files are still read: a series a file lacks is filled as FieldSpec::since says (input
+//   floes only, no events; solver figures NaN: not recorded), and /states/in_contact as all 0 (not recorded:
+//   no floe is shown in contact).
 //   attribute "floesim" on the root: JSON text with layout version, time_step_s, duration_s,
 //   output_interval_s and the provenance.
 #pragma once
@@ -76,6 +79,7 @@ struct Results {
   std::vector<int32_t> state_body_id;
   std::vector<double> state_position_m;     // [R x 3]
   std::vector<double> state_quaternion;     // [R x 4] w x y z
+  std::vector<int8_t> state_in_contact;     // [R] 1: pressed against the vessel in the frame's step (layout /4)
 
   std::vector<int32_t> floe_id;
   std::vector<double> floe_thickness_m;

@@ -16,6 +16,7 @@ OffscreenContext::OffscreenContext(int width_px, int height_px) : width_(width_p
     throw Error("cannot make an OSMesa context of " + std::to_string(width_px) + " x " + std::to_string(height_px) +
                 " pixels current (too large? lower width_px/height_px or supersample)");
   }
+  OSMesaPixelStore(OSMESA_Y_UP, 0);  // the first row of the buffer is the top of the image
   std::string missing;
 #define FLOESIM_GL_LOAD(name)                                                                 \
   gl_.name = reinterpret_cast<decltype(gl_.name)>(OSMesaGetProcAddress("gl" #name));          \
@@ -37,13 +38,11 @@ const char* OffscreenContext::renderer() const {
   return s ? reinterpret_cast<const char*>(s) : "?";
 }
 
-void OffscreenContext::read_rgba_bottom_up(cv::Mat& out) const {
-  gl_.Finish();
-  out.create(height_, width_, CV_8UC4);
-  gl_.PixelStorei(GL_PACK_ALIGNMENT, 4);
-  gl_.ReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, out.data);
+void OffscreenContext::frame_rgba_top_down(cv::Mat& out) {
+  gl_.Finish();  // also copies the rendered image into buffer_ (OSMesa's front buffer)
   const GLenum err = gl_.GetError();
-  FLOESIM_REQUIRE(err == GL_NO_ERROR, "OpenGL error 0x", std::hex, err, " while reading the frame");
+  FLOESIM_REQUIRE(err == GL_NO_ERROR, "OpenGL error 0x", std::hex, err, " while finishing the frame");
+  out = cv::Mat(height_, width_, CV_8UC4, buffer_.data());
 }
 
 }  // namespace floesim::render

@@ -18,16 +18,6 @@ namespace floesim::render {
 
 namespace fs = std::filesystem;
 
-Check<Json> auto_or_number(bool strictly_positive) {
-  return [strictly_positive](const Json& j) {
-    if (j.is_string() && j.get<std::string>() == "auto") return std::string();
-    if (j.is_number() && std::isfinite(j.get<double>()) &&
-        (strictly_positive ? j.get<double>() > 0 : j.get<double>() >= 0))
-      return std::string();
-    return std::string("must be \"auto\" or a number ") + (strictly_positive ? "> 0" : ">= 0");
-  };
-}
-
 PlotOptions read_plot_options(const fs::path& config) {
   return read_options<PlotOptions>(load_json_file(config), config.string());
 }
@@ -81,6 +71,20 @@ std::vector<double> surge_ice_resistance_kN(const Results& r, const std::string&
   return res;
 }
 
+std::string recorded_contact_model(const Results& r, const std::string& source) {
+  const Json& attrs = r.attributes;
+  if (!attrs.contains("contact_model")) return "rigid";
+  FLOESIM_REQUIRE(attrs["contact_model"].is_string(), source, ": attribute contact_model must be a string");
+  const std::string m = attrs["contact_model"].get<std::string>();
+  FLOESIM_REQUIRE(m == "rigid" || m == "compliant" || m == "mixed", source, ": attribute contact_model is \"", m,
+                  "\"; expected rigid, compliant or mixed");
+  return m;
+}
+
+double auto_moving_average_window_s(const Results& r, const std::string& source) {
+  return recorded_contact_model(r, source) == "rigid" ? 20.0 : 0.5;
+}
+
 double recorded_steady_start_s(const Results& r, const std::string& source) {
   if (!r.attributes.contains("steady_start_s")) return 0;
   FLOESIM_REQUIRE(r.attributes["steady_start_s"].is_number(), source, ": attribute steady_start_s must be a number");
@@ -96,16 +100,8 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
   s.time_step_s = uniform_step(t, (source + ": series time_s").c_str());
 
   // 2. The window: "auto" follows the contact model the simulator recorded (PHYSICS.md §5).
-  const Json& attrs = r.attributes;
-  s.contact_model = "rigid";
-  if (attrs.contains("contact_model")) {
-    FLOESIM_REQUIRE(attrs["contact_model"].is_string(), source, ": attribute contact_model must be a string");
-    s.contact_model = attrs["contact_model"].get<std::string>();
-    FLOESIM_REQUIRE(s.contact_model == "rigid" || s.contact_model == "compliant" || s.contact_model == "mixed",
-                    source, ": attribute contact_model is \"", s.contact_model,
-                    "\"; expected rigid, compliant or mixed");
-  }
-  s.window_s = o.moving_average_window_s.is_string() ? (s.contact_model == "rigid" ? 20.0 : 0.5)
+  s.contact_model = recorded_contact_model(r, source);
+  s.window_s = o.moving_average_window_s.is_string() ? auto_moving_average_window_s(r, source)
                                                      : o.moving_average_window_s.get<double>();
   s.window_samples = window_samples(s.window_s, s.time_step_s);
   const std::vector<double> ma = moving_average_centred(res, s.window_samples);

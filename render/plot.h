@@ -14,11 +14,9 @@
 #include "pipeline/options.h"
 #include "pipeline/results_io.h"
 #include "pipeline/units.h"
+#include "render/render_options.h"  // auto_or_number
 
 namespace floesim::render {
-
-// "auto" or a number >= 0 (> 0 if `strictly_positive`).
-Check<Json> auto_or_number(bool strictly_positive);
 
 struct PlotOptions {
   Json moving_average_window_s = "auto";  // s; "auto": 20 s if the run used only rigid contacts, else 0.5 s
@@ -68,6 +66,11 @@ struct SurgeLoadSummary {
 // resistance = -Fx (ice_load column 0, body x, surge) in kN, one sample per step. Error naming `source` if the
 // series is malformed or not finite (the simulation blew up).
 std::vector<double> surge_ice_resistance_kN(const Results& r, const std::string& source);
+// The contact model the simulation recorded (results attribute contact_model: rigid, compliant or mixed; "rigid" if
+// absent), and the moving-average window "auto" means for it (PHYSICS.md §5): 20 s for rigid, else 0.5 s. The plot
+// and the video's strip chart use both, so that they average alike.
+std::string recorded_contact_model(const Results& r, const std::string& source);
+double auto_moving_average_window_s(const Results& r, const std::string& source);
 // The steady start the simulation recorded (results attribute steady_start_s), 0 if absent.
 double recorded_steady_start_s(const Results& r, const std::string& source);
 

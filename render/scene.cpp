@@ -10,8 +10,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/error.h"
-#include "render/gl_context.h"
 #include "pipeline/geometry2d.h"
+#include "render/gl_context.h"
+#include "render/strip_chart.h"
 
 namespace floesim::render {
 
@@ -27,6 +28,10 @@ using Vec2 = Eigen::Vector2d;
 // colour, and sides get relief from the sun direction.
 constexpr float kSun[3] = {-0.4191f, -0.4989f, 0.7585f};
 constexpr float kAmbient = 0.5f;
+// Hull faces meeting at less than this angle share their corner normals (smooth shading); sharper edges stay sharp.
+constexpr double kCreaseDeg = 35;
+// Opacity of the water the side view lays over everything below the surface.
+constexpr float kSideWaterAlpha = 0.45f;
 
 // ---- small camera maths (no GLU: it would link libGL) ----
 
@@ -131,7 +136,22 @@ struct FloeDraw {
   GLint top_count = 0;                   // vertices of the top face
   GLint ring_first = 0, ring_count = 0;  // outline of the top face (line loop)
   double radius = 0;                     // bounding sphere about the centre of mass
+  float shade = 1;                       // the per-floe shade of its top colour (also applied to contact_colour)
 };
+
+// One camera's rectangle in the output frame (pixels, top-left origin): the whole frame, or a half of a split one.
+struct SubView {
+  std::string view;  // chase, top or side
+  cv::Rect rect;
+};
+
+std::vector<SubView> sub_views(const RenderOptions& o) {
+  const int w = o.width_px, h = o.height_px;
+  if (o.view != "split") return {{o.view, {0, 0, w, h}}};
+  if (o.split_layout == "stacked")
+    return {{o.split_views[0], {0, 0, w, h / 2}}, {o.split_views[1], {0, h / 2, w, h - h / 2}}};
+  return {{o.split_views[0], {0, 0, w / 2, h}}, {o.split_views[1], {w / 2, 0, w - w / 2, h}}};
+}
 
 std::string fmt(const char* f, double a) {
   char b[64];
@@ -156,12 +176,14 @@ struct SceneRenderer::Impl {
   std::vector<int64_t> vessel_row;      // per frame
   GLint hull_first = 0, hull_count = 0;
   double hull_radius = 0;
-  float sky[3], water[3], edge[3];
+  float sky[3], water[3], edge[3], contact[3];
+  std::vector<SubView> views;
+  std::unique_ptr<LoadStripChart> strip;  // null without strip_chart
   FrameStats stats;
   // Per-frame batches of the visible floes in camera-relative world coordinates (reused between frames).
   std::vector<float> batch_pos, edge_pos;
   std::vector<uint8_t> batch_col;
-  cv::Mat big, small, bgr;  // read-back buffers, reused between frames
+  cv::Mat big, small;  // the GL frame (aliases the context's buffer) and its downsampled copy
   std::vector<float> water_grid;                  // unit square [-1, 1]^2 at z = 0 as triangles
 
   Impl(const Results& res, const RenderOptions& opt, const std::string& src)
@@ -170,7 +192,10 @@ struct SceneRenderer::Impl {
     parse_hex_colour(o.sky_colour, sky);
     parse_hex_colour(o.water_colour, water);
     parse_hex_colour(o.edge_colour, edge);
+    parse_hex_colour(o.contact_colour, contact);
+    views = sub_views(o);
     check_states();
+    if (o.strip_chart) strip = std::make_unique<LoadStripChart>(r, o, source);
     build_floes();
     build_hull();
     build_water_grid();
@@ -199,6 +224,8 @@ struct SceneRenderer::Impl {
     for (size_t i = 1; i < ids.size(); ++i)
       FLOESIM_REQUIRE(ids[i].first != ids[i - 1].first, source, ": floe id ", ids[i].first,
                       " appears twice in /geometry/floe_id");
+    FLOESIM_REQUIRE(r.state_in_contact.size() == r.state_body_id.size(), source, ": /states/in_contact has ",
+                    r.state_in_contact.size(), " rows, /states/body_id ", r.state_body_id.size());
     row_floe.assign(r.state_body_id.size(), -1);
     vessel_row.assign(frames, -1);
     for (size_t k = 0; k < frames; ++k) {
@@ -262,6 +289,7 @@ struct SceneRenderer::Impl {
       floe_top_colour(o, r.floe_origin_mode[g], r.floe_generation[g], top);
       const float t[3] = {top[0] * shade, top[1] * shade, top[2] * shade};
       FloeDraw& f = floes[g];
+      f.shade = shade;
       f.first = vertex_count();
       const double zt = h / 2, zb = -h / 2;
       const Vec3 up(0, 0, 1);
@@ -287,8 +315,11 @@ struct SceneRenderer::Impl {
     }
   }
 
-  // Flat-shaded hull; upward faces in the upper half are the deck. Winding is not trusted (meshes come from any
-  // tool): two-sided lighting turns every normal towards the viewer.
+  // The hull, lit by the sun (the fixed-function light) with smooth shading: a corner's normal is the area-weighted
+  // mean of the normals of the faces meeting there that turn from its own face by less than kCreaseDeg, so the
+  // rounded bow and bilge shade smoothly while the knuckles, the deck edge and the deckhouse stay sharp. Upward
+  // faces in the upper half are the deck. Winding is not trusted (meshes come from any tool): a neighbour wound the
+  // other way points away and is left out, and two-sided lighting turns every normal towards the viewer.
   void build_hull() {
     const auto& v = r.hull_vertices_m;
     const auto& t = r.hull_triangles;
@@ -309,19 +340,42 @@ struct SceneRenderer::Impl {
         FLOESIM_REQUIRE(t[3 * k + j] >= 0 && static_cast<size_t>(t[3 * k + j]) < nv, source, ": hull triangle ", k,
                         " uses vertex ", t[3 * k + j], " of ", nv);
     const std::vector<bool> internal = hull_internal_faces(v, t);
-    hull_first = vertex_count();
+    // 1. Face normals (area-weighted: the unnormalised cross product) of the faces drawn.
+    std::vector<Vec3> face(nt, Vec3::Zero());
     for (size_t k = 0; k < nt; ++k) {
       if (internal[k]) continue;
-      Vec3 p[3];
+      const Vec3 p0(&v[3 * size_t(t[3 * k])]), p1(&v[3 * size_t(t[3 * k + 1])]), p2(&v[3 * size_t(t[3 * k + 2])]);
+      face[k] = (p1 - p0).cross(p2 - p0);
+    }
+    // 2. Faces around each position (convex parts repeat vertices: corners are matched by position, to 1 mm).
+    std::vector<std::pair<std::array<int64_t, 3>, size_t>> corner;  // (position key, face)
+    const auto key = [&](int32_t i) {
+      return std::array<int64_t, 3>{std::llround(1000 * v[3 * size_t(i)]), std::llround(1000 * v[3 * size_t(i) + 1]),
+                                    std::llround(1000 * v[3 * size_t(i) + 2])};
+    };
+    for (size_t k = 0; k < nt; ++k)
+      if (face[k].norm() > 0)
+        for (int j = 0; j < 3; ++j) corner.push_back({key(t[3 * k + j]), k});
+    std::sort(corner.begin(), corner.end());
+    // 3. Corners: smoothed normals within the crease angle.
+    const double cos_crease = std::cos(kCreaseDeg * kPi / 180);
+    hull_first = vertex_count();
+    for (size_t k = 0; k < nt; ++k) {
+      if (face[k].norm() <= 0) continue;  // internal, or a degenerate sliver: nothing to draw
+      const Vec3 n = face[k].normalized();
+      Vec3 p[3], c[3];
       for (int j = 0; j < 3; ++j) {
         const int32_t i = t[3 * k + j];
         p[j] = Vec3(v[3 * i], v[3 * i + 1], v[3 * i + 2]);
+        const auto kj = key(i);
+        auto it = std::lower_bound(corner.begin(), corner.end(), std::make_pair(kj, size_t(0)));
+        c[j] = Vec3::Zero();
+        for (; it != corner.end() && it->first == kj; ++it)
+          if (face[it->second].normalized().dot(n) > cos_crease) c[j] += face[it->second];
+        c[j] = c[j].norm() > 0 ? Vec3(c[j].normalized()) : n;
       }
-      Vec3 n = (p[1] - p[0]).cross(p[2] - p[0]);
-      if (n.norm() <= 0) continue;  // degenerate sliver: nothing to draw
-      n.normalize();
       const bool is_deck = std::abs(n.z()) > 0.8 && (p[0].z() + p[1].z() + p[2].z()) / 3 > (zmin + zmax) / 2;
-      for (const Vec3& q : p) vertex(q, n, is_deck ? deck : hull);
+      for (int j = 0; j < 3; ++j) vertex(p[j], c[j], is_deck ? deck : hull);
     }
     hull_count = vertex_count() - hull_first;
   }
@@ -351,7 +405,8 @@ struct SceneRenderer::Impl {
     gl.Lightfv(GL_LIGHT0, GL_SPECULAR, zero);
     gl.Enable(GL_COLOR_MATERIAL);
     gl.ColorMaterial(GL_FRONT_AND_BACK, GL_AMBIENT_AND_DIFFUSE);
-    gl.ShadeModel(GL_FLAT);
+    gl.ShadeModel(GL_SMOOTH);  // the hull's corner normals; the floes and the water have one colour per face
+    gl.BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);  // the side view's translucent water
     gl.Fogi(GL_FOG_MODE, GL_LINEAR);
     const float fogc[4] = {sky[0], sky[1], sky[2], 1};
     gl.Fogfv(GL_FOG_COLOR, fogc);
@@ -365,21 +420,35 @@ struct SceneRenderer::Impl {
   Vec3 vessel_position(size_t k) const { return Vec3(&r.state_position_m[3 * vessel_row[k]]); }
   const double* vessel_quaternion(size_t k) const { return &r.state_quaternion[4 * vessel_row[k]]; }
 
-  // Camera matrices in camera-relative world coordinates (origin = vessel's horizontal position), so that floats
-  // in GL keep millimetres even kilometres from the world origin.
-  void camera(size_t k, Mat4& proj, Mat4& view, Vec3& eye) const {
-    const double aspect = double(o.width_px) / o.height_px;
-    if (o.view == "top") {
+  // The vessel's heading: its body x axis in the world, horizontal part (east if it points straight up or down).
+  Vec3 heading(size_t k) const {
+    const Mat4 m = pose_matrix(vessel_quaternion(k), Vec3::Zero());
+    Vec2 fwd(m(0, 0), m(1, 0));
+    fwd = fwd.norm() > 1e-6 ? fwd.normalized() : Vec2(1, 0);
+    return Vec3(fwd.x(), fwd.y(), 0);
+  }
+
+  // Camera matrices of `view` for a viewport of the given aspect, in camera-relative world coordinates (origin =
+  // vessel's horizontal position), so that floats in GL keep millimetres even kilometres from the world origin.
+  void camera(size_t k, const std::string& name, double aspect, Mat4& proj, Mat4& view, Vec3& eye) const {
+    if (name == "top") {
       const double altitude = 1000;
       eye = Vec3(0, 0, altitude);
       view = look_at(eye, Vec3(0, 0, 0), Vec3(0, 1, 0));
       proj = ortho(o.top_width_m / 2, o.top_width_m / 2 / aspect, 1, altitude + 500);
       return;
     }
-    const Mat4 m = pose_matrix(vessel_quaternion(k), Vec3::Zero());
-    Vec2 fwd(m(0, 0), m(1, 0));  // body x axis in the world, horizontal part
-    fwd = fwd.norm() > 1e-6 ? fwd.normalized() : Vec2(1, 0);
-    const Vec3 f(fwd.x(), fwd.y(), 0);
+    const Vec3 f = heading(k);
+    if (name == "side") {
+      // From the starboard beam looking to port, level: the bow to the right, the waterline at side_waterline of
+      // the height from the top, the same metres per pixel across and up.
+      const Vec3 across(-f.y(), f.x(), 0);  // to port
+      const double half_w = o.side_width_m / 2, half_h = half_w / aspect, d = o.side_depth_m + 1000;
+      eye = -d * across + Vec3(0, 0, half_h * (2 * o.side_waterline - 1));
+      view = look_at(eye, eye + across, Vec3(0, 0, 1));
+      proj = ortho(half_w, half_h, d - o.side_depth_m - 500, d + o.side_depth_m + 500);
+      return;
+    }
     const double pitch = o.chase_pitch_deg * kPi / 180;
     eye = -o.chase_distance_m * f + Vec3(0, 0, o.chase_height_m);
     const Vec3 dir = std::cos(pitch) * f - std::sin(pitch) * Vec3::UnitZ();
@@ -388,16 +457,45 @@ struct SceneRenderer::Impl {
     proj = perspective(o.fov_deg * kPi / 180, aspect, 0.5, o.view_distance_m);
   }
 
+  // All views of results frame k into the GL buffer: cleared once, then each view in its viewport.
   void draw(size_t k) {
-    Mat4 proj, view;
-    Vec3 eye;
-    camera(k, proj, view, eye);
-    const Vec3 vp = vessel_position(k);
-    const Vec3 origin(vp.x(), vp.y(), 0);
-    const bool chase = o.view == "chase";
-
     gl.ClearColor(sky[0], sky[1], sky[2], 1);
     gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    stats = FrameStats{};
+    const int ss = o.supersample;
+    for (const SubView& v : views) {
+      // GL's viewport counts rows from the bottom.
+      gl.Viewport(v.rect.x * ss, (o.height_px - v.rect.y - v.rect.height) * ss, v.rect.width * ss,
+                  v.rect.height * ss);
+      draw_view(k, v.view, double(v.rect.width) / v.rect.height);
+    }
+    const GLenum err = gl.GetError();
+    FLOESIM_REQUIRE(err == GL_NO_ERROR, "OpenGL error 0x", std::hex, err, " while drawing frame ", std::dec, k);
+  }
+
+  // A vertical quad in the plane through the vessel across the view (camera-relative coordinates) from z = z0 to
+  // z1, `half` metres either side along the heading, `ahead` metres towards the far side of the view.
+  void draw_beam_quad(const Vec3& f, const Vec3& across, double half, double ahead, double z0, double z1) {
+    const Vec3 c = ahead * across;
+    const Vec3 q[4] = {c - half * f + Vec3(0, 0, z0), c + half * f + Vec3(0, 0, z0), c + half * f + Vec3(0, 0, z1),
+                       c - half * f + Vec3(0, 0, z1)};
+    float quad[18];
+    int i = 0;
+    for (int j : {0, 1, 2, 0, 2, 3})
+      for (int d = 0; d < 3; ++d) quad[i++] = float(q[j][d]);
+    gl.VertexPointer(3, GL_FLOAT, 0, quad);
+    gl.DrawArrays(GL_TRIANGLES, 0, 6);
+  }
+
+  void draw_view(size_t k, const std::string& name, double aspect) {
+    Mat4 proj, view;
+    Vec3 eye;
+    camera(k, name, aspect, proj, view, eye);
+    const Vec3 vp = vessel_position(k);
+    const Vec3 origin(vp.x(), vp.y(), 0);
+    const bool chase = name == "chase", side = name == "side";
+    const Vec3 f = heading(k), across(-f.y(), f.x(), 0);
+
     gl.MatrixMode(GL_PROJECTION);
     gl.LoadMatrixd(proj.data());
     gl.MatrixMode(GL_MODELVIEW);
@@ -411,6 +509,8 @@ struct SceneRenderer::Impl {
     // The water surface hides everything below z = 0. Floes float only centimetres above it, closer than the
     // depth buffer resolves at a few hundred metres, so the water is not depth-tested against them: it is painted
     // first without writing depth, and every body is clipped at z = 0 by a user clip plane instead (exact).
+    // The side view looks along the surface instead: it shows what is under water (floes pushed under the hull)
+    // through a translucent layer drawn last, over a backdrop of water behind the scene.
     const GLdouble water_plane[4] = {0, 0, 1, 0};  // keeps z >= 0 (given while the modelview is the view matrix)
     gl.ClipPlane(GL_CLIP_PLANE0, water_plane);
 
@@ -419,7 +519,10 @@ struct SceneRenderer::Impl {
     gl.Disable(GL_LIGHTING);
     gl.EnableClientState(GL_VERTEX_ARRAY);
     gl.DepthMask(GL_FALSE);
-    {
+    gl.Color4f(water[0], water[1], water[2], 1);
+    if (side) {
+      draw_beam_quad(f, across, o.side_width_m, o.side_depth_m + 400, -1e4, 0);
+    } else {
       const double s = chase ? 1.5 * o.view_distance_m : o.top_width_m;
       Mat4 t = Mat4::Identity();
       t(0, 0) = t(1, 1) = s;
@@ -428,30 +531,30 @@ struct SceneRenderer::Impl {
       const Mat4 mv = view * t;
       gl.LoadMatrixd(mv.data());
       gl.VertexPointer(3, GL_FLOAT, 0, water_grid.data());
-      gl.Color4f(water[0], water[1], water[2], 1);
       gl.DrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(water_grid.size() / 3));
     }
     gl.DepthMask(GL_TRUE);
-    gl.Enable(GL_CLIP_PLANE0);
+    if (!side) gl.Enable(GL_CLIP_PLANE0);
 
     // Floes: the visible ones are posed on the CPU into one batch and drawn with a single call. llvmpipe costs
     // ~20-40 us per draw call, so one call per floe (glMultMatrix of its pose) spent most of a 1000-floe frame in
     // call overhead; rotating ~100k vertices here costs about a millisecond.
     const Frustum frustum(proj * view);
-    stats = FrameStats{};
     batch_pos.clear();
     const Eigen::Vector3f sun_dir(kSun[0], kSun[1], kSun[2]);
     const float diffuse = (1 - kAmbient) / kSun[2];
     batch_col.clear();
     edge_pos.clear();
     const bool ortho_view = !chase;
-    const Eigen::Vector3f eye_f = eye.cast<float>(), to_viewer(0, 0, 1);
+    // Towards the viewer: the eye for the perspective view, the view's back direction for the orthographic ones.
+    const Eigen::Vector3f eye_f = eye.cast<float>(), to_viewer = view.block<1, 3>(2, 0).transpose().cast<float>();
     gl.LoadMatrixd(view.data());
     for (int64_t row = r.frame_offset[k]; row < r.frame_offset[k + 1]; ++row) {
       const int32_t g = row_floe[row];
       if (g < 0) continue;
       const Vec3 c = Vec3(&r.state_position_m[3 * row]) - origin;
-      if (frustum.outside(c, floes[g].radius)) {
+      // The side view shows a slab of the field about the vessel's centre plane (a floe is in it or not, whole).
+      if (frustum.outside(c, floes[g].radius) || (side && std::abs(c.dot(across)) > o.side_depth_m)) {
         ++stats.floes_culled;
         continue;
       }
@@ -462,26 +565,30 @@ struct SceneRenderer::Impl {
       const Eigen::Vector3f t = c.cast<float>();
       const FloeDraw& f = floes[g];
       // The same directional light as the fixed-function hull, evaluated here per face: unlit vertices are
-      // cheaper for llvmpipe, and the batch needs no normals.
-      auto emit = [&](GLint v0, GLint n, const Eigen::Vector3f& normal) {
+      // cheaper for llvmpipe, and the batch needs no normals. `top` replaces the prebuilt colour (contact).
+      auto emit = [&](GLint v0, GLint n, const Eigen::Vector3f& normal, const float* top) {
         const float light = std::min(1.0f, kAmbient + diffuse * std::max(0.0f, normal.dot(sun_dir)));
         const uint8_t* c0 = &col[4 * v0];
-        const uint8_t rgba[4] = {uint8_t(c0[0] * light + 0.5f), uint8_t(c0[1] * light + 0.5f),
-                                 uint8_t(c0[2] * light + 0.5f), 255};
+        uint8_t rgba[4] = {uint8_t(c0[0] * light + 0.5f), uint8_t(c0[1] * light + 0.5f),
+                           uint8_t(c0[2] * light + 0.5f), 255};
+        if (top)
+          for (int i = 0; i < 3; ++i)
+            rgba[i] = uint8_t(std::lround(255 * std::clamp(top[i] * f.shade * light, 0.f, 1.f)));
         for (GLint v = v0; v < v0 + n; ++v) {
           const Eigen::Vector3f p = rot * Eigen::Map<const Eigen::Vector3f>(&pos[3 * v]) + t;
           batch_pos.insert(batch_pos.end(), {p.x(), p.y(), p.z()});
           batch_col.insert(batch_col.end(), rgba, rgba + 4);
         }
       };
-      emit(f.first, f.top_count, rot.col(2));
+      const bool touching = o.show_contact && r.state_in_contact[row] != 0;
+      emit(f.first, f.top_count, rot.col(2), touching ? contact : nullptr);
       // Sides facing away from the camera are hidden by the slab itself: dropping them here halves the side
       // triangles (and in the top view, looking straight down, all of them).
       for (GLint v0 = f.first + f.top_count; v0 < f.first + f.count; v0 += 6) {
         const Eigen::Vector3f n = rot * Eigen::Map<const Eigen::Vector3f>(&nrm[3 * v0]);
         const Eigen::Vector3f p = rot * Eigen::Map<const Eigen::Vector3f>(&pos[3 * v0]) + t;
         const float facing = ortho_view ? n.dot(to_viewer) : n.dot(eye_f - p);
-        if (facing > 1e-4f) emit(v0, 6, n);
+        if (facing > 1e-4f) emit(v0, 6, n, nullptr);
       }
       if (o.floe_edges) {
         // The outline as GL_LINES pairs, so that all floes go in one call too.
@@ -525,10 +632,21 @@ struct SceneRenderer::Impl {
     }
     gl.DisableClientState(GL_COLOR_ARRAY);
     gl.DisableClientState(GL_NORMAL_ARRAY);
-    gl.DisableClientState(GL_VERTEX_ARRAY);
     gl.Disable(GL_CLIP_PLANE0);
-    const GLenum err = gl.GetError();
-    FLOESIM_REQUIRE(err == GL_NO_ERROR, "OpenGL error 0x", std::hex, err, " while drawing frame ", std::dec, k);
+
+    // Side view: the water in front of everything under the surface, translucent (what is under it shows, tinted).
+    if (side) {
+      gl.Disable(GL_LIGHTING);
+      gl.Disable(GL_DEPTH_TEST);
+      gl.Enable(GL_BLEND);
+      gl.LoadMatrixd(view.data());
+      gl.Color4f(water[0], water[1], water[2], kSideWaterAlpha);
+      draw_beam_quad(f, across, o.side_width_m, 0, -1e4, 0);
+      gl.Disable(GL_BLEND);
+      gl.Enable(GL_DEPTH_TEST);
+      gl.Enable(GL_LIGHTING);
+    }
+    gl.DisableClientState(GL_VERTEX_ARRAY);
   }
 
   // Vessel speed over ground from the stored frames (centred difference where possible).
@@ -574,27 +692,43 @@ struct SceneRenderer::Impl {
                   cv::LINE_AA);
       y += int(12 * s);
     }
-    if (o.view == "top") {
-      // Scale bar of a round length near 15 % of the width, and a north arrow.
-      const double px_per_m = img.cols / o.top_width_m;
-      const double target = 0.15 * img.cols / px_per_m;
-      double len = std::pow(10.0, std::floor(std::log10(target)));
-      for (double m : {5.0, 2.0})
-        if (len * m <= target) {
-          len *= m;
-          break;
-        }
-      const int x0 = int(24 * s), y0 = img.rows - int(28 * s), x1 = x0 + int(std::lround(len * px_per_m));
-      cv::rectangle(img, {x0 - int(8 * s), y0 - int(34 * s)}, {x1 + int(8 * s), y0 + int(12 * s)},
-                    cv::Scalar(20, 20, 20), cv::FILLED);
-      cv::rectangle(img, {x0, y0 - int(4 * s)}, {x1, y0 + int(4 * s)}, cv::Scalar(255, 255, 255), cv::FILLED);
-      cv::putText(img, fmt("%g m", len), {x0, y0 - int(12 * s)}, font, 0.6 * s, cv::Scalar(255, 255, 255), thick,
-                  cv::LINE_AA);
-      const cv::Point n0(img.cols - int(40 * s), int(80 * s)), n1(img.cols - int(40 * s), int(30 * s));
-      cv::arrowedLine(img, n0, n1, cv::Scalar(255, 255, 255), std::max(2, thick), cv::LINE_AA, 0, 0.35);
-      cv::putText(img, "N", {n0.x - int(9 * s), n0.y + int(24 * s)}, font, 0.6 * s, cv::Scalar(255, 255, 255), thick,
-                  cv::LINE_AA);
-    }
+    // A scale bar and a north arrow in each top view (above the strip chart, which covers the frame's bottom).
+    const int bottom = o.strip_chart ? strip_chart_top(o, img.rows) : img.rows;
+    for (const SubView& v : views)
+      if (v.view == "top") top_view_marks(img, v.rect, std::min(bottom, v.rect.y + v.rect.height), s, thick);
+  }
+
+  // Scale bar of a round length near 15 % of the view's width at its bottom-left, a north arrow at its top-right.
+  void top_view_marks(cv::Mat& img, const cv::Rect& view, int bottom, double s, int thick) const {
+    const int font = cv::FONT_HERSHEY_SIMPLEX;
+    const double px_per_m = view.width / o.top_width_m;
+    const double target = 0.15 * view.width / px_per_m;
+    double len = std::pow(10.0, std::floor(std::log10(target)));
+    for (double m : {5.0, 2.0})
+      if (len * m <= target) {
+        len *= m;
+        break;
+      }
+    const int x0 = view.x + int(24 * s), y0 = bottom - int(28 * s), x1 = x0 + int(std::lround(len * px_per_m));
+    cv::rectangle(img, {x0 - int(8 * s), y0 - int(34 * s)}, {x1 + int(8 * s), y0 + int(12 * s)},
+                  cv::Scalar(20, 20, 20), cv::FILLED);
+    cv::rectangle(img, {x0, y0 - int(4 * s)}, {x1, y0 + int(4 * s)}, cv::Scalar(255, 255, 255), cv::FILLED);
+    cv::putText(img, fmt("%g m", len), {x0, y0 - int(12 * s)}, font, 0.6 * s, cv::Scalar(255, 255, 255), thick,
+                cv::LINE_AA);
+    const int xr = view.x + view.width - int(40 * s);
+    const cv::Point n0(xr, view.y + int(80 * s)), n1(xr, view.y + int(30 * s));
+    cv::arrowedLine(img, n0, n1, cv::Scalar(255, 255, 255), std::max(2, thick), cv::LINE_AA, 0, 0.35);
+    cv::putText(img, "N", {n0.x - int(9 * s), n0.y + int(24 * s)}, font, 0.6 * s, cv::Scalar(255, 255, 255), thick,
+                cv::LINE_AA);
+  }
+
+  // A split frame: a dark line between its halves.
+  void separate_halves(cv::Mat& img) const {
+    if (views.size() < 2) return;
+    const cv::Rect& b = views[1].rect;
+    const int w = std::max(2, int(std::lround(3 * img.rows / 720.0)));
+    if (b.x > 0) cv::line(img, {b.x, 0}, {b.x, img.rows}, cv::Scalar(30, 30, 30), w);
+    else cv::line(img, {0, b.y}, {img.cols, b.y}, cv::Scalar(30, 30, 30), w);
   }
 };
 
@@ -653,16 +787,17 @@ void SceneRenderer::render(size_t frame, cv::Mat& out) {
   FLOESIM_REQUIRE(frame < impl_->r.frames(), "internal: frame ", frame, " of ", impl_->r.frames());
   impl_->draw(frame);
   Impl& m = *impl_;
-  m.ctx.read_rgba_bottom_up(m.big);
-  // Downsample first (box filter over the supersamples), then convert and flip the small image only.
+  m.ctx.frame_rgba_top_down(m.big);
+  // Downsample first (box filter over the supersamples), then convert the small image only.
   const cv::Mat* small = &m.big;
   if (m.o.supersample > 1) {
     cv::resize(m.big, m.small, cv::Size(m.o.width_px, m.o.height_px), 0, 0, cv::INTER_AREA);
     small = &m.small;
   }
-  cv::cvtColor(*small, m.bgr, cv::COLOR_RGBA2BGR);
-  cv::flip(m.bgr, out, 0);  // GL's first row is the bottom one
-  if (impl_->o.overlay) impl_->overlay(frame, out);
+  cv::cvtColor(*small, out, cv::COLOR_RGBA2BGR);
+  m.separate_halves(out);
+  if (m.strip) m.strip->draw(out, m.r.frame_time_s[frame]);
+  if (m.o.overlay) m.overlay(frame, out);
 }
 
 const FrameStats& SceneRenderer::last_stats() const { return impl_->stats; }

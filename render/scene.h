@@ -1,9 +1,11 @@
-// Draws one results frame: water, floe slabs, the hull, seen from a camera that follows the vessel. All geometry
-// comes from the results file; the floe slabs and the hull are built once, in their body frames. Per frame, the
-// floes inside the view are posed (rotation + translation of the prebuilt slab) into one batch drawn with a
-// single call, and the hull is drawn with its pose matrix. Pieces of broken floes are bodies like any other
-// floe, coloured by how they were made (floe_top_colour below); a floe that broke has no state from then on
-// and so is not drawn.
+// Draws one results frame: water, floe slabs, the hull, seen from a camera that follows the vessel (chase, top or
+// side; split puts two of them side by side or stacked in one frame), then the load strip chart (strip_chart.h) and
+// the text overlay. All geometry comes from the results file; the floe slabs and the hull are built once, in their
+// body frames. Per frame and view, the floes inside the view are posed (rotation + translation of the prebuilt
+// slab) into one batch drawn with a single call, and the hull, smooth-shaded under the sun, is drawn with its pose
+// matrix. Pieces of broken floes are bodies like any other floe, coloured by how they were made (floe_top_colour
+// below); a floe that broke has no state from then on and so is not drawn. A floe pressed against the vessel at
+// the frame (/states/in_contact) shows contact_colour on its top.
 #pragma once
 #include <memory>
 #include <string>

@@ -74,6 +74,8 @@ RenderStats render_video(const Results& r, const RenderOptions& o, const fs::pat
       {"duration_s", static_cast<double>(n) / o.fps},
       {"simulated_time_s", {r.frame_time_s.front(), r.frame_time_s[n - 1]}},
       {"view", o.view},
+      {"split_views", o.view == "split" ? nlohmann::json(o.split_views) : nlohmann::json()},
+      {"strip_chart", o.strip_chart},
       {"provenance", provenance},
   };
   fs::path sidecar = out_mp4;

@@ -221,6 +221,8 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
   r.state_body_id.reserve(frames * nb);
   r.state_position_m.reserve(frames * nb * 3);
   r.state_quaternion.reserve(frames * nb * 4);
+  r.state_in_contact.reserve(frames * nb);
+  std::vector<int8_t> pressed;  // per body: pressed against the vessel in this step (frames only)
 
   const auto t0 = std::chrono::steady_clock::now();
   double record_s = 0, awake_sum = 0, contact_sum = 0, iter_sum = 0, pair_sum = 0, hit_sum = 0, edge_sum = 0;
@@ -258,6 +260,11 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
     if (k % every == 0) {
       r.frame_time_s.push_back(s.time_s);
       const Model& wm = world.model();
+      // Floes the vessel pressed on in this step: a vessel contact that carried a normal impulse (speculative
+      // contacts that stayed open carry none). Read only: the results stay what they were without this.
+      pressed.assign(wm.bodies.size(), 0);
+      for (const Contact& c : world.contacts())
+        if (c.pn > 0 && (c.body_a == v || c.body_b == v)) pressed[size_t(c.body_a == v ? c.body_b : c.body_a)] = 1;
       for (size_t b = 0; b < wm.bodies.size(); ++b) {
         const Body& body = wm.bodies[b];
         if (body.kind == BodyKind::wall || !s.alive[b]) continue;  // walls are fixed: not in the results layout
@@ -266,6 +273,7 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
         const Quat& qb = s.orientation[b];
         r.state_position_m.insert(r.state_position_m.end(), {x.x(), x.y(), x.z()});
         r.state_quaternion.insert(r.state_quaternion.end(), {qb.w(), qb.x(), qb.y(), qb.z()});
+        r.state_in_contact.push_back(pressed[b]);
       }
       r.frame_offset.push_back(static_cast<int64_t>(r.state_body_id.size()));
     }

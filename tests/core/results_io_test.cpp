@@ -32,6 +32,7 @@ Results small_results(int steps) {
   r.state_body_id = {0, 1, 0, 1};
   r.state_position_m = std::vector<double>(12, 1.0);
   r.state_quaternion = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+  r.state_in_contact = {0, 1, 0, 0};  // floe 1 pressed against the vessel in the first frame
   r.floe_id = {1};
   r.floe_thickness_m = {1.0};
   r.floe_vertex_offset = {0, 3};
@@ -161,6 +162,7 @@ TEST(ResultsIo, RoundTripAndBitIdenticalRewrites) {
   EXPECT_EQ(back.get("ice_load").size(), 7u * 6u);
   EXPECT_DOUBLE_EQ(back.get("ice_load")[6 * 3], 1.5);
   EXPECT_EQ(back.state_body_id, r.state_body_id);
+  EXPECT_EQ(back.state_in_contact, r.state_in_contact);
   EXPECT_EQ(back.attributes["time_step_s"], 0.01);
   fs::remove(a);
   fs::remove(b);
@@ -192,7 +194,7 @@ TEST(ResultsIo, FractureEventsAndLineageRoundTrip) {
   const Results r = fractured_results();
   write_results(p, r);
   const Results b = read_results(p);
-  EXPECT_EQ(b.attributes["layout"], "floesim-results/3");
+  EXPECT_EQ(b.attributes["layout"], "floesim-results/4");
   EXPECT_EQ(b.floe_id, r.floe_id);
   EXPECT_EQ(b.floe_vertices_m, r.floe_vertices_m);
   EXPECT_EQ(b.floe_parent_id, r.floe_parent_id);
@@ -287,6 +289,7 @@ TEST(ResultsIo, LayoutTwoFilesReadWithTheSolverSeriesNotRecorded) {
     const hid_t f = H5Fopen(p.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
     ASSERT_GE(f, 0);
     for (const std::string& name : added) ASSERT_GE(H5Ldelete(f, ("/series/" + name).c_str(), H5P_DEFAULT), 0) << name;
+    ASSERT_GE(H5Ldelete(f, "/states/in_contact", H5P_DEFAULT), 0);
     H5Fclose(f);
   }
   replace_attributes(p, {{"layout", "floesim-results/2"}, {"time_step_s", 0.01}});
@@ -300,6 +303,29 @@ TEST(ResultsIo, LayoutTwoFilesReadWithTheSolverSeriesNotRecorded) {
   fs::remove(p);
 }
 
+TEST(ResultsIo, LayoutThreeFilesReadWithNoFloeInContact) {
+  // A floesim-results/3 file: today's writer, then /states/in_contact removed and the layout set back. Contact was
+  // not recorded: every state reads as not in contact; the states themselves read as written.
+  const fs::path p = fs::temp_directory_path() / "floesim_results_layout3.h5";
+  const Results w = small_results(4);
+  write_results(p, w);
+  {
+    const hid_t f = H5Fopen(p.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(f, 0);
+    ASSERT_GE(H5Ldelete(f, "/states/in_contact", H5P_DEFAULT), 0);
+    H5Fclose(f);
+  }
+  replace_attributes(p, {{"layout", "floesim-results/3"}, {"time_step_s", 0.01}});
+  const Results r = read_results(p);
+  EXPECT_EQ(r.state_body_id, w.state_body_id);
+  EXPECT_EQ(r.state_in_contact, std::vector<int8_t>(4, 0));
+  // A /4 file without the dataset is damaged: the error names it.
+  replace_attributes(p, {{"layout", "floesim-results/4"}, {"time_step_s", 0.01}});
+  const std::string e = error_of([&] { read_results(p); });
+  EXPECT_NE(e.find("/states/in_contact"), std::string::npos) << e;
+  fs::remove(p);
+}
+
 TEST(ResultsIo, LayoutOneFilesFromBeforeFractureReadWithDefaults) {
   // A floesim-results/1 file: today's writer, then what /1 did not have removed and the layout set back.
   const fs::path p = fs::temp_directory_path() / "floesim_results_layout1.h5";
@@ -309,7 +335,7 @@ TEST(ResultsIo, LayoutOneFilesFromBeforeFractureReadWithDefaults) {
     ASSERT_GE(f, 0);
     for (const char* name : {"/fracture", "/geometry/floe_parent_id", "/geometry/floe_generation",
                              "/geometry/floe_origin_mode", "/geometry/floe_created_s", "/geometry/floe_ended_s",
-                             "/series/fracture_events", "/series/floe_bodies"})
+                             "/series/fracture_events", "/series/floe_bodies", "/states/in_contact"})
       ASSERT_GE(H5Ldelete(f, name, H5P_DEFAULT), 0) << name;
     H5Fclose(f);
   }
@@ -331,7 +357,7 @@ TEST(ResultsIo, LayoutOneFilesFromBeforeFractureReadWithDefaults) {
   // Rewritten, it becomes a file of the current layout with the same content.
   const fs::path q = fs::temp_directory_path() / "floesim_results_layout1_rewritten.h5";
   write_results(q, r);
-  EXPECT_EQ(read_results(q).attributes["layout"], "floesim-results/3");
+  EXPECT_EQ(read_results(q).attributes["layout"], "floesim-results/4");
   fs::remove(q);
 
   // A layout from the future is refused, naming it.

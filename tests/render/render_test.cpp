@@ -28,6 +28,7 @@ RenderOptions small_top_view() {
   o.view = "top";
   o.top_width_m = 200;  // 1.6 px/m
   o.overlay = false;    // pixel checks below must not hit the text panel
+  o.strip_chart = false;  // nor the load strip chart at the bottom (tests/render/video_views_test.cpp)
   return o;
 }
 

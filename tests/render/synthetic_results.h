@@ -24,6 +24,8 @@ struct SyntheticFloe {
   int32_t origin_mode = kFractureNone;
   double created_s = 0;
   double ended_s = std::numeric_limits<double>::infinity();
+  double z = std::nan("");  // centre of mass height; NaN: 0.1 x thickness (floating)
+  std::vector<int> contact_frames = {};  // frames in which it is pressed against the vessel (/states/in_contact)
 };
 
 struct SyntheticEvent {
@@ -120,11 +122,15 @@ inline Results make_results(const Synthetic& s) {
     r.state_body_id.push_back(0);
     r.state_position_m.insert(r.state_position_m.end(), {s.vessel_speed_mps * t, 0.0, 0.0});
     r.state_quaternion.insert(r.state_quaternion.end(), {1, 0, 0, 0});
+    r.state_in_contact.push_back(0);
     for (const auto& f : s.floes) {
       if (!(f.created_s <= t && t < f.ended_s)) continue;  // not yet made, or broken
       r.state_body_id.push_back(f.id);
-      r.state_position_m.insert(r.state_position_m.end(), {f.x, f.y, 0.1 * f.thickness_m});
+      r.state_position_m.insert(r.state_position_m.end(),
+                                {f.x, f.y, std::isnan(f.z) ? 0.1 * f.thickness_m : f.z});
       r.state_quaternion.insert(r.state_quaternion.end(), {1, 0, 0, 0});
+      r.state_in_contact.push_back(
+          std::find(f.contact_frames.begin(), f.contact_frames.end(), k) != f.contact_frames.end() ? 1 : 0);
     }
     r.frame_offset.push_back(static_cast<int64_t>(r.state_body_id.size()));
   }

@@ -72,6 +72,59 @@ TEST(SimTransit, LayoutIsExact) {
 // (Floes in line would not do: the second impact kicks the first floe into a slow turn, and its centre then runs
 // ahead of the face.) Tolerance 1e-4: the floes' final speeds are U to the solver's tolerance (1e-5 m/s against
 // 2 m/s); the wall's own speed changes by M U / 3.6e14 kg ~ 1e-10.
+// /states/in_contact against what the vessel felt: in a frame's step the ice load on the vessel is the sum of its
+// contacts' impulses, so it is non-zero exactly when some floe pressed on the hull; and a floe marked in contact
+// lies within the hull's reach (its centre within the hull's extent plus the floe's half-diagonal).
+TEST(SimTransit, FloesMarkedInContactAreTheOnesTheHullPressesOn) {
+  const HullModel hull = coarse_hull(8);
+  SimulateOptions o;
+  o.duration_s = 12;
+  o.output_interval_s = 0.1;
+  FloeField field = floe_block();
+  field.floes.push_back(rect_floe(99, 80, 80, 7, 7, 1.0));  // far to port: never reached
+  const Model m = build_model(field, &hull, o);
+  RunStats stats;
+  const Results r = simulate(m, stats);
+  ASSERT_EQ(r.state_in_contact.size(), r.state_body_id.size());
+  double hx = 0, hy = 0;  // hull half-extents (body frame)
+  for (size_t i = 0; i < r.hull_vertices_m.size() / 3; ++i) {
+    hx = std::max(hx, std::abs(r.hull_vertices_m[3 * i]));
+    hy = std::max(hy, std::abs(r.hull_vertices_m[3 * i + 1]));
+  }
+  const std::vector<double>& t = r.get("time_s");
+  const std::vector<double>& load = r.get("ice_load");
+  size_t frames_in_contact = 0, step = 0;
+  for (size_t k = 0; k < r.frames(); ++k) {
+    while (step < t.size() && std::abs(t[step] - r.frame_time_s[k]) > 1e-9) ++step;
+    ASSERT_LT(step, t.size()) << "frame " << k << " has no step";
+    const bool loaded = load[6 * step] != 0 || load[6 * step + 1] != 0 || load[6 * step + 2] != 0;
+    Vec3 vessel = Vec3::Zero();
+    Quat q = Quat::Identity();
+    int marked = 0;
+    for (int64_t row = r.frame_offset[k]; row < r.frame_offset[k + 1]; ++row) {
+      const double* p = &r.state_position_m[3 * row];
+      if (r.state_body_id[row] == 0) {
+        EXPECT_EQ(r.state_in_contact[row], 0) << "the vessel is never in contact with itself";
+        vessel = Vec3(p[0], p[1], p[2]);
+        const double* w = &r.state_quaternion[4 * row];
+        q = Quat(w[0], w[1], w[2], w[3]);
+        continue;
+      }
+      if (!r.state_in_contact[row]) continue;
+      ++marked;
+      EXPECT_NE(r.state_body_id[row], 99) << "the far floe was marked in contact at t = " << r.frame_time_s[k];
+      const Vec3 local = q.conjugate() * (Vec3(p[0], p[1], p[2]) - vessel);
+      EXPECT_LT(std::abs(local.x()), hx + 5.0) << "floe " << r.state_body_id[row] << " at t = " << r.frame_time_s[k];
+      EXPECT_LT(std::abs(local.y()), hy + 5.0) << "floe " << r.state_body_id[row] << " at t = " << r.frame_time_s[k];
+    }
+    EXPECT_EQ(marked > 0, loaded) << "t = " << r.frame_time_s[k] << ": " << marked << " floes marked, ice load "
+                                  << load[6 * step] << " N";
+    frames_in_contact += marked > 0;
+  }
+  std::printf("[measured] %zu of %zu frames with a floe in contact\n", frames_in_contact, r.frames());
+  EXPECT_GT(frames_in_contact, 5u) << "the bow reaches the block";
+}
+
 TEST(SimTransit, MeanLoadIsTheMomentumGivenToTheIce) {
   SimulateOptions o = testing::floe_options();
   o.fracture.enabled = false;  // the contact law alone
