@@ -1,0 +1,56 @@
+// The results HDF5 reader (pipeline/results_io.h read_results): layout checks, offsets, lineage, fracture table.
+// FLOESIM_FUZZ_WRITE_SEED=FILE writes a small valid results file (the seed) and exits.
+#include <cmath>
+
+#include "fuzz_util.h"
+#include "pipeline/results_io.h"
+
+namespace {
+
+// Two steps, one frame of two bodies, one floe (a triangle), one hull triangle, no fracture events.
+void write_seed(const char* out) {
+  floesim::Results r;
+  for (const auto& f : floesim::series_fields()) {
+    auto& v = r.series[f.name];
+    v.assign(2 * f.cols, 0.0);
+  }
+  r.series["time_s"] = {0.0, 0.01};
+  r.frame_time_s = {0.0};
+  r.frame_offset = {0, 2};
+  r.state_body_id = {0, 1};
+  r.state_position_m = {0, 0, 0, 10, 0, 0};
+  r.state_quaternion = {1, 0, 0, 0, 1, 0, 0, 0};
+  r.floe_id = {1};
+  r.floe_thickness_m = {1.0};
+  r.floe_vertex_offset = {0, 3};
+  r.floe_vertices_m = {-1, -1, 2, -1, -1, 2};
+  r.floe_parent_id = {-1};
+  r.floe_generation = {0};
+  r.floe_origin_mode = {0};
+  r.floe_created_s = {0.0};
+  r.floe_ended_s = {INFINITY};
+  r.hull_vertices_m = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  r.hull_triangles = {0, 1, 2};
+  r.attributes = {{"time_step_s", 0.01}, {"duration_s", 0.02}, {"output_interval_s", 0.01}};
+  floesim::write_results(out, r);
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  if (const char* out = std::getenv("FLOESIM_FUZZ_WRITE_SEED")) {
+    write_seed(out);
+    std::exit(0);
+  }
+  return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  static const auto file = floesim::fuzz::temp_file(".h5");
+  floesim::fuzz::write_input(file, data, size);
+  floesim::fuzz::expect_ok_or_error([&] {
+    const floesim::Results r = floesim::read_results(file);
+    (void)r.steps();
+  });
+  return 0;
+}
