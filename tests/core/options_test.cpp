@@ -89,14 +89,17 @@ TEST(Options, IntegerFieldRefusesFractionsAndValuesOutOfRange) {
   EXPECT_EQ(read_options<Opts>(Json::parse(R"({"sections": 1.2e1})"), "x.json").sections, 12);
 }
 
+namespace {
+struct Seeded {
+  std::uint64_t seed = 1;
+  template <class V>
+  void visit(V& v) {
+    v.field("seed", seed, "-", "seed");
+  }
+};
+}  // namespace
+
 TEST(Options, UnsignedFieldRefusesNegativeAndFractionalValues) {
-  struct Seeded {
-    std::uint64_t seed = 1;
-    template <class V>
-    void visit(V& v) {
-      v.field("seed", seed, "-", "seed");
-    }
-  };
   for (const char* bad : {R"({"seed": -1})", R"({"seed": -1.5})", R"({"seed": 1e30})", R"({"seed": 0.5})"}) {
     try {
       read_options<Seeded>(Json::parse(bad), "x.json");
