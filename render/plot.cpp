@@ -17,16 +17,6 @@ namespace floesim::render {
 
 namespace fs = std::filesystem;
 
-Check<Json> auto_or_number(bool strictly_positive) {
-  return [strictly_positive](const Json& j) {
-    if (j.is_string() && j.get<std::string>() == "auto") return std::string();
-    if (j.is_number() && std::isfinite(j.get<double>()) &&
-        (strictly_positive ? j.get<double>() > 0 : j.get<double>() >= 0))
-      return std::string();
-    return std::string("must be \"auto\" or a number ") + (strictly_positive ? "> 0" : ">= 0");
-  };
-}
-
 PlotOptions read_plot_options(const fs::path& config) {
   return read_options<PlotOptions>(load_json_file(config), config.string());
 }

@@ -1,6 +1,9 @@
 #include "render/render_options.h"
 
 #include <cctype>
+#include <cmath>
+
+#include "render/plot.h"
 
 namespace floesim::render {
 
@@ -9,6 +12,18 @@ Check<std::string> hex_colour() {
     bool ok = s.size() == 7 && s[0] == '#';
     for (size_t i = 1; ok && i < s.size(); ++i) ok = std::isxdigit(static_cast<unsigned char>(s[i])) != 0;
     return ok ? std::string() : std::string("must be a colour \"#rrggbb\"");
+  };
+}
+
+// plot's check (declared in plot.h), here with the other checks of the render stages' options, which need no
+// rendering code (tests/fuzz/fuzz_options reads every options struct without linking the renderer).
+Check<Json> auto_or_number(bool strictly_positive) {
+  return [strictly_positive](const Json& j) {
+    if (j.is_string() && j.get<std::string>() == "auto") return std::string();
+    if (j.is_number() && std::isfinite(j.get<double>()) &&
+        (strictly_positive ? j.get<double>() > 0 : j.get<double>() >= 0))
+      return std::string();
+    return std::string("must be \"auto\" or a number ") + (strictly_positive ? "> 0" : ">= 0");
   };
 }
 
