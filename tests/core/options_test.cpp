@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+
 #include "pipeline/options.h"
 
 using namespace floesim;
@@ -110,4 +113,19 @@ TEST(Options, UnsignedFieldRefusesNegativeAndFractionalValues) {
   }
   EXPECT_EQ(read_options<Seeded>(Json::parse(R"({"seed": 18446744073709551615})"), "x.json").seed,
             18446744073709551615ull);
+}
+
+// A number too large for a double is nlohmann's out_of_range, not a parse_error: it escaped load_json_file and
+// was not the clear error every other bad file gives (found by tests/fuzz/fuzz_floes, crashes/fuzz_floes/crash-*).
+TEST(Options, NumberOverflowInAJsonFileIsAClearError) {
+  const std::filesystem::path f = std::filesystem::temp_directory_path() / "floesim_overflow.json";
+  std::ofstream(f) << R"({"thickness_m": 66e566})";
+  try {
+    load_json_file(f);
+    ADD_FAILURE() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("floesim_overflow.json: not valid JSON"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("number overflow"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(f);
 }
