@@ -65,7 +65,9 @@ nlohmann::json convex_parts_geojson(const FloeField& field) {
       nlohmann::json ring = nlohmann::json::array();
       for (const Vec2& v : p) ring.push_back({v.x(), v.y()});
       ring.push_back({p[0].x(), p[0].y()});  // GeoJSON rings are closed
-      polys.push_back({ring});
+      // Json::array, not `{ring}`: a one-element brace list is the ring itself under clang (a MultiPolygon of bare
+      // rings; found by the clang sanitizer build of the tests), a list of it under gcc.
+      polys.push_back(nlohmann::json::array({ring}));
     }
     feats.push_back({{"type", "Feature"},
                      {"id", f.id},

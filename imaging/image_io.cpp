@@ -1,6 +1,7 @@
 #include "imaging/image_io.h"
 
 #include <array>
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -14,6 +15,33 @@ uint32_t be32(const unsigned char* p) {
   return (uint32_t(p[0]) << 24) | (uint32_t(p[1]) << 16) | (uint32_t(p[2]) << 8) | p[3];
 }
 uint32_t be16(const unsigned char* p) { return (uint32_t(p[0]) << 8) | p[1]; }
+
+// TIFF (classic, either byte order): ImageWidth (256) and ImageLength (257) of the first image file directory.
+bool read_tiff_size(std::ifstream& in, const unsigned char* h, int& width, int& height) {
+  const bool le = h[0] == 'I';
+  auto u16 = [le](const unsigned char* p) { return le ? uint32_t(p[0]) | (uint32_t(p[1]) << 8) : be16(p); };
+  auto u32 = [le](const unsigned char* p) {
+    return le ? uint32_t(p[0]) | (uint32_t(p[1]) << 8) | (uint32_t(p[2]) << 16) | (uint32_t(p[3]) << 24) : be32(p);
+  };
+  if (u16(h + 2) != 42) return false;  // 43 is BigTIFF: sized after decoding
+  in.clear();
+  in.seekg(u32(h + 4));
+  unsigned char n[2];
+  if (!in.read(reinterpret_cast<char*>(n), 2)) return false;
+  long w = -1, l = -1;
+  for (uint32_t k = 0, count = u16(n); k < count && k < 4096; ++k) {
+    unsigned char e[12];
+    if (!in.read(reinterpret_cast<char*>(e), 12)) return false;
+    const uint32_t tag = u16(e), type = u16(e + 2);
+    const long value = type == 3 ? long(u16(e + 8)) : type == 4 ? long(u32(e + 8)) : -1;
+    if (tag == 256) w = value;
+    if (tag == 257) l = value;
+  }
+  if (w < 0 || l < 0) return false;
+  width = static_cast<int>(std::min<long>(w, 0x7fffffff));
+  height = static_cast<int>(std::min<long>(l, 0x7fffffff));
+  return true;
+}
 }  // namespace
 
 bool read_image_size(const std::filesystem::path& file, int& width, int& height) {
@@ -29,6 +57,8 @@ bool read_image_size(const std::filesystem::path& file, int& width, int& height)
     height = static_cast<int>(std::min<uint32_t>(be32(&h[20]), 0x7fffffff));
     return true;
   }
+  if (got >= 8 && ((h[0] == 'I' && h[1] == 'I') || (h[0] == 'M' && h[1] == 'M')))
+    return read_tiff_size(in, h.data(), width, height);
   if (got >= 2 && h[0] == 0xFF && h[1] == 0xD8) {
     // JPEG: walk the marker segments to the first start-of-frame (SOFn) segment.
     in.clear();

@@ -1,6 +1,7 @@
 #include "pipeline/floes_io.h"
 
 #include <cmath>
+#include <cstdint>
 #include <set>
 
 #include "pipeline/atomic_file.h"
@@ -31,37 +32,80 @@ nlohmann::json floes_to_geojson(const FloeField& field) {
   return fc;
 }
 
+namespace {
+
+// Reading a user's GeoJSON must never let a nlohmann exception or an unchecked conversion through (fuzz_floes found
+// "width_m": "wide" escaping as nlohmann::type_error, a geometry without "coordinates" read through a missing key
+// and "id": 1e20 cast to int): every member is checked for its type first.
+const nlohmann::json* member(const nlohmann::json& o, const char* key) {
+  if (!o.is_object()) return nullptr;
+  auto it = o.find(key);
+  return it == o.end() ? nullptr : &*it;
+}
+
+bool is_string(const nlohmann::json* v, const char* s) { return v && v->is_string() && v->get<std::string>() == s; }
+
+// A finite number >= 0, or `fallback` when absent.
+double extent(const nlohmann::json& fl, const char* key, const std::string& file) {
+  const nlohmann::json* v = member(fl, key);
+  if (!v) return 0.0;
+  FLOESIM_REQUIRE(v->is_number() && std::isfinite(v->get<double>()) && v->get<double>() >= 0, file, ": floesim.",
+                  key, " must be a number >= 0 (the field's extent in metres), got ", v->dump());
+  return v->get<double>();
+}
+
+// An integer that fits an int (1 and 1.0 alike); false otherwise.
+bool int_value(const nlohmann::json& v, int& out) {
+  if (!v.is_number()) return false;
+  const double d = v.get<double>();
+  if (v.is_number_integer() ? (v.get<int64_t>() < INT32_MIN || v.get<int64_t>() > INT32_MAX ||
+                               (v.is_number_unsigned() && v.get<uint64_t>() > uint64_t(INT32_MAX)))
+                            : !(std::floor(d) == d && d >= INT32_MIN && d <= INT32_MAX))
+    return false;
+  out = v.is_number_integer() ? static_cast<int>(v.get<int64_t>()) : static_cast<int>(d);
+  return true;
+}
+
+}  // namespace
+
 FloeField floes_from_geojson(const nlohmann::json& j, const std::string& file) {
   FloeField field;
-  FLOESIM_REQUIRE(j.is_object() && j.value("type", "") == "FeatureCollection", file,
+  FLOESIM_REQUIRE(j.is_object() && is_string(member(j, "type"), "FeatureCollection"), file,
                   ": not a GeoJSON FeatureCollection (expected {\"type\": \"FeatureCollection\", ...})");
-  FLOESIM_REQUIRE(j.contains("features") && j["features"].is_array(), file, ": has no \"features\" array");
-  if (j.contains("floesim") && j["floesim"].is_object()) {
-    field.width_m = j["floesim"].value("width_m", 0.0);
-    field.height_m = j["floesim"].value("height_m", 0.0);
-    if (j["floesim"].contains("provenance")) field.provenance = j["floesim"]["provenance"];
+  const nlohmann::json* features = member(j, "features");
+  FLOESIM_REQUIRE(features && features->is_array(), file, ": has no \"features\" array");
+  if (const nlohmann::json* fl = member(j, "floesim"); fl && fl->is_object()) {
+    field.width_m = extent(*fl, "width_m", file);
+    field.height_m = extent(*fl, "height_m", file);
+    if (const nlohmann::json* p = member(*fl, "provenance")) field.provenance = *p;
   }
   std::set<int> ids;
   int index = 0;
-  for (const auto& feat : j["features"]) {
+  for (const auto& feat : *features) {
     const std::string where = file + ": feature #" + std::to_string(index++);
-    FLOESIM_REQUIRE(feat.is_object() && feat.contains("geometry") && feat["geometry"].is_object(), where,
-                    " has no geometry object");
-    const auto& g = feat["geometry"];
-    FLOESIM_REQUIRE(g.value("type", "") == "Polygon", where, " has geometry type ", g.value("type", "?"),
+    const nlohmann::json* geometry = member(feat, "geometry");
+    FLOESIM_REQUIRE(geometry && geometry->is_object(), where, " has no geometry object");
+    const auto& g = *geometry;
+    const nlohmann::json* type = member(g, "type");
+    FLOESIM_REQUIRE(is_string(type, "Polygon"), where, " has geometry type ", type ? type->dump() : "(none)",
                     "; only Polygon is supported (split MultiPolygons into one feature per floe)");
-    const auto& coords = g["coordinates"];
-    FLOESIM_REQUIRE(coords.is_array() && !coords.empty(), where, " has no coordinates");
+    const nlohmann::json* coordinates = member(g, "coordinates");
+    FLOESIM_REQUIRE(coordinates && coordinates->is_array() && !coordinates->empty(), where, " has no coordinates");
+    const auto& coords = *coordinates;
     FLOESIM_REQUIRE(coords.size() == 1, where, " has ", coords.size() - 1,
                     " hole(s); floes must be simple polygons without holes (melt ponds are ice: close them)");
+    FLOESIM_REQUIRE(coords[0].is_array(), where, ": coordinates[0] must be an array of [x, y] vertices, got ",
+                    coords[0].dump());
     Floe f;
-    const auto& props = feat.contains("properties") && feat["properties"].is_object() ? feat["properties"]
-                                                                                      : nlohmann::json::object();
-    try {
-      f.id = props.contains("id") ? props["id"].get<int>() : feat.at("id").get<int>();
-      f.thickness_m = props.value("thickness_m", 1.0);
-    } catch (const std::exception&) {
-      throw Error(where + ": properties.id must be an integer and properties.thickness_m a number");
+    const nlohmann::json* props = member(feat, "properties");
+    if (props && !props->is_object()) props = nullptr;
+    const nlohmann::json* id = props ? member(*props, "id") : nullptr;
+    if (!id) id = member(feat, "id");
+    FLOESIM_REQUIRE(id && int_value(*id, f.id), where, ": properties.id must be an integer, got ",
+                    id ? id->dump() : "none");
+    if (const nlohmann::json* t = props ? member(*props, "thickness_m") : nullptr) {
+      FLOESIM_REQUIRE(t->is_number(), where, ": properties.thickness_m must be a number, got ", t->dump());
+      f.thickness_m = t->get<double>();
     }
     const std::string fw = file + ": floe id " + std::to_string(f.id);
     FLOESIM_REQUIRE(f.id >= 1, fw, ": id must be >= 1 (0 means water in the label image)");

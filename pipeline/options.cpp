@@ -40,7 +40,9 @@ Json load_json_file(const std::filesystem::path& file) {
   if (!in) throw Error(file.string() + ": cannot open (does the file exist and is it readable?)");
   try {
     return Json::parse(in, nullptr, true, /*ignore_comments=*/true);
-  } catch (const Json::parse_error& e) {
+  } catch (const Json::exception& e) {
+    // Not only parse_error: a number beyond a double ("1e999") is out_of_range.406 (found by tests/fuzz/fuzz_floes;
+    // it escaped as an "internal error" instead of this message).
     throw Error(file.string() + ": not valid JSON: " + e.what());
   }
 }

@@ -15,6 +15,7 @@
 #include <memory>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -55,9 +56,12 @@ class OptionReader {
       if (check) check_value(key, value, check);  // defaults are checked too (a default of 0 may be a "must set")
       return;
     }
+    bool ok = false;
     try {
-      value = j_.at(key).get<T>();
+      ok = get_value(j_.at(key), value);
     } catch (const std::exception&) {
+    }
+    if (!ok) {
       problems_->push_back(where(key) + " has the wrong type: expected " + type_name<T>() + ", got " +
                            j_.at(key).dump());
       return;
@@ -121,6 +125,41 @@ class OptionReader {
   void check_value(const char* key, const T& value, const Check<T>& check) {
     std::string msg = check(value);
     if (!msg.empty()) problems_->push_back(where(key) + " " + msg + ", got " + Json(value).dump());
+  }
+  // The JSON value as T; false if it is not one. nlohmann's get<int>() casts a number unchecked (2.5 reads as 2,
+  // 1e20 is undefined behaviour; found by tests/fuzz/fuzz_options), so an integer field accepts only an integral
+  // value that fits it (3, 3.0 and 3e0 alike).
+  template <class T>
+  static bool get_value(const Json& v, T& out) {
+    if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
+      using L = std::numeric_limits<T>;
+      if (v.is_number_unsigned()) {
+        const auto x = v.get<uint64_t>();
+        if (x > static_cast<uint64_t>(L::max())) return false;
+        out = static_cast<T>(x);
+        return true;
+      }
+      if (v.is_number_integer()) {
+        const auto x = v.get<int64_t>();
+        if (x < 0 && !L::is_signed) return false;
+        if (x > 0 && static_cast<uint64_t>(x) > static_cast<uint64_t>(L::max())) return false;
+        if (L::is_signed && x < static_cast<int64_t>(L::min())) return false;
+        out = static_cast<T>(x);
+        return true;
+      }
+      if (v.is_number_float()) {
+        const double d = v.get<double>();
+        // [min, 2^digits): both bounds are exact doubles for every integer type.
+        if (!(std::floor(d) == d && d >= static_cast<double>(L::min()) && d < std::ldexp(1.0, L::digits)))
+          return false;
+        out = static_cast<T>(d);
+        return true;
+      }
+      return false;
+    } else {
+      out = v.get<T>();
+      return true;
+    }
   }
   template <class T>
   static const char* type_name() {

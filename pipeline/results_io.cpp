@@ -132,6 +132,14 @@ void write_ds(hid_t loc, const std::string& name, const std::vector<T>& data, si
                     ": cannot write dataset ", name, " (disk full?)");
 }
 
+// The most rows of `row_bytes` a file can hold: deflate compresses at most 1032:1, plus room for HDF5's fill
+// values in a small dataset.
+hsize_t max_rows(const std::string& file, size_t row_bytes) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(file, ec);
+  return static_cast<hsize_t>((1032.0 * (ec ? 0 : static_cast<double>(size)) + (1 << 20)) / row_bytes);
+}
+
 template <class T>
 std::vector<T> read_ds(hid_t file_id, const std::string& name, size_t cols, const std::string& file) {
   FLOESIM_REQUIRE(H5Lexists(file_id, name.c_str(), H5P_DEFAULT) > 0, file, ": dataset ", name,
@@ -139,11 +147,18 @@ std::vector<T> read_ds(hid_t file_id, const std::string& name, size_t cols, cons
   H5Id ds(H5Dopen2(file_id, name.c_str(), H5P_DEFAULT), H5Dclose);
   FLOESIM_REQUIRE(ds.id >= 0, file, ": cannot open dataset ", name);
   H5Id space(H5Dget_space(ds), H5Sclose);
-  int rank = H5Sget_simple_extent_ndims(space);
+  // The rank is checked before the dimensions are read into dims[2] (a rank-3 dataset overran it), and the row
+  // count against the file's size before anything is allocated (a damaged header may claim 2^62 rows: the product
+  // with the columns wrapped around, and H5Dread wrote past the buffer).
+  const int rank = H5Sget_simple_extent_ndims(space);
+  FLOESIM_REQUIRE(rank == 1 || rank == 2, file, ": dataset ", name, " has rank ", rank, ", expected 1 or 2 (damaged file?)");
   hsize_t dims[2] = {0, 1};
-  H5Sget_simple_extent_dims(space, dims, nullptr);
+  FLOESIM_REQUIRE(H5Sget_simple_extent_dims(space, dims, nullptr) == rank, file, ": cannot read the shape of dataset ",
+                  name);
   const size_t got_cols = rank == 2 ? dims[1] : 1;
   FLOESIM_REQUIRE(got_cols == cols, file, ": dataset ", name, " has ", got_cols, " columns, expected ", cols);
+  FLOESIM_REQUIRE(dims[0] <= max_rows(file, cols * sizeof(T)), file, ": dataset ", name, " claims ", dims[0],
+                  " rows, more than a file of this size can hold (damaged file?)");
   std::vector<T> v(dims[0] * got_cols);
   if (!v.empty())
     FLOESIM_REQUIRE(H5Dread(ds, h5type<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) >= 0, file,
@@ -349,15 +364,25 @@ Results read_results(const std::filesystem::path& path, bool with_states) {
     FLOESIM_REQUIRE(H5Aexists(fid, "floesim") > 0, file, ": no 'floesim' attribute: not a floesim results file");
     H5Id at(H5Aopen(fid, "floesim", H5P_DEFAULT), H5Aclose);
     H5Id st(H5Aget_type(at), H5Tclose);
-    std::string text(H5Tget_size(st), '\0');
+    H5Id as(H5Aget_space(at), H5Sclose);
+    // One fixed-length string (an array of them would be read past the buffer), of a size the file can hold.
+    const size_t text_size = H5Tget_size(st);
+    FLOESIM_REQUIRE(at.id >= 0 && H5Tget_class(st) == H5T_STRING && H5Tis_variable_str(st) == 0 &&
+                        H5Sget_simple_extent_npoints(as) == 1 && text_size > 0 &&
+                        text_size <= std::filesystem::file_size(path),
+                    file, ": the 'floesim' attribute is not one JSON string: not a floesim results file");
+    std::string text(text_size, '\0');
     H5Id mt(H5Tcopy(H5T_C_S1), H5Tclose);
     H5Tset_size(mt, text.size());
     FLOESIM_REQUIRE(H5Aread(at, mt, text.data()) >= 0, file, ": cannot read the attributes");
     text.resize(std::strlen(text.c_str()));
     r.attributes = nlohmann::json::parse(text, nullptr, false);
-    FLOESIM_REQUIRE(!r.attributes.is_discarded(), file, ": the 'floesim' attribute is not JSON");
+    FLOESIM_REQUIRE(!r.attributes.is_discarded() && r.attributes.is_object(), file,
+                    ": the 'floesim' attribute is not a JSON object");
   }
-  const std::string layout = r.attributes.value("layout", "?");
+  const auto layout_it = r.attributes.find("layout");
+  const std::string layout =
+      layout_it != r.attributes.end() && layout_it->is_string() ? layout_it->get<std::string>() : "?";
   int version = 0;
   for (int v = 1; v <= kLayoutVersion; ++v)
     if (layout == layout_name(v)) version = v;
@@ -382,10 +407,18 @@ Results read_results(const std::filesystem::path& path, bool with_states) {
                                       : std::vector<int8_t>(r.state_body_id.size(), 0);
     FLOESIM_REQUIRE(r.state_position_m.size() == 3 * r.state_body_id.size() &&
                         r.state_quaternion.size() == 4 * r.state_body_id.size() &&
-                        r.state_in_contact.size() == r.state_body_id.size() &&
-                        static_cast<size_t>(r.frame_offset.back()) == r.state_body_id.size(),
-                    file, ": /states arrays disagree with /frames/offset");
+                        r.state_in_contact.size() == r.state_body_id.size(),
+                    file, ": /states arrays have different lengths");
   }
+  // Offsets index the arrays after them: 0, non-decreasing, ending at their length (the render walks them).
+  auto check_offsets = [&](const std::vector<int64_t>& off, size_t rows, const char* name, const char* of) {
+    FLOESIM_REQUIRE(!off.empty() && off.front() == 0, file, ": ", name, " does not start at 0");
+    for (size_t k = 1; k < off.size(); ++k)
+      FLOESIM_REQUIRE(off[k] >= off[k - 1], file, ": ", name, " decreases at row ", k);
+    FLOESIM_REQUIRE(static_cast<uint64_t>(off.back()) == rows, file, ": ", name, " ends at ", off.back(), ", but ", of,
+                    " has ", rows, " rows");
+  };
+  if (with_states) check_offsets(r.frame_offset, r.state_body_id.size(), "/frames/offset", "/states/body_id");
   r.floe_id = read_ds<int32_t>(fid, "/geometry/floe_id", 1, file);
   r.floe_thickness_m = read_ds<double>(fid, "/geometry/floe_thickness_m", 1, file);
   r.floe_vertex_offset = read_ds<int64_t>(fid, "/geometry/floe_vertex_offset", 1, file);
@@ -393,6 +426,14 @@ Results read_results(const std::filesystem::path& path, bool with_states) {
   r.hull_vertices_m = read_ds<double>(fid, "/geometry/hull_vertices_m", 3, file);
   r.hull_triangles = read_ds<int32_t>(fid, "/geometry/hull_triangles", 3, file);
   FLOESIM_REQUIRE(r.floe_vertex_offset.size() == r.floe_id.size() + 1, file, ": floe vertex offsets disagree");
+  FLOESIM_REQUIRE(r.floe_thickness_m.size() == r.floe_id.size(), file,
+                  ": /geometry/floe_thickness_m and /geometry/floe_id have different lengths");
+  check_offsets(r.floe_vertex_offset, r.floe_vertices_m.size() / 2, "/geometry/floe_vertex_offset",
+                "/geometry/floe_vertices_m");
+  const int64_t hull_vertices = static_cast<int64_t>(r.hull_vertices_m.size() / 3);
+  for (int32_t t : r.hull_triangles)
+    FLOESIM_REQUIRE(t >= 0 && t < hull_vertices, file, ": /geometry/hull_triangles names vertex ", t, ", but there are ",
+                    hull_vertices);
 
   const size_t floes = r.floe_id.size();
   if (before_fracture) {

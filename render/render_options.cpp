@@ -21,6 +21,8 @@ Check<std::vector<std::string>> two_views() {
   };
 }
 
+// The plot's check too (declared in render_options.h): the checks of the render stages' options need no rendering
+// code (tests/fuzz/fuzz_options reads every options struct without linking the renderer).
 Check<Json> auto_or_number(bool strictly_positive) {
   return [strictly_positive](const Json& j) {
     if (j.is_string() && j.get<std::string>() == "auto") return std::string();

@@ -731,6 +731,11 @@ HullModel load_hull(const fs::path& file, const HullLoadOptions& o, const HullPl
     const Eigen::Matrix4d world = up * local;
     const bool mirrored = world.topLeftCorner<3, 3>().determinant() < 0;
     for (unsigned i = 0; i < node->mNumMeshes; ++i) {
+      // assimp does not validate what its importers build (no aiProcess_ValidateDataStructure, which also refuses
+      // harmless files): indices are checked here before they index anything.
+      FLOESIM_REQUIRE(node->mMeshes[i] < scene->mNumMeshes && scene->mMeshes[node->mMeshes[i]] != nullptr, where,
+                      ": the file's node tree references mesh ", node->mMeshes[i], " of ", scene->mNumMeshes,
+                      " (damaged file)");
       const aiMesh* mesh = scene->mMeshes[node->mMeshes[i]];
       Instance in;
       in.name = mesh->mName.length > 0 ? mesh->mName.C_Str()
@@ -747,6 +752,9 @@ HullModel load_hull(const fs::path& file, const HullLoadOptions& o, const HullPl
           ++in.skipped_faces;
           continue;
         }
+        for (unsigned k = 0; k < 3; ++k)
+          FLOESIM_REQUIRE(face.mIndices[k] < mesh->mNumVertices, where, ": mesh '", in.name, "' face ", f,
+                          " names vertex ", face.mIndices[k], " of ", mesh->mNumVertices, " (damaged file)");
         std::array<int, 3> t{int(face.mIndices[0]), int(face.mIndices[1]), int(face.mIndices[2])};
         if (mirrored) std::swap(t[1], t[2]);  // a mirroring transform turns outward normals inward
         in.t.push_back(t);

@@ -124,6 +124,10 @@ CasePlan plan_case(const Json& c, const std::string& where, const fs::path& case
     fs::path p = j.at(key).get<std::string>();
     if (p.is_relative()) p = fs::absolute(case_dir) / p;
     FLOESIM_REQUIRE(fs::exists(p), cf, ": ", where, ".", key, " names ", p.string(), ", which does not exist");
+    // A folder (".", "") was hashed as if empty, and a device (/dev/zero) was hashed forever: only a file will do.
+    std::error_code ec;
+    FLOESIM_REQUIRE(fs::is_regular_file(p, ec), cf, ": ", where, ".", key, " names ", p.string(),
+                    ", which is not a file (a folder or a device?): name the file itself");
     return p.lexically_normal();
   };
 

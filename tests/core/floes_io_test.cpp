@@ -52,7 +52,9 @@ TEST(FloesIo, ClockwiseRingsAreStoredCounterClockwise) {
 
 TEST(FloesIo, RejectsSelfIntersectionNamingTheFloe) {
   Json bow = square_feature(7, 0);
-  bow["geometry"]["coordinates"] = {Json::array({{0, 0}, {10, 10}, {10, 0}, {0, 10}, {0, 0}})};
+  // Json::array around the ring: a one-element brace list `{ring}` is the ring itself under clang, a list of it
+  // under gcc (nlohmann's initializer-list rule; the clang build of bench/sanitize found it).
+  bow["geometry"]["coordinates"] = Json::array({Json::array({{0, 0}, {10, 10}, {10, 0}, {0, 10}, {0, 0}})});
   const std::string e = error_of(collection({bow}));
   EXPECT_NE(e.find("floe id 7"), std::string::npos) << e;
   EXPECT_NE(e.find("intersects itself"), std::string::npos) << e;
@@ -68,4 +70,35 @@ TEST(FloesIo, RejectsHolesDuplicatesAndBadThickness) {
   thin["properties"]["thickness_m"] = -1;
   EXPECT_NE(error_of(collection({thin})).find("thickness_m must be > 0"), std::string::npos);
   EXPECT_NE(error_of(Json::object()).find("not a GeoJSON FeatureCollection"), std::string::npos);
+}
+
+// Members of the wrong type are clear errors, never a nlohmann exception or an unchecked cast (found by
+// tests/fuzz/fuzz_floes; the inputs are in tests/fuzz/crashes/fuzz_floes/).
+TEST(FloesIo, WrongTypesAreClearErrors) {
+  Json wide = collection({square_feature(1, 0)});
+  wide["floesim"] = {{"width_m", "wide"}};
+  EXPECT_NE(error_of(wide).find("floesim.width_m must be a number >= 0"), std::string::npos) << error_of(wide);
+  Json typed = collection({square_feature(1, 0)});
+  typed["type"] = 7;
+  EXPECT_NE(error_of(typed).find("not a GeoJSON FeatureCollection"), std::string::npos);
+  Json no_coords = square_feature(1, 0);
+  no_coords["geometry"].erase("coordinates");
+  EXPECT_NE(error_of(collection({no_coords})).find("has no coordinates"), std::string::npos);
+  Json geometry_type = square_feature(1, 0);
+  geometry_type["geometry"]["type"] = 3;
+  EXPECT_NE(error_of(collection({geometry_type})).find("has geometry type 3"), std::string::npos);
+  for (Json id : {Json(1e20), Json(1.5), Json("one"), Json(4294967297ll)}) {
+    Json f = square_feature(1, 0);
+    f["properties"]["id"] = id;
+    EXPECT_NE(error_of(collection({f})).find("properties.id must be an integer"), std::string::npos) << id;
+  }
+  Json thick = square_feature(1, 0);
+  thick["properties"]["thickness_m"] = "1 m";
+  EXPECT_NE(error_of(collection({thick})).find("properties.thickness_m must be a number"), std::string::npos);
+  Json ring = square_feature(1, 0);
+  ring["geometry"]["coordinates"] = Json::array({5});
+  EXPECT_NE(error_of(collection({ring})).find("coordinates[0] must be an array"), std::string::npos);
+  Json whole = square_feature(1, 0);
+  whole["properties"]["id"] = 2.0;  // an integral number is an integer
+  EXPECT_EQ(floes_from_geojson(collection({whole}), "f.geojson").floes.at(0).id, 2);
 }

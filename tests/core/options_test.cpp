@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+
 #include "pipeline/options.h"
 
 using namespace floesim;
@@ -75,4 +78,54 @@ TEST(Options, EchoRoundTrips) {
   Opts back = read_options<Opts>(echo, "echo.json");
   EXPECT_EQ(back.sections, 12);
   EXPECT_NE(options_doc(o).find("`inner.speed_mps`"), std::string::npos);
+}
+
+// An integer field takes only an integral value that fits: nlohmann's unchecked cast read 2.5 as 2 (silently) and
+// 1e20 as undefined behaviour (UBSan: float-cast-overflow; tests/fuzz/crashes/fuzz_options/int_overflow.json).
+TEST(Options, IntegerFieldRefusesFractionsAndValuesOutOfRange) {
+  for (const char* bad : {R"({"sections": 12.5})", R"({"sections": 1e20})", R"({"sections": -1e300})",
+                          R"({"sections": 4294967308})", R"({"sections": 18446744073709551615})"}) {
+    const std::string e = error_of(Json::parse(bad));
+    EXPECT_NE(e.find("sim.sections has the wrong type: expected an integer"), std::string::npos) << bad << ": " << e;
+  }
+  EXPECT_EQ(read_options<Opts>(Json::parse(R"({"sections": 12.0})"), "x.json").sections, 12);
+  EXPECT_EQ(read_options<Opts>(Json::parse(R"({"sections": 1.2e1})"), "x.json").sections, 12);
+}
+
+namespace {
+struct Seeded {
+  std::uint64_t seed = 1;
+  template <class V>
+  void visit(V& v) {
+    v.field("seed", seed, "-", "seed");
+  }
+};
+}  // namespace
+
+TEST(Options, UnsignedFieldRefusesNegativeAndFractionalValues) {
+  for (const char* bad : {R"({"seed": -1})", R"({"seed": -1.5})", R"({"seed": 1e30})", R"({"seed": 0.5})"}) {
+    try {
+      read_options<Seeded>(Json::parse(bad), "x.json");
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("seed has the wrong type"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(read_options<Seeded>(Json::parse(R"({"seed": 18446744073709551615})"), "x.json").seed,
+            18446744073709551615ull);
+}
+
+// A number too large for a double is nlohmann's out_of_range, not a parse_error: it escaped load_json_file and
+// was not the clear error every other bad file gives (found by tests/fuzz/fuzz_floes, crashes/fuzz_floes/crash-*).
+TEST(Options, NumberOverflowInAJsonFileIsAClearError) {
+  const std::filesystem::path f = std::filesystem::temp_directory_path() / "floesim_overflow.json";
+  std::ofstream(f) << R"({"thickness_m": 66e566})";
+  try {
+    load_json_file(f);
+    ADD_FAILURE() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("floesim_overflow.json: not valid JSON"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("number overflow"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(f);
 }

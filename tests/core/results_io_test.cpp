@@ -367,3 +367,81 @@ TEST(ResultsIo, LayoutOneFilesFromBeforeFractureReadWithDefaults) {
   EXPECT_NE(e.find("floesim-results/9"), std::string::npos) << e;
   fs::remove(p);
 }
+
+// Damaged files the reader once mis-read (found while fuzzing it, tests/fuzz/fuzz_results): each is a clear Error
+// naming the dataset, never an overrun buffer, a huge allocation or a nlohmann exception.
+TEST(ResultsIo, DamagedShapesAttributesAndOffsetsAreClearErrors) {
+  const fs::path p = fs::temp_directory_path() / "floesim_results_damaged.h5";
+  auto fresh = [&] { write_results(p, small_results(3)); };
+  auto expect_error = [&](const std::string& what) {
+    const std::string e = error_of([&] { read_results(p); });
+    EXPECT_NE(e.find(what), std::string::npos) << "expected '" << what << "', got: " << e;
+  };
+  // A dataset of rank 3 (its dimensions used to be read into an array of two).
+  fresh();
+  {
+    const hid_t f = H5Fopen(p.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(H5Ldelete(f, "/frames/time_s", H5P_DEFAULT), 0);
+    const hsize_t dims[3] = {2, 1, 1};
+    const hid_t sp = H5Screate_simple(3, dims, nullptr);
+    const hid_t ds = H5Dcreate2(f, "/frames/time_s", H5T_NATIVE_DOUBLE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    H5Dclose(ds);
+    H5Sclose(sp);
+    H5Fclose(f);
+  }
+  expect_error("dataset /frames/time_s has rank 3");
+  // A dataset that claims far more rows than the file holds (chunked, nothing written: only fill values).
+  fresh();
+  {
+    const hid_t f = H5Fopen(p.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(H5Ldelete(f, "/states/body_id", H5P_DEFAULT), 0);
+    const hsize_t dims[1] = {hsize_t(1) << 40}, chunk[1] = {1024};
+    const hid_t sp = H5Screate_simple(1, dims, nullptr);
+    const hid_t pl = H5Pcreate(H5P_DATASET_CREATE);
+    H5Pset_chunk(pl, 1, chunk);
+    const hid_t ds = H5Dcreate2(f, "/states/body_id", H5T_NATIVE_INT32, sp, H5P_DEFAULT, pl, H5P_DEFAULT);
+    ASSERT_GE(ds, 0);
+    H5Dclose(ds);
+    H5Pclose(pl);
+    H5Sclose(sp);
+    H5Fclose(f);
+  }
+  expect_error("dataset /states/body_id claims 1099511627776 rows");
+  // The attribute: not an object, a layout that is not a string, an array of strings.
+  fresh();
+  replace_attributes(p, 5);
+  expect_error("the 'floesim' attribute is not a JSON object");
+  fresh();
+  replace_attributes(p, {{"layout", 3}});
+  expect_error("layout ? is not supported");
+  fresh();
+  {
+    const hid_t f = H5Fopen(p.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(H5Adelete(f, "floesim"), 0);
+    const hid_t st = H5Tcopy(H5T_C_S1);
+    H5Tset_size(st, 4);
+    const hsize_t n[1] = {3};
+    const hid_t sp = H5Screate_simple(1, n, nullptr);
+    const hid_t at = H5Acreate2(f, "floesim", st, sp, H5P_DEFAULT, H5P_DEFAULT);
+    EXPECT_GE(H5Awrite(at, st, "{}\0\0{}\0\0{}\0\0"), 0);
+    H5Aclose(at);
+    H5Sclose(sp);
+    H5Tclose(st);
+    H5Fclose(f);
+  }
+  expect_error("the 'floesim' attribute is not one JSON string");
+  // Offsets and indices that point outside their arrays (a reader of the frames would have run past them).
+  fresh();
+  replace_dataset<int64_t>(p, "/frames/offset", {0, 3, 2}, 1);
+  expect_error("/frames/offset decreases at row 2");
+  fresh();
+  replace_dataset<int64_t>(p, "/geometry/floe_vertex_offset", {0, 7}, 1);
+  expect_error("/geometry/floe_vertex_offset ends at 7, but /geometry/floe_vertices_m has 3 rows");
+  fresh();
+  replace_dataset<int32_t>(p, "/geometry/hull_triangles", {0, 1, 9}, 3);
+  expect_error("/geometry/hull_triangles names vertex 9");
+  fresh();
+  replace_dataset<double>(p, "/states/quaternion_wxyz", {1, 0, 0, 0}, 4);
+  expect_error("/states arrays have different lengths");
+  fs::remove(p);
+}

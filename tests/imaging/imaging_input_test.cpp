@@ -164,5 +164,33 @@ TEST(SynthBadInput, CrossFieldChecks) {
   }
 }
 
+
+TEST_F(DigitiseBadInput, HugeTiffRefusedFromItsHeader) {
+  // A little-endian TIFF announcing 30000 x 30000 pixels with 16 bytes of data: OpenCV allocated 900 MB and decoded
+  // for seconds before the size was checked (tests/fuzz/fuzz_image); now refused from its header.
+  std::string t = std::string("II*\0", 4) + std::string("\x18\0\0\0", 4) + std::string(16, '\x80');
+  auto entry = [&](uint16_t tag, uint16_t type, uint32_t value) {
+    const unsigned char e[12] = {uint8_t(tag), uint8_t(tag >> 8), uint8_t(type), 0, 1, 0, 0, 0,
+                                 uint8_t(value), uint8_t(value >> 8), uint8_t(value >> 16), uint8_t(value >> 24)};
+    t.append(reinterpret_cast<const char*>(e), 12);
+  };
+  t += std::string("\x06\0", 2);
+  entry(256, 4, 30000);
+  entry(257, 4, 30000);
+  entry(258, 3, 8);
+  entry(262, 3, 1);
+  entry(273, 4, 8);
+  entry(279, 4, 16);
+  t += std::string(4, '\0');
+  const auto f = dir_.path / "huge.tif";
+  std::ofstream(f, std::ios::binary) << t;
+  int w = 0, h = 0;
+  ASSERT_TRUE(read_image_size(f, w, h));
+  EXPECT_EQ(w, 30000);
+  EXPECT_EQ(h, 30000);
+  DigitiseRequest r = request(f);
+  r.config = {{"max_pixels", 1e8}};
+  expect_refused(r, {"huge.tif", "30000 x 30000", "900 megapixels", "max_pixels"});
+}
 }  // namespace
 }  // namespace floesim::imaging
