@@ -24,6 +24,7 @@ floesim::Results small_results() {
   r.state_body_id = {0, 1};
   r.state_position_m = {0, 0, 0, 10, 0, 0};
   r.state_quaternion = {1, 0, 0, 0, 1, 0, 0, 0};
+  r.state_in_contact = {0, 1};
   r.floe_id = {1, 2};
   r.floe_thickness_m = {1.0, 1.0};
   r.floe_vertex_offset = {0, 3, 6};
@@ -154,7 +155,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       if (r.floe_vertex_offset[k] < 0 || r.floe_vertex_offset[k] > r.floe_vertex_offset[k + 1] ||
           size_t(r.floe_vertex_offset[k + 1]) > r.floe_vertices_m.size() / 2)
         std::abort();
-    if (r.state_quaternion.size() != 4 * R || r.floe_thickness_m.size() != r.floe_id.size()) std::abort();
+    if (r.state_quaternion.size() != 4 * R || r.state_in_contact.size() != R ||
+        r.floe_thickness_m.size() != r.floe_id.size())
+      std::abort();
     for (const auto& f : floesim::series_fields())
       if (r.get(f.name).size() != r.steps() * f.cols) std::abort();
   });
