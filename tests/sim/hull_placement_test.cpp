@@ -17,6 +17,7 @@
 #include "pipeline/options.h"
 #include "sim/hull.h"
 #include "tests/sim/obj_faces.h"
+#include "tests/sim/sim_fixtures.h"
 
 #ifndef FLOESIM_SHARED_DATA_DIR
 #error "FLOESIM_SHARED_DATA_DIR must be defined by the build"
@@ -28,19 +29,8 @@ namespace {
 namespace fs = std::filesystem;
 using testing::read_obj_faces;
 
-fs::path temp_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("floesim_hull_placement_test_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-fs::path hull_file(const std::string& name) {
-  const fs::path f = fs::path(FLOESIM_SHARED_DATA_DIR) / "hulls" / name;
-  if (!fs::exists(f))
-    ADD_FAILURE() << "test data missing: " << f << " (FLOESIM_SHARED_DATA_DIR must hold ../shared/data)";
-  return f;
-}
+using testing::hull_file;
+using testing::temp_dir;
 
 // A copy of an OBJ (in a temporary folder, never in the repository) with every vertex v -> scale * (v + shift):
 // the same hull as a CAD file might hold it (keel at z = 0, full scale).

@@ -12,6 +12,7 @@
 #include "pipeline/error.h"
 #include "sim/hull.h"
 #include "tests/sim/obj_faces.h"
+#include "tests/sim/sim_fixtures.h"
 
 #ifndef FLOESIM_SHARED_DATA_DIR
 #error "FLOESIM_SHARED_DATA_DIR must be defined by the build"
@@ -22,19 +23,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path temp_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("floesim_hull_test_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-fs::path hull_file(const std::string& name) {
-  const fs::path f = fs::path(FLOESIM_SHARED_DATA_DIR) / "hulls" / name;
-  if (!fs::exists(f))
-    ADD_FAILURE() << "test data missing: " << f << " (FLOESIM_SHARED_DATA_DIR must hold ../shared/data)";
-  return f;
-}
+using testing::hull_file;
+using testing::temp_dir;
 
 // Half-breadths of the waterline: points where edges of the parts cross z = 0.
 struct Waterline {

@@ -1,11 +1,13 @@
 // A reference reader of an OBJ's own faces (fan-triangulated, no welding), independent of assimp and of the hull
-// loader, so the loader's results can be checked against the raw file.
+// loader, so the loader's results can be checked against the raw file; and where the real hulls are.
 #pragma once
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <gtest/gtest.h>
 
 #include "sim/mesh.h"
 
@@ -29,6 +31,14 @@ inline TriMesh read_obj_faces(const std::filesystem::path& file) {
     }
   }
   return m;
+}
+
+// A real hull of ../shared/data/hulls (read from there, never copied into the repository); a test failure if absent.
+inline std::filesystem::path hull_file(const std::string& name) {
+  const std::filesystem::path f = std::filesystem::path(FLOESIM_SHARED_DATA_DIR) / "hulls" / name;
+  if (!std::filesystem::exists(f))
+    ADD_FAILURE() << "test data missing: " << f << " (FLOESIM_SHARED_DATA_DIR must hold ../shared/data)";
+  return f;
 }
 
 }  // namespace floesim::sim::testing

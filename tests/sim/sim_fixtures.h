@@ -2,8 +2,12 @@
 // options with the pieces of physics a test needs switched on.
 #pragma once
 #include <filesystem>
+#include <initializer_list>
 #include <string>
 
+#include <gtest/gtest.h>
+
+#include "pipeline/error.h"
 #include "pipeline/floes_io.h"
 #include "sim/hull.h"
 #include "sim/model.h"
@@ -52,6 +56,18 @@ inline HullModel box_hull(double lx, double ly, double z0, double hz) {
   h.parts = {extrude_polygon(rect, z0, hz)};
   h.surface = h.parts[0];
   return h;
+}
+
+// Runs f, expects floesim::Error whose message contains every piece.
+template <class F>
+void expect_error(F f, std::initializer_list<const char*> pieces) {
+  try {
+    f();
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    for (const char* p : pieces) EXPECT_NE(msg.find(p), std::string::npos) << "missing '" << p << "' in: " << msg;
+  }
 }
 
 // A fresh temporary directory for one test.

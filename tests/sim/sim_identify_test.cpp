@@ -23,16 +23,7 @@ using testing::temp_dir;
 
 const fs::path kBin = FLOESIM_BIN_DIR;
 
-template <class F>
-void expect_error(F f, std::initializer_list<const char*> pieces) {
-  try {
-    f();
-    ADD_FAILURE() << "no error";
-  } catch (const Error& e) {
-    const std::string msg = e.what();
-    for (const char* p : pieces) EXPECT_NE(msg.find(p), std::string::npos) << "missing '" << p << "' in: " << msg;
-  }
-}
+using testing::expect_error;
 
 // The test's own Fossen wind load (written out here, not the code under test): q = 1/2 rho V^2.
 Load3 hand_wind(double V, double gamma_deg, double rho, double af, double al, double loa, double cx, double cy,

@@ -14,17 +14,7 @@ namespace {
 using testing::rect_floe;
 using testing::temp_dir;
 
-// Runs f, expects floesim::Error whose message contains every piece.
-template <class F>
-void expect_error(F f, std::initializer_list<const char*> pieces) {
-  try {
-    f();
-    ADD_FAILURE() << "no error";
-  } catch (const Error& e) {
-    const std::string msg = e.what();
-    for (const char* p : pieces) EXPECT_NE(msg.find(p), std::string::npos) << "missing '" << p << "' in: " << msg;
-  }
-}
+using testing::expect_error;
 
 SimulateOptions options_from(const nlohmann::json& j) { return read_options<SimulateOptions>(j, "sim.json"); }
 

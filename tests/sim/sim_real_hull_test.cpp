@@ -18,12 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path hull_file(const std::string& name) {
-  const fs::path p = fs::path(FLOESIM_SHARED_DATA_DIR) / "hulls" / name;
-  if (!fs::exists(p))
-    ADD_FAILURE() << "missing test data " << p << " (FLOESIM_SHARED_DATA_DIR must hold hulls/; CI always has it)";
-  return p;
-}
+using testing::hull_file;
 
 // The raw mesh (all faces of the OBJ, no welding or slicing): its volume below z = 0 is what the ship displaces.
 double raw_displaced_volume(const fs::path& f) {
