@@ -8,37 +8,13 @@
 #include <cmath>
 
 #include "fuzz_util.h"
+#include "small_results.h"
 #include "pipeline/results_io.h"
 
 namespace {
 
-// Two steps, one frame of two bodies, one floe (a triangle), one hull triangle, no fracture events.
-void write_seed(const char* out) {
-  floesim::Results r;
-  for (const auto& f : floesim::series_fields()) {
-    auto& v = r.series[f.name];
-    v.assign(2 * f.cols, 0.0);
-  }
-  r.series["time_s"] = {0.0, 0.01};
-  r.frame_time_s = {0.0};
-  r.frame_offset = {0, 2};
-  r.state_body_id = {0, 1};
-  r.state_position_m = {0, 0, 0, 10, 0, 0};
-  r.state_quaternion = {1, 0, 0, 0, 1, 0, 0, 0};
-  r.floe_id = {1};
-  r.floe_thickness_m = {1.0};
-  r.floe_vertex_offset = {0, 3};
-  r.floe_vertices_m = {-1, -1, 2, -1, -1, 2};
-  r.floe_parent_id = {-1};
-  r.floe_generation = {0};
-  r.floe_origin_mode = {0};
-  r.floe_created_s = {0.0};
-  r.floe_ended_s = {INFINITY};
-  r.hull_vertices_m = {0, 0, 0, 1, 0, 0, 0, 1, 0};
-  r.hull_triangles = {0, 1, 2};
-  r.attributes = {{"time_step_s", 0.01}, {"duration_s", 0.02}, {"output_interval_s", 0.01}};
-  floesim::write_results(out, r);
-}
+// The seed: a small valid results file (the one fuzz_results starts from).
+void write_seed(const char* out) { floesim::write_results(out, floesim::fuzz::small_results()); }
 
 }  // namespace
 
