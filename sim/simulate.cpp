@@ -146,11 +146,8 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
   return f;
 }
 
-// Level ice (issue #10): what the vessel broke of the sheet. Along the vessel's start heading (u) from the sheet's
-// edge where the vessel meets it (the smallest u of a sheet vertex within half a beam of the track) to where the
-// vessel's centre of mass is at the end: behind midship the channel is fully formed. The sheet's area there at the
-// start (the model's tiles) minus at the end (the tiles alive in the last frame), over that length, is the mean
-// width of the channel; against the waterline beam (the beam over the reamers).
+}  // namespace
+
 nlohmann::json level_ice_summary(const Model& model, const Results& r) {
   nlohmann::json j;
   const int v = model.vessel;
@@ -165,14 +162,21 @@ nlohmann::json level_ice_summary(const Model& model, const Results& r) {
   const Vec2 start = vb.initial_position.head<2>();
   auto to_track = [&](const Vec2& p) { return Vec2(along.dot(p - start), across.dot(p - start)); };
   const double beam = model.vessel_info.beam_wl_m;
+  const double far = 1e6;
+  auto world = [&](double u, double w) { return Vec2(start + u * along + w * across); };
+  auto placed = [](const Polygon& outline, const Vec2& at) {
+    Polygon w;
+    for (const Vec2& p : outline) w.push_back(p + at);
+    return w;
+  };
+  // The vessel's path: the band half a beam either side of its start line.
+  const Polygon path = {world(-far, -beam / 2), world(far, -beam / 2), world(far, beam / 2), world(-far, beam / 2)};
   double sheet_area = 0, u_edge = std::numeric_limits<double>::infinity();
   for (int b : tiles) {
     const Body& t = model.bodies[b];
     sheet_area += t.section_area;
-    for (const Vec2& p : t.outline) {
-      const Vec2 q = to_track(p + t.initial_position.head<2>());
-      if (std::abs(q.y()) <= beam / 2) u_edge = std::min(u_edge, q.x());
-    }
+    for (const Polygon& piece : polygon_intersection(placed(t.outline, t.initial_position.head<2>()), path))
+      for (const Vec2& p : piece) u_edge = std::min(u_edge, to_track(p).x());
   }
   j["sheet_area_start_m2"] = sheet_area;
   // The vessel at the end (last frame) and the tiles alive then.
@@ -187,14 +191,10 @@ nlohmann::json level_ice_summary(const Model& model, const Results& r) {
   nlohmann::json channel = {{"beam_m", beam}};
   if (std::isfinite(u_edge) && u_end > u_edge + 1.0) {
     // The window as a polygon in the world: the strip between u_edge and u_end, as wide as the sheet could be.
-    const double far = 1e6;
-    auto world = [&](double u, double w) { return Vec2(start + u * along + w * across); };
     const Polygon strip = {world(u_edge, -far), world(u_end, -far), world(u_end, far), world(u_edge, far)};
     auto area_in_strip = [&](const Polygon& outline, const Vec2& at) {
-      Polygon w;
-      for (const Vec2& p : outline) w.push_back(p + at);
       double a = 0;
-      for (const Polygon& piece : polygon_intersection(w, strip)) a += signed_area(piece);
+      for (const Polygon& piece : polygon_intersection(placed(outline, at), strip)) a += signed_area(piece);
       return a;
     };
     double before = 0, after = 0;
@@ -220,8 +220,6 @@ nlohmann::json level_ice_summary(const Model& model, const Results& r) {
   j["channel"] = channel;
   return j;
 }
-
-}  // namespace
 
 std::vector<double> moving_average(const std::vector<double>& x, size_t n) {
   std::vector<double> y;

@@ -196,6 +196,45 @@ TEST(LevelIce, TransitIsByteIdenticalOnRerunAndAcrossThreads) {
   EXPECT_EQ(bytes[0], bytes[2]);
 }
 
+TEST(LevelIce, ChannelWidthIsTheSheetAreaLostBehindMidshipOverItsLength) {
+  // A 100 m x 100 m sheet (one tile) ahead of the coarse hull (start x = -60, heading +x); at the end the vessel's
+  // centre is at x = 80 and the tile left is the sheet with a channel 20 m wide cut from x = 0 to x = 90 (ahead of
+  // the window's end, as the bow reaches past midship). By hand: the window runs from the sheet's edge (x = 0) to
+  // x = 80, the area lost there is 80 x 20 m^2, the mean width 20 m.
+  SimulateOptions o = testing::floe_options();
+  o.vessel.x_m = -60;
+  o.level_ice.extent_m = {0, -50, 100, 50};
+  o.level_ice.tile_m = 200;
+  const HullModel hull = coarse_hull();
+  const Model m = build_model(FloeField{}, &hull, o);
+  ASSERT_EQ(tiles_of(m).size(), 1u);
+  const Polygon left = {Vec2(0, -50), Vec2(100, -50), Vec2(100, 50), Vec2(0, 50),
+                        Vec2(0, 10),  Vec2(90, 10),   Vec2(90, -10), Vec2(0, -10)};
+  const Vec2 c = centroid(left);
+  Results r;
+  r.frame_time_s = {10.0};
+  r.frame_offset = {0, 2};
+  r.state_body_id = {0, 99};
+  r.state_position_m = {80, 0, 0, c.x(), c.y(), 0};
+  r.state_quaternion = {1, 0, 0, 0, 1, 0, 0, 0};
+  r.state_in_contact = {0, 0};
+  r.floe_id = {1, 99};
+  r.floe_level_ice = {1, 1};
+  r.floe_vertex_offset = {0, 4};
+  for (const Vec2& p : m.bodies[tiles_of(m)[0]].outline) r.floe_vertices_m.insert(r.floe_vertices_m.end(), {p.x(), p.y()});
+  for (const Vec2& p : left) r.floe_vertices_m.insert(r.floe_vertices_m.end(), {p.x() - c.x(), p.y() - c.y()});
+  r.floe_vertex_offset.push_back(static_cast<int64_t>(r.floe_vertices_m.size() / 2));
+  const Json j = level_ice_summary(m, r);
+  EXPECT_EQ(j["tiles_start"], 1);
+  EXPECT_NEAR(j["sheet_area_start_m2"].get<double>(), 1e4, 1e-6);
+  const Json& ch = j["channel"];
+  EXPECT_NEAR(ch["from_m"].get<double>(), 60.0, 1e-9);  // along the track from the vessel's start
+  EXPECT_NEAR(ch["to_m"].get<double>(), 140.0, 1e-9);
+  EXPECT_NEAR(ch["broken_area_m2"].get<double>(), 1600.0, 1e-6);
+  EXPECT_NEAR(ch["mean_width_m"].get<double>(), 20.0, 1e-9);
+  EXPECT_NEAR(ch["width_over_beam"].get<double>(), 20.0 / m.vessel_info.beam_wl_m, 1e-12);
+}
+
 TEST(LevelIce, BadInputNamesTheKeyAndTheFix) {
   const std::vector<std::pair<std::string, std::string>> bad = {
       {R"({"level_ice": {"extent_m": [0, 0, 100]}})", "level_ice.extent_m"},
