@@ -405,8 +405,17 @@ void World::stage_sleep() {
   for (int b : awake_list_) island_ok_[b] = 1;
   for (int b : awake_list_)
     if (b == model_.vessel || state_.still_time_s[b] < s.time_s) island_ok_[find(b)] = 0;
+  // Far astern (sleep.freeze_astern_m): asleep at any speed; the island rule above no longer applies to it.
+  const int vessel = model_.vessel;
+  const bool freeze = s.freeze_astern_m > 0 && vessel >= 0;
+  const Vec3 heading = freeze ? Vec3(state_.orientation[vessel] * Vec3::UnitX()) : Vec3::UnitX();
+  auto far_astern = [&](int b) {
+    const Vec3 d = state_.position[b] - state_.position[vessel];
+    return d.dot(heading) < 0 && d.head<2>().norm() > s.freeze_astern_m;
+  };
   for (int b : awake_list_) {
-    if (b == model_.vessel || !state_.alive[b] || !island_ok_[find(b)]) continue;
+    if (b == model_.vessel || !state_.alive[b]) continue;
+    if (!island_ok_[find(b)] && !(freeze && far_astern(b))) continue;
     state_.awake[b] = 0;
     state_.velocity[b].setZero();
     state_.angular_velocity[b].setZero();

@@ -235,6 +235,31 @@ TEST(LevelIce, ChannelWidthIsTheSheetAreaLostBehindMidshipOverItsLength) {
   EXPECT_NEAR(ch["width_over_beam"].get<double>(), 20.0 / m.vessel_info.beam_wl_m, 1e-12);
 }
 
+TEST(LevelIce, FloesFarAsternSleepAtAnySpeed) {
+  // sleep.freeze_astern_m = 150: of three floes drifting at 0.5 m/s, the one 300 m astern of the vessel falls asleep
+  // after one step, the ones 100 m astern and 300 m ahead keep moving.
+  SimulateOptions o = testing::floe_options();
+  o.sleep.enabled = true;
+  o.sleep.freeze_astern_m = 150;
+  o.vessel.x_m = 0;
+  FloeField f;
+  f.floes = {testing::rect_floe(1, -310, 40, 20, 20, 1.0), testing::rect_floe(2, -110, 40, 20, 20, 1.0),
+             testing::rect_floe(3, 290, 40, 20, 20, 1.0)};
+  const HullModel hull = coarse_hull();
+  const Model m = build_model(f, &hull, o);
+  World w(m);
+  for (int b = 1; b <= 3; ++b) {
+    w.wake(b);
+    w.mutable_state().velocity[b] = Vec3(0, 0.5, 0);
+  }
+  w.step();
+  EXPECT_EQ(w.state().awake[1], 0);
+  EXPECT_EQ(w.state().velocity[1], Vec3::Zero());
+  EXPECT_EQ(w.state().awake[2], 1);
+  EXPECT_EQ(w.state().awake[3], 1);
+  EXPECT_GT(w.state().velocity[2].y(), 0.4);
+}
+
 TEST(LevelIce, BadInputNamesTheKeyAndTheFix) {
   const std::vector<std::pair<std::string, std::string>> bad = {
       {R"({"level_ice": {"extent_m": [0, 0, 100]}})", "level_ice.extent_m"},
@@ -248,6 +273,7 @@ TEST(LevelIce, BadInputNamesTheKeyAndTheFix) {
       {R"({"level_ice": {"thickness_profile": [{"x_m": 0, "thickness_m": -1}]}})",
        "level_ice.thickness_profile[0].thickness_m"},
       {R"({"level_ice": {"sheet": 1}})", "sheet"},
+      {R"({"sleep": {"freeze_astern_m": -1}})", "sleep.freeze_astern_m"},
   };
   for (const auto& [text, key] : bad) {
     try {
