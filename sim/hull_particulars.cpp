@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <functional>
 #include <limits>
 #include <map>
+#include <utility>
 #include <vector>
 
 #include "pipeline/error.h"
@@ -127,6 +127,8 @@ double lowest_z_at(const TriMesh& m, double x) {
 HullParticulars measure_particulars(const TriMesh& surface, const std::string& where) {
   using D = ParticularsDefinition;
   HullParticulars r;
+  for (const Vec3& v : surface.vertices)
+    FLOESIM_REQUIRE(v.allFinite(), where, ": the hull has a vertex that is not a finite number");
   // 1. The waterline and its main part: the section's segments joined where they share an end point (exactly: see
   //    section()) into connected pieces; the piece of longest x extent is the hull's waterline. A rudder that pierces
   //    the water is a closed outline of its own even where it lies under the hull's counter (KCS).
@@ -139,7 +141,12 @@ HullParticulars measure_particulars(const TriMesh& surface, const std::string& w
     if (fresh) parent.push_back(it->second);
     return it->second;
   };
-  std::function<int(int)> root = [&](int i) { return parent[i] == i ? i : parent[i] = root(parent[i]); };
+  auto root = [&](int i) {  // union-find, iterative (a waterline may have many thousand points)
+    int r = i;
+    while (parent[r] != r) r = parent[r];
+    while (parent[i] != r) i = std::exchange(parent[i], r);
+    return r;
+  };
   std::vector<std::pair<int, int>> ends;
   for (const Seg& g : wl) {
     ends.emplace_back(id_of(g.p), id_of(g.q));

@@ -94,7 +94,8 @@ std::string run_resistance(const ResistanceOptions& o, const fs::path& hull_json
   } catch (const Error& e) {
     std::string from;
     for (const auto& [k, s] : sources) from += "\n  hull." + k + " from " + s;
-    throw Error(std::string(e.what()) + "\n(the hull's particulars came from:" + from + ")");
+    throw Error(std::string(e.what()) + "\n(the hull's particulars came from:" + from +
+                "\nany of them can be replaced in the config's \"hull\" section, e.g. {\"hull\": {\"stem_angle_deg\": 60}})");
   }
 
   // 2. The record: hull (with where each value came from), ice, rows in kN, provenance.
