@@ -142,10 +142,10 @@ HullParticulars measure_particulars(const TriMesh& surface, const std::string& w
     return it->second;
   };
   auto root = [&](int i) {  // union-find, iterative (a waterline may have many thousand points)
-    int r = i;
-    while (parent[r] != r) r = parent[r];
-    while (parent[i] != r) i = std::exchange(parent[i], r);
-    return r;
+    int top = i;
+    while (parent[top] != top) top = parent[top];
+    while (parent[i] != top) i = std::exchange(parent[i], top);
+    return top;
   };
   std::vector<std::pair<int, int>> ends;
   for (const Seg& g : wl) {
@@ -155,7 +155,7 @@ HullParticulars measure_particulars(const TriMesh& surface, const std::string& w
   }
   std::map<int, std::pair<double, double>> extent;  // root -> x range
   for (size_t i = 0; i < wl.size(); ++i) {
-    auto [it, fresh] = extent.emplace(root(ends[i].first), std::make_pair(kInf, -kInf));
+    const auto it = extent.emplace(root(ends[i].first), std::make_pair(kInf, -kInf)).first;
     it->second.first = std::min({it->second.first, wl[i].p.x(), wl[i].q.x()});
     it->second.second = std::max({it->second.second, wl[i].p.x(), wl[i].q.x()});
   }

@@ -33,7 +33,7 @@ double kn(double n) { return n / 1e3; }
 
 }  // namespace
 
-LevelIce level_ice(const ResistanceOptions& o, double h) {
+LevelIce level_ice(const IceResistanceOptions& o, double h) {
   LevelIce i;
   i.thickness_m = h;
   i.flexural_strength_pa = o.ice.flexural_strength_pa;
@@ -46,7 +46,7 @@ LevelIce level_ice(const ResistanceOptions& o, double h) {
   return i;
 }
 
-IceHull resolve_ice_hull(const ResistanceOptions& o, const fs::path& hull_json, const std::string& config_name,
+IceHull resolve_ice_hull(const IceResistanceOptions& o, const fs::path& hull_json, const std::string& config_name,
                          std::vector<std::pair<std::string, std::string>>* sources) {
   IceHull h;
   if (!hull_json.empty()) h = read_ice_hull(hull_json);
@@ -73,13 +73,13 @@ IceHull resolve_ice_hull(const ResistanceOptions& o, const fs::path& hull_json, 
   return h;
 }
 
-std::string run_resistance(const ResistanceOptions& o, const fs::path& hull_json, const fs::path& config_file,
+std::string run_resistance(const IceResistanceOptions& o, const fs::path& hull_json, const fs::path& config_file,
                            const fs::path& out) {
   const std::string cfg = config_file.empty() ? std::string("the resistance options") : config_file.string();
   {  // the options' own checks, also when the struct was filled in code rather than read from JSON
     const Json none = Json::object();
     OptionReader r(none, cfg, "");
-    const_cast<ResistanceOptions&>(o).visit(r);
+    const_cast<IceResistanceOptions&>(o).visit(r);
     r.finish();
   }
   const std::string ext = out.extension().string();

@@ -16,7 +16,7 @@ namespace floesim::sim {
 
 // The ice sheet. Defaults: the simulate stage's (FractureOptions: sigma_f, E, nu; IceOptions: rho_i, the ice-hull
 // friction), i.e. SAMS Table 1. Lindqvist calls the flexural strength sigma_b.
-struct ResistanceIceOptions {
+struct IceResistanceIceOptions {
   double flexural_strength_pa = FractureOptions{}.flexural_strength_pa;  // sigma_f (sigma_b)
   double youngs_modulus_pa = FractureOptions{}.youngs_modulus_pa;        // E
   double poisson_ratio = FractureOptions{}.poisson_ratio;                // nu
@@ -34,7 +34,7 @@ struct ResistanceIceOptions {
   }
 };
 
-struct ResistanceWaterOptions {
+struct IceResistanceWaterOptions {
   double density_kg_m3 = WaterOptions{}.density_kg_m3;  // rho_w
   double gravity_mps2 = WaterOptions{}.gravity_mps2;    // g
   template <class V>
@@ -46,7 +46,7 @@ struct ResistanceWaterOptions {
 
 // The hull's particulars: 0 = the value measured by floesim-hull (--hull FILE's "particulars"); a value > 0
 // replaces it. Without --hull every one must be given.
-struct ResistanceHullOptions {
+struct IceResistanceHullOptions {
   double length_m = 0;            // L
   double beam_m = 0;              // B
   double draught_m = 0;           // T
@@ -68,12 +68,12 @@ struct ResistanceHullOptions {
   }
 };
 
-struct ResistanceOptions {
+struct IceResistanceOptions {
   std::vector<double> thicknesses_m = {1.0};       // h: SAMS Table 1's 1 m (simulate reads h from the floes file)
   std::vector<double> speeds_mps = {1.0, 2.0, 3.0};  // v
-  ResistanceIceOptions ice;
-  ResistanceWaterOptions water;
-  ResistanceHullOptions hull;
+  IceResistanceIceOptions ice;
+  IceResistanceWaterOptions water;
+  IceResistanceHullOptions hull;
   template <class V>
   void visit(V& v) {
     // A list of finite numbers, each > 0 (or >= 0 when zero_ok).
@@ -95,18 +95,18 @@ struct ResistanceOptions {
 };
 
 // The ice the formulas take, at thickness h.
-LevelIce level_ice(const ResistanceOptions& o, double thickness_m);
+LevelIce level_ice(const IceResistanceOptions& o, double thickness_m);
 
 // The hull the formulas take: hull_json's particulars (if the path is not empty) with the config's non-zero values
 // in their place. Errors name the file or the key and say how to fix it. `sources` (optional) gets, per field, where
 // its value came from (hull_json's path or "config").
-IceHull resolve_ice_hull(const ResistanceOptions& o, const std::filesystem::path& hull_json,
+IceHull resolve_ice_hull(const IceResistanceOptions& o, const std::filesystem::path& hull_json,
                          const std::string& config_name, std::vector<std::pair<std::string, std::string>>* sources);
 
 // The floesim-resistance stage: both formulas over o.thicknesses_m x o.speeds_mps, written to `out` (FILE.json: the
 // table with the hull, ice and provenance; FILE.csv: the table as CSV, and FILE.json beside it), atomically. Returns
 // the table as text (printed on stdout). config_file (may be empty) is recorded and names keys in errors.
-std::string run_resistance(const ResistanceOptions& o, const std::filesystem::path& hull_json,
+std::string run_resistance(const IceResistanceOptions& o, const std::filesystem::path& hull_json,
                            const std::filesystem::path& config_file, const std::filesystem::path& out);
 
 }  // namespace floesim::sim

@@ -29,11 +29,11 @@ int main(int argc, char** argv) {
   return floesim::run_stage(app, argc, argv, [&] {
     namespace sim = floesim::sim;
     if (help_config) {
-      std::cout << floesim::options_doc(sim::ResistanceOptions{});
+      std::cout << floesim::options_doc(sim::IceResistanceOptions{});
       return;
     }
     const floesim::Json j = config.empty() ? floesim::Json::object() : floesim::load_json_file(config);
-    auto o = floesim::read_options<sim::ResistanceOptions>(j, config.empty() ? "resistance options" : config);
+    auto o = floesim::read_options<sim::IceResistanceOptions>(j, config.empty() ? "resistance options" : config);
     if (!speeds.empty()) o.speeds_mps = speeds;
     if (!thicknesses.empty()) o.thicknesses_m = thicknesses;
     if (check_config) {

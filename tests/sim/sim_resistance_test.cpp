@@ -36,8 +36,8 @@ std::string slurp(const fs::path& f) {
 }
 
 // PHYSICS.md §6.1-6.2's example hull and ice, as a config.
-ResistanceOptions example_options() {
-  ResistanceOptions o;
+IceResistanceOptions example_options() {
+  IceResistanceOptions o;
   o.thicknesses_m = {1.0};
   o.speeds_mps = {0.0, 1.0, 2.0};
   o.ice.flexural_strength_pa = 0.5e6;
@@ -54,7 +54,7 @@ ResistanceOptions example_options() {
 TEST(Resistance, DefaultIceIsTheSimulationsSamsTable1) {
   // SAMS Table 1 (PHYSICS.md, top): h = 1 m, sigma_f = 500 kPa, E = 5 GPa, nu = 0.3, rho_i = 900, rho_w = 1025,
   // mu_is = 0.15; and the values simulate itself runs with.
-  const ResistanceOptions o;
+  const IceResistanceOptions o;
   EXPECT_EQ(o.thicknesses_m, std::vector<double>{1.0});
   EXPECT_EQ(o.ice.flexural_strength_pa, 500e3);
   EXPECT_EQ(o.ice.youngs_modulus_pa, 5e9);
@@ -114,7 +114,7 @@ TEST(Resistance, OdenLikeHullMatchesTheBluntWaterlineClosedForm) {
   // written out here from PHYSICS.md §6.1, with the hull's measured L, B, T, phi, and the default (Table 1) ice.
   const fs::path dir = temp_dir("resistance_oden");
   write_generated_hull(HullGeneratorOptions{}, dir / "hull.obj", "");
-  ResistanceOptions o;
+  IceResistanceOptions o;
   o.thicknesses_m = {0.5, 1.0, 1.5};
   o.speeds_mps = {1.0, 2.0, 3.0};
   std::cout << run_resistance(o, dir / "hull.json", "", dir / "ref.json");
@@ -165,7 +165,7 @@ TEST(Resistance, BadOptionsAndInputsAreErrorsNamingTheKey) {
   const fs::path dir = temp_dir("resistance_bad");
   auto problem = [&](const char* text) {
     try {
-      read_options<ResistanceOptions>(Json::parse(text), "res.json");
+      read_options<IceResistanceOptions>(Json::parse(text), "res.json");
     } catch (const Error& e) {
       return std::string(e.what());
     }
@@ -179,18 +179,18 @@ TEST(Resistance, BadOptionsAndInputsAreErrorsNamingTheKey) {
   EXPECT_NE(problem(R"({"hull": {"stem_angle_deg": 120}})").find("hull.stem_angle_deg"), std::string::npos);
   EXPECT_NE(problem(R"({"ice": {"flexural_strength": 5e5}})").find("ice.flexural_strength"), std::string::npos);
   // No hull.json and not all particulars: every missing key named.
-  ResistanceOptions o;
+  IceResistanceOptions o;
   o.hull.length_m = 100;
   expect_error([&] { run_resistance(o, "", "res.json", dir / "r.json"); },
                {"res.json", "hull.beam_m", "hull.bow_length_m", "--hull"});
   // A hull.json from before the particulars were measured.
   std::ofstream(dir / "old.json") << R"({"hydrostatics": {"volume_m3": 1}})";
-  expect_error([&] { run_resistance(ResistanceOptions{}, dir / "old.json", "", dir / "r.json"); },
+  expect_error([&] { run_resistance(IceResistanceOptions{}, dir / "old.json", "", dir / "r.json"); },
                {"old.json", "particulars", "floesim-hull"});
   // A measured particular the formula cannot take (a bulb's stem angle): the key, its value and its source.
   std::ofstream(dir / "bulb.json") << R"({"particulars": {"length_m": 7.36, "beam_m": 1.02, "draught_m": 0.34,
       "stem_angle_deg": 155.9, "entrance_angle_deg": 18.3, "parallel_midbody_m": 3.96, "bow_length_m": 2.33}})";
-  expect_error([&] { run_resistance(ResistanceOptions{}, dir / "bulb.json", "", dir / "r.json"); },
+  expect_error([&] { run_resistance(IceResistanceOptions{}, dir / "bulb.json", "", dir / "r.json"); },
                {"hull.stem_angle_deg", "155.9", "bulb.json"});
   o = example_options();
   expect_error([&] { run_resistance(o, "", "", dir / "r.txt"); }, {".json or .csv"});
