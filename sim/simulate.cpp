@@ -179,6 +179,19 @@ nlohmann::json level_ice_summary(const Model& model, const Results& r) {
       for (const Vec2& p : piece) u_edge = std::min(u_edge, to_track(p).x());
   }
   j["sheet_area_start_m2"] = sheet_area;
+  // The sheet's ice as the level-ice resistance formulas take it (PHYSICS.md §6; a sweep's gather evaluates them
+  // beside the simulated mean): the area-weighted mean thickness of the sheet and the material of the run.
+  double h_area = 0;
+  for (int b : tiles) h_area += model.bodies[b].thickness_m * model.bodies[b].section_area;
+  const SimulateOptions& o = model.options;
+  j["ice"] = {{"thickness_m", h_area / sheet_area},
+              {"flexural_strength_pa", o.fracture.flexural_strength_pa},
+              {"youngs_modulus_pa", o.fracture.youngs_modulus_pa},
+              {"poisson_ratio", o.fracture.poisson_ratio},
+              {"ice_density_kg_m3", o.ice.density_kg_m3},
+              {"water_density_kg_m3", o.water.density_kg_m3},
+              {"gravity_mps2", o.water.gravity_mps2},
+              {"mu_ice_structure", o.ice.mu_ice_structure}};
   // The vessel at the end (last frame) and the tiles alive then.
   const size_t last = r.frames() - 1;
   double u_end = -std::numeric_limits<double>::infinity();
