@@ -18,7 +18,9 @@ namespace floesim::sim {
 namespace {
 
 using testing::coarse_hull;
+using testing::lc_by_hand;
 using testing::ramp_hull;
+using testing::table_pf;
 
 std::vector<int> tiles_of(const Model& m) {
   std::vector<int> t;
@@ -102,17 +104,6 @@ TEST(LevelIce, SheetAtRestCostsNothingAndNeverMoves) {
     EXPECT_EQ(w.state().position[b], m.bodies[b].initial_position);  // bit for bit
     EXPECT_EQ(w.state().awake[b], 0);
   }
-}
-
-// l_c for E = 5 GPa, nu = 0.3, h = 1 m by hand; the §2.1 wedge table at alpha 0.1 .. 0.3 read linearly.
-double lc_by_hand(double h) {
-  const double D = 5e9 * h * h * h / (12 * (1 - 0.3 * 0.3));
-  return std::pow(D / (1025 * 9.81), 0.25);
-}
-double table_pf(double alpha) {
-  const double a[] = {0.1, 0.2, 0.3}, p[] = {0.223, 0.265, 0.305};
-  const int k = alpha < 0.2 ? 0 : 1;
-  return p[k] + (alpha - a[k]) / (a[k + 1] - a[k]) * (p[k + 1] - p[k]);
 }
 
 TEST(LevelIce, RampBreaksTheSheetAtTheTableLoadAndTheSheetStaysPut) {
