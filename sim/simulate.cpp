@@ -231,6 +231,25 @@ nlohmann::json level_ice_summary(const Model& model, const Results& r) {
     channel["note"] = "the vessel's centre of mass did not reach the sheet: no channel behind midship yet";
   }
   j["channel"] = channel;
+  // The mean surge ice resistance over the steady part, split by what the hull touched: the sheet's tiles (breaking
+  // its edge: crushing until the wedges fail in bending) and the floes and broken pieces (clearing, turning and
+  // submerging them, with their friction).
+  if (!r.series.count("time_s") || !r.series.count("ice_load") || !r.series.count("ice_load_level_ice")) return j;
+  const auto& t = r.get("time_s");
+  const auto& all = r.get("ice_load");
+  const auto& sheet = r.get("ice_load_level_ice");
+  double sum_all = 0, sum_sheet = 0, n = 0;
+  for (size_t i = 0; i < t.size(); ++i) {
+    if (t[i] < model.options.steady_start_s - 0.5 * model.options.time_step_s) continue;
+    sum_all -= all[6 * i];
+    sum_sheet -= sheet[6 * i];
+    n += 1;
+  }
+  if (n > 0)
+    j["resistance_split"] = {{"from_s", model.options.steady_start_s},
+                             {"breaking_sheet_N", sum_sheet / n},
+                             {"clearing_pieces_N", (sum_all - sum_sheet) / n},
+                             {"breaking_share", sum_all != 0 ? sum_sheet / sum_all : 0.0}};
   return j;
 }
 
@@ -297,6 +316,7 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
   auto& c_ice = *col["ice_load"];
   auto& c_ice_rigid = *col["ice_load_rigid"];
   auto& c_ice_compliant = *col["ice_load_compliant"];
+  auto& c_ice_level_ice = *col["ice_load_level_ice"];
   auto& c_hydro = *col["hydro_load"];
   auto& c_wind = *col["wind_load"];
   auto& c_prop = *col["propulsion_load"];
@@ -332,6 +352,7 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
     push_body_wrench(c_ice, R, rep.ice_load);
     push_body_wrench(c_ice_rigid, R, rep.ice_load_rigid);
     push_body_wrench(c_ice_compliant, R, rep.ice_load_compliant);
+    push_body_wrench(c_ice_level_ice, R, rep.ice_load_level_ice);
     push_body_wrench(c_hydro, R, rep.hydro_load);
     push_body_wrench(c_wind, R, rep.wind_load);
     push_body_wrench(c_prop, R, rep.propulsion_load);
