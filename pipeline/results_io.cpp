@@ -48,7 +48,7 @@ const std::vector<FieldSpec>& series_fields() {
       {"ice_load_level_ice", 6, "N, N m",
        "part of ice_load from contacts with level ice tiles (breaking the sheet's edge; the rest is the floes and "
        "broken pieces being cleared, turned and submerged), body axes",
-       5},
+       6},
   };
   return k;
 }
@@ -172,8 +172,8 @@ std::vector<T> read_ds(hid_t file_id, const std::string& name, size_t cols, cons
 
 // The layout this version writes (floesim-results/N); it still reads every earlier one so that old artefacts still
 // plot and render: /1 had no fracture (no /fracture, no lineage), /2 no solver series beyond sweeps and residual,
-// /3 no /states/in_contact, /4 no /geometry/floe_level_ice.
-constexpr int kLayoutVersion = 5;
+// /3 no /states/in_contact, /4 no /geometry/floe_level_ice, /5 no ice_load_level_ice series.
+constexpr int kLayoutVersion = 6;
 constexpr const char* kLayoutPrefix = "floesim-results/";
 std::string layout_name(int version) { return kLayoutPrefix + std::to_string(version); }
 
