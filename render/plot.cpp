@@ -315,7 +315,7 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
       {"files", {"surge_ice_load.png", "surge_ice_load.svg", "surge_ice_load.csv", "fracture_events.csv"}},
       {"provenance", provenance},
   };
-  write_text_atomic(side.tmp(), j.dump(2) + "\n");
+  write_file_checked(side.tmp(), j.dump(2) + "\n", side.path());
   png.commit();
   svg.commit();
   csv.commit();

@@ -698,10 +698,10 @@ int run_sweep(const SweepOptions& o) {
   const fs::path run = fs::absolute(o.run_dir);
   const fs::path bin = o.bin_dir.empty() ? self_dir() : fs::absolute(o.bin_dir);
   const SweepPlan p = plan_members(s, members, run, bin);
+  check_stage_settings(s, members, p);  // writes nothing in the run folder
   // One writer at a time in the run folder (see lock_run_folder), taken before anything is written there.
   const int lock = lock_run_folder(run);
   (void)lock;
-  check_stage_settings(s, members, p);
   write_report_config(s, base, bin, run);
 
   write_sweep_files(s, members, p, run);
