@@ -106,11 +106,18 @@ std::string differences(const nlohmann::json& then, const nlohmann::json& now) {
   return out;
 }
 
-// The provenance without the settings that change no result.
+// The provenance without what changes no result: the settings threads and checkpoint_interval_s, and the settings
+// file itself (its name and hash: what it sets is in "config", resolved).
 nlohmann::json keyed(nlohmann::json p) {
   if (p.contains("config") && p["config"].is_object()) {
     p["config"].erase("threads");
     p["config"].erase("checkpoint_interval_s");
+  }
+  if (p.contains("inputs") && p["inputs"].is_array()) {
+    nlohmann::json kept = nlohmann::json::array();
+    for (const auto& in : p["inputs"])
+      if (!(in.is_object() && in.value("role", "") == "config")) kept.push_back(in);
+    p["inputs"] = kept;
   }
   return p;
 }

@@ -16,7 +16,8 @@
 //
 // The run's key is the SHA-256 of the stage's provenance (program version, input files' SHA-256, resolved options)
 // without `threads` and `checkpoint_interval_s`, which change no result (determinism across thread counts is
-// tested): a checkpoint of other inputs or settings is refused, naming what differs.
+// tested), and without the settings file's own hash (what it sets is in the resolved options): a checkpoint of
+// other inputs or settings is refused, naming what differs.
 #pragma once
 #include <filesystem>
 #include <memory>
