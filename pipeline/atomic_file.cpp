@@ -19,6 +19,7 @@ std::string write_failure_reason(int err) {
     case EROFS: return r + " (write the run to a writable folder, e.g. --out elsewhere)";
     case EACCES:
     case EPERM: return r + " (make the folder writable for this user, or write the run elsewhere)";
+    case ENOTDIR: return r + " (a file stands where a folder of the path should be: choose another path)";
     default: return r;
   }
 }
