@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <set>
@@ -100,12 +101,13 @@ int wait_child(Child& c) {
 }
 
 // One line from a child's pipe; false at its end. A stop signal (EINTR) does not end it: the child is told too,
-// and its last lines still come.
-bool read_line(FILE* in, char* line, int size) {
+// and its last lines still come; `on_signal` (if any) runs at once, while the child's children are still stopping.
+bool read_line(FILE* in, char* line, int size, const std::function<void()>& on_signal = {}) {
   for (;;) {
     if (std::fgets(line, size, in)) return true;
     if (!std::ferror(in) || errno != EINTR) return false;
     std::clearerr(in);
+    if (on_signal) on_signal();
   }
 }
 
@@ -272,12 +274,14 @@ int run_ninja(const fs::path& run, int jobs, const std::vector<Member>& members,
     return out;
   };
   bool looked = false;
-  while (read_line(in, line, sizeof line)) {
-    if (interrupt_signal() && !looked) {
-      *interrupted_stages = running_now();
-      if (interrupted_stages->empty()) *interrupted_stages = before;
-      looked = true;
-    }
+  const auto look = [&] {  // the stages a stop signal reaches, seen as soon as it arrives
+    if (!interrupt_signal() || looked) return;
+    *interrupted_stages = running_now();
+    if (interrupted_stages->empty()) *interrupted_stages = before;
+    looked = true;
+  };
+  while (read_line(in, line, sizeof line, look)) {
+    look();
     std::string l(line);
     int finished = -1, total = 0, running = 0;
     if (std::sscanf(l.c_str(), "[%d/%d %d]", &finished, &total, &running) == 3) {
