@@ -237,6 +237,7 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress, co
   }
   if (!world) world = std::make_unique<World>(model);
   const long first = world->state().step + 1;
+  stats.resumed_at_step = first - 1;
 
   const auto t0 = std::chrono::steady_clock::now();
   auto wall_now = [&] { return sums.wall_s + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
@@ -314,7 +315,10 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress, co
       if (cp && checkpoint_every > 0 && k % checkpoint_every == 0 && k < steps) {
         const double before = sums.wall_s;
         sums.wall_s = wall_now();
+        const auto tc = std::chrono::steady_clock::now();
         cp->save(w, r, sums);
+        stats.checkpoint_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - tc).count();
+        ++stats.checkpoints;
         sums.wall_s = before;
       }
       if (progress && (k * 10) % steps < 10 && k != steps) {
@@ -596,6 +600,12 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   rep << std::fixed << std::setprecision(2);
   rep << "floes " << model.floe_count() << ", steps " << stats.steps << ", wall " << stats.wall_s << " s, "
       << ms << " ms/step, " << o.duration_s / stats.wall_s << " simulated s per wall s\n";
+  if (stats.resumed_at_step > 0)
+    rep << "resumed at step " << stats.resumed_at_step << " (t = " << stats.resumed_at_step * o.time_step_s
+        << " s); the wall time includes the run before\n";
+  if (stats.checkpoints > 0)
+    rep << stats.checkpoints << " checkpoints written (every " << o.checkpoint_interval_s << " s of simulated time), "
+        << 1e3 * stats.checkpoint_s / stats.checkpoints << " ms each on average\n";
   rep << "mean awake floes " << stats.mean_awake_floes << ", mean contacts " << stats.mean_contacts
       << ", mean solver sweeps " << stats.mean_iterations << "\n";
   rep << "mean part pairs per step: " << stats.mean_pairs << " from the broad phase, " << stats.mean_touching

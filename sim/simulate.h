@@ -18,6 +18,9 @@ struct RunStats {
   double mean_pairs = 0, mean_touching = 0, mean_edge_pairs = 0;  // broad-phase pairs, touching pairs, edge ones
   double mean_crushing_pairs = 0;  // touching pairs with a compliant (crushing) contact
   long steps = 0;
+  long resumed_at_step = 0;        // the checkpoint this process continued from (0: from the start)
+  int checkpoints = 0;             // written by this process
+  double checkpoint_s = 0;         // their wall time
 };
 
 // Checkpoints of a run (sim/checkpoint.h): where, and whether to continue from the one there.
