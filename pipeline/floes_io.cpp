@@ -23,9 +23,11 @@ nlohmann::json floes_to_geojson(const FloeField& field) {
     nlohmann::json ring = nlohmann::json::array();
     for (const Vec2& v : f.outline) ring.push_back({v.x(), v.y()});
     if (!f.outline.empty()) ring.push_back({f.outline[0].x(), f.outline[0].y()});  // GeoJSON rings are closed
+    nlohmann::json props = {{"id", f.id}, {"area_m2", f.area_m2}, {"thickness_m", f.thickness_m}};
+    if (f.level_ice) props["kind"] = "level_ice";
     feats.push_back({{"type", "Feature"},
                      {"id", f.id},
-                     {"properties", {{"id", f.id}, {"area_m2", f.area_m2}, {"thickness_m", f.thickness_m}}},
+                     {"properties", props},
                      {"geometry", {{"type", "Polygon"}, {"coordinates", {ring}}}}});
   }
   fc["features"] = feats;
@@ -108,6 +110,11 @@ FloeField floes_from_geojson(const nlohmann::json& j, const std::string& file) {
       f.thickness_m = t->get<double>();
     }
     const std::string fw = file + ": floe id " + std::to_string(f.id);
+    if (const nlohmann::json* k = props ? member(*props, "kind") : nullptr) {
+      FLOESIM_REQUIRE(k->is_string() && (*k == "floe" || *k == "level_ice"), fw,
+                      ": properties.kind must be \"floe\" or \"level_ice\" (a sheet), got ", k->dump());
+      f.level_ice = *k == "level_ice";
+    }
     FLOESIM_REQUIRE(f.id >= 1, fw, ": id must be >= 1 (0 means water in the label image)");
     FLOESIM_REQUIRE(ids.insert(f.id).second, fw, ": duplicate id");
     FLOESIM_REQUIRE(std::isfinite(f.thickness_m) && f.thickness_m > 0, fw, ": thickness_m must be > 0, got ",

@@ -1,6 +1,7 @@
 // The floe field artefact: a GeoJSON FeatureCollection of Polygon features in metres
 // (x to the right, y up, origin at the image's bottom-left corner). Each feature's properties hold
-// `id` (>= 1, equal to its value in the label image), `area_m2` and `thickness_m`.
+// `id` (>= 1, equal to its value in the label image), `area_m2`, `thickness_m` and optionally `kind` ("floe", the
+// default, or "level_ice": a level ice sheet, simulated as fixed tiles that only fracture breaks).
 // A top-level member "floesim" holds the field extent and the provenance.
 #pragma once
 #include <filesystem>
@@ -18,6 +19,7 @@ struct Floe {
   Polygon outline;  // counter-clockwise, open ring, metres
   double area_m2 = 0;
   double thickness_m = 1.0;
+  bool level_ice = false;  // properties.kind "level_ice": a sheet held by the ice around it (sim: fixed tiles)
 };
 
 struct FloeField {

@@ -174,8 +174,8 @@ std::vector<T> read_ds(hid_t file_id, const std::string& name, size_t cols, cons
 
 // The layout this version writes (floesim-results/N); it still reads every earlier one so that old artefacts still
 // plot and render: /1 had no fracture (no /fracture, no lineage), /2 no solver series beyond sweeps and residual,
-// /3 no /states/in_contact.
-constexpr int kLayoutVersion = 4;
+// /3 no /states/in_contact, /4 no /geometry/floe_level_ice.
+constexpr int kLayoutVersion = 5;
 constexpr const char* kLayoutPrefix = "floesim-results/";
 std::string layout_name(int version) { return kLayoutPrefix + std::to_string(version); }
 
@@ -305,6 +305,8 @@ void write_results(const std::filesystem::path& path, const Results& r) {
                     it->second.size(), " values, expected ", n, " x ", f.cols);
   }
   FLOESIM_REQUIRE(r.frame_offset.size() == r.frame_time_s.size() + 1, file, ": internal: frame offsets");
+  FLOESIM_REQUIRE(r.floe_level_ice.empty() || r.floe_level_ice.size() == r.floe_id.size(), file,
+                  ": internal: floe_level_ice has ", r.floe_level_ice.size(), " rows for ", r.floe_id.size(), " floes");
   FLOESIM_REQUIRE(r.state_position_m.size() == 3 * r.state_body_id.size() &&
                       r.state_quaternion.size() == 4 * r.state_body_id.size() &&
                       r.state_in_contact.size() == r.state_body_id.size(),
@@ -338,6 +340,8 @@ void write_results(const std::filesystem::path& path, const Results& r) {
     write_ds(fid, "/states/in_contact", r.state_in_contact, 1, file);
     write_ds(fid, "/geometry/floe_id", r.floe_id, 1, file);
     write_ds(fid, "/geometry/floe_thickness_m", r.floe_thickness_m, 1, file);
+    write_ds(fid, "/geometry/floe_level_ice",
+             r.floe_level_ice.empty() ? std::vector<int8_t>(r.floe_id.size(), 0) : r.floe_level_ice, 1, file);
     write_ds(fid, "/geometry/floe_vertex_offset", r.floe_vertex_offset, 1, file);
     write_ds(fid, "/geometry/floe_vertices_m", r.floe_vertices_m, 2, file);
     write_ds(fid, "/geometry/hull_vertices_m", r.hull_vertices_m, 3, file);
@@ -435,6 +439,11 @@ Results read_results(const std::filesystem::path& path, bool with_states) {
   FLOESIM_REQUIRE(r.floe_vertex_offset.size() == r.floe_id.size() + 1, file, ": floe vertex offsets disagree");
   FLOESIM_REQUIRE(r.floe_thickness_m.size() == r.floe_id.size(), file,
                   ": /geometry/floe_thickness_m and /geometry/floe_id have different lengths");
+  // Level ice came with layout /5: an earlier file has none.
+  r.floe_level_ice = version >= 5 ? read_ds<int8_t>(fid, "/geometry/floe_level_ice", 1, file)
+                                  : std::vector<int8_t>(r.floe_id.size(), 0);
+  FLOESIM_REQUIRE(r.floe_level_ice.size() == r.floe_id.size(), file,
+                  ": /geometry/floe_level_ice and /geometry/floe_id have different lengths");
   check_offsets(r.floe_vertex_offset, r.floe_vertices_m.size() / 2, "/geometry/floe_vertex_offset",
                 "/geometry/floe_vertices_m");
   const int64_t hull_vertices = static_cast<int64_t>(r.hull_vertices_m.size() / 3);

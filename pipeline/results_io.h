@@ -11,6 +11,8 @@
 //                                                   this frame (a vessel contact carried a normal impulse), else 0
 //   /geometry/floe_id            [n]      int32
 //   /geometry/floe_thickness_m   [n]      float64
+//   /geometry/floe_level_ice     [n]      int8      1: a tile of a level ice sheet (fixed, held by the sheet; what
+//                                                   a wedge leaves of a tile is one too), 0: a floe or a piece
 //   /geometry/floe_vertex_offset [n+1]    int64     outline of floe k: rows offset[k] .. offset[k+1]-1
 //   /geometry/floe_vertices_m    [V x 2]  float64   CCW outline in the floe's body frame (origin = centre of mass;
 //                                                   the slab spans z = -h/2 .. h/2 in that frame)
@@ -34,9 +36,10 @@
 //   /fracture/brash_mass_kg      [E]      float64   mass of pieces below the minimum size, removed (counted here)
 //   /fracture/child_offset       [E+1]    int64     pieces of event k: child_id[offset[k] .. offset[k+1]-1]
 //   /fracture/child_id           [C]      int32     floe ids of the pieces that became bodies
-//   Layout "floesim-results/4" (this one) added /states/in_contact; "/3" added the solver series (relax sweeps and
+//   Layout "floesim-results/5" (this one) added /geometry/floe_level_ice (all 0 when reading an earlier file);
+//   "/4" added /states/in_contact; "/3" added the solver series (relax sweeps and
 //   residual, subspace solves, capped steps, contact-law violations); "/2" added /fracture and the lineage
-//   datasets. "/1" to "/3" files are still read: a series a file lacks is filled as FieldSpec::since says (input
+//   datasets. "/1" to "/4" files are still read: a series a file lacks is filled as FieldSpec::since says (input
 //   floes only, no events; solver figures NaN: not recorded), and /states/in_contact as all 0 (not recorded:
 //   no floe is shown in contact).
 //   attribute "floesim" on the root: JSON text with layout version, time_step_s, duration_s,
@@ -83,6 +86,7 @@ struct Results {
 
   std::vector<int32_t> floe_id;
   std::vector<double> floe_thickness_m;
+  std::vector<int8_t> floe_level_ice;       // [n] 1: a level ice tile (layout /5); empty when writing: all 0
   std::vector<int64_t> floe_vertex_offset;  // size n+1
   std::vector<double> floe_vertices_m;      // [V x 2]
   // Lineage of every floe that ever existed (same order as floe_id).

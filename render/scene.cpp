@@ -284,9 +284,12 @@ struct SceneRenderer::Impl {
       }
       if (area2 < 0) std::reverse(ring.begin(), ring.end());  // the layout says CCW; be lenient, not wrong
       // A deterministic shade per floe id (Knuth's multiplicative hash), 0.92 .. 1.0 of the top colour.
-      const float shade = 0.92f + 0.08f * float((uint32_t(r.floe_id[g]) * 2654435761u >> 16) & 255u) / 255.f;
+      // Level ice is one sheet: its tiles (and what wedges leave of them) share one shade and the input colour.
+      const bool sheet = r.floe_level_ice.size() == n && r.floe_level_ice[g];
+      const float shade =
+          sheet ? 1.0f : 0.92f + 0.08f * float((uint32_t(r.floe_id[g]) * 2654435761u >> 16) & 255u) / 255.f;
       float top[3];
-      floe_top_colour(o, r.floe_origin_mode[g], r.floe_generation[g], top);
+      floe_top_colour(o, sheet ? kFractureNone : r.floe_origin_mode[g], r.floe_generation[g], top);
       const float t[3] = {top[0] * shade, top[1] * shade, top[2] * shade};
       FloeDraw& f = floes[g];
       f.shade = shade;

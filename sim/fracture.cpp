@@ -107,9 +107,10 @@ Candidate evaluate(const Model& model, const State& state, const PairLoad& pl, l
       rb *= std::max(0.1, 1 + fo.speed_coefficient_spm * vn);  // never below a tenth of the static piece
     }
     // A floe shorter than the wedge (apex -> crack) along the load does not bend as a wedge (§2.1, finite floes):
-    // it tilts, submerges or splits instead.
+    // it tilts, submerges or splits instead. Level ice cannot tilt away: a cusp left between two earlier cracks
+    // is held by the sheet and breaks off whole (the wedge's cut takes what of it lies inside).
     const double extent = chord_length(body.outline, c.point, inward);
-    if (extent >= wf.xi_star * lc) {
+    if (body.fixed || extent >= wf.xi_star * lc) {
       bend.threshold = std::max(pr, wf.load_n);
       bend.mode = pr >= wf.load_n ? kFractureRadial : kFractureBending;
       bend.theta = theta;
@@ -126,7 +127,9 @@ Candidate evaluate(const Model& model, const State& state, const PairLoad& pl, l
   double r_split = 0;
   Candidate split = c;
   const double fh = f_h.norm();
-  if (fh > 0 && (!edge || f_h.dot(inward) > 0)) {
+  // Level ice does not split: the in-plane load of a hull is carried by the semi-infinite sheet around the tile
+  // (its chord L is not the tile's), and a sheet fails in bending at the hull (PHYSICS.md §2.4).
+  if (!body.fixed && fh > 0 && (!edge || f_h.dot(inward) > 0)) {
     const Vec2 d = f_h / fh;
     // The contact point lies in the overlap, at the edge: if rounding puts it just outside the outline, the chord
     // is taken from a point nudged into the floe along the force.
@@ -156,8 +159,9 @@ Candidate evaluate(const Model& model, const State& state, const PairLoad& pl, l
 
 // The pieces of a decided failure, in the floe's body frame; empty when the cut leaves the floe whole or cannot be
 // made (a piece below the minimum size of a split, a degenerate boolean result).
-std::vector<Polygon> cut(const Body& body, const Candidate& c, const FractureOptions& fo) {
+std::vector<Polygon> cut(const Body& body, const Candidate& c, const FractureOptions& fo, int* wedge_pieces) {
   std::vector<Polygon> pieces;
+  *wedge_pieces = 0;
   try {
     if (c.mode == kFractureSplitting) {
       const LineSplit s = split_by_line(body.outline, c.point, c.direction);
@@ -181,6 +185,7 @@ std::vector<Polygon> cut(const Body& body, const Candidate& c, const FractureOpt
       const PolygonCut wedge = cut_polygon(body.outline, sector);
       if (wedge.inside.empty() || wedge.outside.empty()) return {};
       pieces = wedge.inside;
+      *wedge_pieces = static_cast<int>(wedge.inside.size());
       pieces.insert(pieces.end(), wedge.outside.begin(), wedge.outside.end());
     }
   } catch (const Error&) {
@@ -192,6 +197,45 @@ std::vector<Polygon> cut(const Body& body, const Candidate& c, const FractureOpt
   const double area = signed_area(body.outline);
   if (!(std::abs(sum - area) <= 1e-9 * area)) return {};
   return pieces;
+}
+
+// The contacts of one pair (indices into shares, each naming a contact) in patches: two contacts share a patch when
+// their horizontal extents (span_lo - span_hi) come within join_m of each other (union-find; patches in the order
+// of their first contact, contacts in their order: deterministic).
+template <class Share>
+std::vector<std::vector<size_t>> contact_patches(const std::vector<Contact>& contacts, const std::vector<Share>& shares,
+                                                 const std::vector<size_t>& pair, double join_m) {
+  const size_t n = pair.size();
+  std::vector<size_t> root(n);
+  for (size_t k = 0; k < n; ++k) root[k] = k;
+  auto find = [&](size_t k) {
+    while (root[k] != k) k = root[k] = root[root[k]];
+    return k;
+  };
+  auto flat = [](const Vec3& v) { return Vec2(v.x(), v.y()); };
+  for (size_t a = 0; a < n; ++a)
+    for (size_t b = a + 1; b < n; ++b) {
+      const Contact& ca = contacts[shares[pair[a]].contact];
+      const Contact& cb = contacts[shares[pair[b]].contact];
+      const Vec2 a0 = flat(ca.span_lo), a1 = flat(ca.span_hi), b0 = flat(cb.span_lo), b1 = flat(cb.span_hi);
+      const double d = std::min({point_segment_distance(a0, b0, b1), point_segment_distance(a1, b0, b1),
+                                 point_segment_distance(b0, a0, a1), point_segment_distance(b1, a0, a1)});
+      if (d <= join_m) {
+        const size_t ra = find(a), rb = find(b);
+        if (ra != rb) root[std::max(ra, rb)] = std::min(ra, rb);
+      }
+    }
+  std::vector<std::vector<size_t>> groups;
+  std::vector<int> group_of(n, -1);
+  for (size_t k = 0; k < n; ++k) {
+    const size_t r = find(k);
+    if (group_of[r] < 0) {
+      group_of[r] = static_cast<int>(groups.size());
+      groups.emplace_back();
+    }
+    groups[group_of[r]].push_back(pair[k]);
+  }
+  return groups;
 }
 
 }  // namespace
@@ -249,31 +293,44 @@ std::vector<FractureCut> find_fractures(const Model& model, const State& state, 
     Candidate best;
     PairLoad best_load;
     while (i < shares.size() && shares[i].floe == floe) {
-      PairLoad pl;
-      pl.floe = floe;
-      pl.other = shares[i].other;
-      pl.at_structure = model.bodies[pl.other].kind == BodyKind::vessel;
-      for (; i < shares.size() && shares[i].floe == floe && shares[i].other == pl.other; ++i) {
-        const Contact& c = contacts[shares[i].contact];
-        const double sign = shares[i].on_b ? 1.0 : -1.0;  // the impulse acts on b, its opposite on a
-        pl.force += sign * (c.pn * c.normal + c.pt1 * c.t1 + c.pt2 * c.t2) / dt;
-        pl.normal += sign * c.pn * c.normal;
-        pl.point += c.pn * c.point;
-        pl.weight += c.pn;
-        pl.span.push_back(c.span_lo);
-        pl.span.push_back(c.span_hi);
-      }
-      pl.point /= pl.weight;
-      const Candidate cand = evaluate(model, state, pl, step);
-      if (cand.ratio > best.ratio) {
-        best = cand;
-        best_load = std::move(pl);
+      const int other = shares[i].other;
+      std::vector<size_t> pair;  // indices into shares
+      for (; i < shares.size() && shares[i].floe == floe && shares[i].other == other; ++i) pair.push_back(i);
+      // A floe's contacts with one body load it as one (the floe answers as a whole). A level ice tile is part of
+      // a sheet: the hull's two sides, or its stem and a shoulder, bend it at separate places, so each patch of
+      // touching contacts is a load of its own (summed, the two sides' horizontal forces would cancel and the
+      // width would span the hull).
+      const Body& fb = model.bodies[floe];
+      const std::vector<std::vector<size_t>> groups =
+          fb.fixed ? contact_patches(contacts, shares, pair, std::max(2 * fb.thickness_m, 1.0))
+                   : std::vector<std::vector<size_t>>{pair};
+      for (const std::vector<size_t>& group : groups) {
+        PairLoad pl;
+        pl.floe = floe;
+        pl.other = other;
+        pl.at_structure = model.bodies[other].kind == BodyKind::vessel;
+        for (size_t k : group) {
+          const Contact& c = contacts[shares[k].contact];
+          const double sign = shares[k].on_b ? 1.0 : -1.0;  // the impulse acts on b, its opposite on a
+          pl.force += sign * (c.pn * c.normal + c.pt1 * c.t1 + c.pt2 * c.t2) / dt;
+          pl.normal += sign * c.pn * c.normal;
+          pl.point += c.pn * c.point;
+          pl.weight += c.pn;
+          pl.span.push_back(c.span_lo);
+          pl.span.push_back(c.span_hi);
+        }
+        pl.point /= pl.weight;
+        const Candidate cand = evaluate(model, state, pl, step);
+        if (cand.ratio > best.ratio) {
+          best = cand;
+          best_load = std::move(pl);
+        }
       }
     }
     if (best.ratio < 1) continue;
     FractureCut fc;
     fc.body = floe;
-    fc.pieces = cut(model.bodies[floe], best, fo);
+    fc.pieces = cut(model.bodies[floe], best, fo, &fc.wedge_pieces);
     if (fc.pieces.empty()) continue;
     FractureEvent& e = fc.event;
     e.time_s = step * dt;

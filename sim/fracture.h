@@ -49,6 +49,7 @@ struct FractureCut {
   int body = -1;
   FractureEvent event;
   std::vector<Polygon> pieces;
+  int wedge_pieces = 0;  // bending and radial: pieces[0, wedge_pieces) are the wedge, the rest what the floe keeps
 };
 
 // The fractures of this step from the contacts after the relax pass (impulses over dt are forces). Floes that

@@ -80,6 +80,77 @@ struct FloeGeometry {
   double area = 0;
 };
 
+// The level ice of a model as fixed floes (issue #10): each sheet (the options' rectangle, the floes file's features
+// of kind "level_ice") cut into tiles by a grid centred on the sheet (level_ice.tile_m) whose lines also run
+// along every opening's sides, so that each grid cell lies wholly inside or outside an opening (a cell is dropped
+// when its centre is in one; a boolean difference would leave holes). Ids follow the floes file's largest id.
+// Deterministic: sheets in order, cells row by row, the pieces of a cell as polygon_intersection orders them.
+std::vector<Floe> level_ice_tiles(const FloeField& field, const LevelIceOptions& li) {
+  struct Sheet {
+    Polygon outline;
+    double thickness_m;  // <= 0: from the options' profile at each tile's centre
+    std::string name;
+  };
+  std::vector<Sheet> sheets;
+  int next_id = 1;
+  for (const Floe& f : field.floes) {
+    next_id = std::max(next_id, f.id + 1);
+    if (f.level_ice) sheets.push_back({f.outline, f.thickness_m, "level ice sheet, floe id " + std::to_string(f.id)});
+  }
+  if (!li.extent_m.empty()) {
+    const std::vector<double>& e = li.extent_m;
+    sheets.push_back({{Vec2(e[0], e[1]), Vec2(e[2], e[1]), Vec2(e[2], e[3]), Vec2(e[0], e[3])}, 0.0,
+                      "level_ice.extent_m"});
+  }
+  std::vector<Floe> tiles;
+  const double t = li.tile_m;
+  for (const Sheet& sh : sheets) {
+    const Aabb2 box = bounds(sh.outline);
+    // Grid lines: tile_m apart, centred on the sheet's box (a vessel on the sheet's centre line meets the middle of
+    // a tile, not a crack-stopping side), plus the openings' sides inside it.
+    auto lines = [&](double lo, double hi, int axis) {
+      std::vector<double> v;
+      const double mid = 0.5 * (lo + hi) - 0.5 * t;
+      for (double k = std::floor((lo - mid) / t); mid + k * t < hi; k += 1) v.push_back(std::max(lo, mid + k * t));
+      v.push_back(hi);
+      for (const LevelIceOpening& op : li.openings)
+        for (double c : {op.rect_m[axis], op.rect_m[axis + 2]})
+          if (c > lo && c < hi) v.push_back(c);
+      std::sort(v.begin(), v.end());
+      v.erase(std::unique(v.begin(), v.end()), v.end());
+      return v;
+    };
+    const std::vector<double> xs = lines(box.lo.x(), box.hi.x(), 0), ys = lines(box.lo.y(), box.hi.y(), 1);
+    for (size_t j = 0; j + 1 < ys.size(); ++j)
+      for (size_t i = 0; i + 1 < xs.size(); ++i) {
+        const Vec2 lo(xs[i], ys[j]), hi(xs[i + 1], ys[j + 1]), mid = 0.5 * (lo + hi);
+        bool open = false;
+        for (const LevelIceOpening& op : li.openings)
+          open = open || (mid.x() > op.rect_m[0] && mid.x() < op.rect_m[2] && mid.y() > op.rect_m[1] &&
+                          mid.y() < op.rect_m[3]);
+        if (open) continue;
+        const Polygon cell = {lo, Vec2(hi.x(), lo.y()), hi, Vec2(lo.x(), hi.y())};
+        std::vector<Polygon> pieces;
+        try {
+          pieces = polygon_intersection(sh.outline, cell);
+        } catch (const Error& e) {
+          throw Error(sh.name + ": cannot cut the sheet into tiles at [" + std::to_string(lo.x()) + ", " +
+                      std::to_string(lo.y()) + "] (" + e.what() + "); change level_ice.tile_m");
+        }
+        for (Polygon& p : pieces) {
+          Floe f;
+          f.id = next_id++;
+          f.outline = std::move(p);
+          f.area_m2 = signed_area(f.outline);
+          f.thickness_m = sh.thickness_m > 0 ? sh.thickness_m : li.thickness_at(centroid(f.outline).x());
+          f.level_ice = true;
+          tiles.push_back(std::move(f));
+        }
+      }
+  }
+  return tiles;
+}
+
 double overlap_area(const FloeGeometry& a, const FloeGeometry& b) {
   double area = 0;
   for (size_t i = 0; i < a.pieces.size(); ++i)
@@ -181,6 +252,14 @@ void set_added_mass(Body& b, const Vec3& added_mass, const Vec3& added_inertia) 
 }
 
 }  // namespace
+
+void hold_fixed(Body& b) {
+  b.fixed = true;
+  b.inv_mass = 0;
+  b.inv_inertia = Mat3::Zero();
+  b.inv_mass_added = Vec3::Zero();
+  b.inv_inertia_added = Mat3::Zero();
+}
 
 Body make_floe_body(const Polygon& outline, double h, int id, int body_index, const Vec2& centre,
                     const SimulateOptions& o, std::vector<ConvexPart>& parts) {
@@ -437,10 +516,15 @@ Model build_model(const FloeField& field, const HullModel* hull, const SimulateO
   // Floes float at hydrostatic equilibrium; without water they are placed with their base at z = -draught anyway.
   const double draught_ratio = rho_i / rho_w;
 
-  // 1. Floe geometry in the world: cleaned outline and convex pieces.
-  std::vector<FloeGeometry> geo(field.floes.size());
-  for (size_t k = 0; k < field.floes.size(); ++k) {
-    const Floe& f = field.floes[k];
+  // 1. Floe geometry in the world: cleaned outline and convex pieces. The level ice sheets come as tiles (fixed
+  // floes) after the free floes.
+  std::vector<Floe> floes;
+  for (const Floe& f : field.floes)
+    if (!f.level_ice) floes.push_back(f);
+  for (Floe& f : level_ice_tiles(field, o.level_ice)) floes.push_back(std::move(f));
+  std::vector<FloeGeometry> geo(floes.size());
+  for (size_t k = 0; k < floes.size(); ++k) {
+    const Floe& f = floes[k];
     FLOESIM_REQUIRE(std::isfinite(f.thickness_m) && f.thickness_m > 0, "floe ", f.id, ": thickness_m must be > 0, got ",
                     f.thickness_m);
     FloeGeometry& fg = geo[k];
@@ -605,7 +689,7 @@ Model build_model(const FloeField& field, const HullModel* hull, const SimulateO
 
     // Footprint of the hull parts in the band of z the floes occupy, at the initial pose.
     double zlo = 0, zhi = 0;
-    for (const Floe& f : field.floes) {
+    for (const Floe& f : floes) {
       zlo = std::min(zlo, -draught_ratio * f.thickness_m);
       zhi = std::max(zhi, (1 - draught_ratio) * f.thickness_m);
     }
@@ -631,6 +715,10 @@ Model build_model(const FloeField& field, const HullModel* hull, const SimulateO
       for (size_t j = 0; j < fg.pieces.size() && !hit; ++j)
         hit = fp_box[i].overlaps(fg.piece_box[j]) && convex_intersection_area(footprint[i], fg.pieces[j]) > 1e-9;
     }
+    // The vessel starts in open water or in broken ice: a floe in its way is removed, level ice is an error.
+    FLOESIM_REQUIRE(!(hit && f.level_ice), "the level ice sheet (tile id ", f.id, " at ", fg.box.lo.x(), ", ",
+                    fg.box.lo.y(), " m) overlaps the vessel's start: move vessel.x_m / vessel.y_m into open water, or "
+                    "cut an opening (level_ice.openings) where the vessel starts");
     if (hit) {
       model.removed_floe_ids.push_back(f.id);
       continue;
@@ -640,6 +728,7 @@ Model build_model(const FloeField& field, const HullModel* hull, const SimulateO
     for (const Vec2& v : fg.outline) local.push_back(v - c);
     model.bodies.push_back(make_floe_body(local, f.thickness_m, f.id, static_cast<int>(model.bodies.size()), c, o,
                                           model.parts));
+    if (f.level_ice) hold_fixed(model.bodies.back());
   }
 
   // 5. Domain walls: static boxes outside the sides of the domain rectangle, overlapping at the corners (two walls

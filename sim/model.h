@@ -81,6 +81,12 @@ struct Body {
   double pitch_damping = 0;            // N m s/rad, about body y
   Vec3 initial_position = Vec3::Zero();
   Quat initial_orientation = Quat::Identity();
+  // Level ice (issue #10): a tile of a sheet, held by the ice around it (hold_fixed). Like a wall it has infinite
+  // mass (inverse masses 0), is never awake and feels no force, so the sheet costs nothing per step until something
+  // moving touches it; unlike a wall it is ice: it keeps its mass for the ice balance, is recorded, and fracture
+  // breaks wedges off it (bending and radial cracking; a sheet does not split in-plane). What is left of a tile
+  // stays fixed; the wedges are free floes.
+  bool fixed = false;
 };
 
 // What the vessel model needs of the hull, computed from the mesh at the design waterline (z = 0).
@@ -141,6 +147,12 @@ double ittc57_resistance(double u_mps, const VesselParticulars& v, const Simulat
 // outline) are appended to `parts` with body index `body_index`; first_part/part_count point at them.
 Body make_floe_body(const Polygon& outline, double thickness_m, int id, int body_index, const Vec2& centre,
                     const SimulateOptions& o, std::vector<ConvexPart>& parts);
+
+// A body the solver and the integrator never move: a domain wall or a tile of level ice.
+inline bool is_fixed_body(const Body& b) { return b.kind == BodyKind::wall || b.fixed; }
+
+// Makes a floe body a fixed tile of level ice: inverse masses and inertias 0 (Body::fixed).
+void hold_fixed(Body& b);
 
 // Convex part from a closed convex triangle mesh (body frame): merges coplanar triangles into faces.
 ConvexPart make_convex_part(const TriMesh& mesh, int body);

@@ -103,7 +103,9 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
     thickness[r.floe_id[k]] = r.floe_thickness_m[k];
     if (r.floe_parent_id[k] < 0) start += m;
     if (std::isinf(r.floe_ended_s[k])) end += m;
-    if (r.floe_parent_id[k] >= 0) {
+    // Pieces: the floes fracture made (a wedge off a level ice tile is one; what the tile keeps is still sheet).
+    const bool sheet = !r.floe_level_ice.empty() && r.floe_level_ice[k];
+    if (r.floe_parent_id[k] >= 0 && !sheet) {
       piece_area.push_back(a);
       piece_diameter.push_back(std::sqrt(4 * a / kPi));
     }
@@ -147,6 +149,79 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
 }
 
 }  // namespace
+
+nlohmann::json level_ice_summary(const Model& model, const Results& r) {
+  nlohmann::json j;
+  const int v = model.vessel;
+  std::vector<int> tiles;
+  for (size_t b = 0; b < model.bodies.size(); ++b)
+    if (model.bodies[b].fixed) tiles.push_back(static_cast<int>(b));
+  j["tiles_start"] = tiles.size();
+  if (tiles.empty() || v < 0 || r.frames() == 0) return j;
+  const Body& vb = model.bodies[v];
+  const Vec3 heading = vb.initial_orientation * Vec3::UnitX();
+  const Vec2 along = Vec2(heading.x(), heading.y()).normalized(), across(-along.y(), along.x());
+  const Vec2 start = vb.initial_position.head<2>();
+  auto to_track = [&](const Vec2& p) { return Vec2(along.dot(p - start), across.dot(p - start)); };
+  const double beam = model.vessel_info.beam_wl_m;
+  const double far = 1e6;
+  auto world = [&](double u, double w) { return Vec2(start + u * along + w * across); };
+  auto placed = [](const Polygon& outline, const Vec2& at) {
+    Polygon w;
+    for (const Vec2& p : outline) w.push_back(p + at);
+    return w;
+  };
+  // The vessel's path: the band half a beam either side of its start line.
+  const Polygon path = {world(-far, -beam / 2), world(far, -beam / 2), world(far, beam / 2), world(-far, beam / 2)};
+  double sheet_area = 0, u_edge = std::numeric_limits<double>::infinity();
+  for (int b : tiles) {
+    const Body& t = model.bodies[b];
+    sheet_area += t.section_area;
+    for (const Polygon& piece : polygon_intersection(placed(t.outline, t.initial_position.head<2>()), path))
+      for (const Vec2& p : piece) u_edge = std::min(u_edge, to_track(p).x());
+  }
+  j["sheet_area_start_m2"] = sheet_area;
+  // The vessel at the end (last frame) and the tiles alive then.
+  const size_t last = r.frames() - 1;
+  double u_end = -std::numeric_limits<double>::infinity();
+  std::map<int32_t, Vec2> end_position;
+  for (int64_t row = r.frame_offset[last]; row < r.frame_offset[last + 1]; ++row) {
+    const Vec2 x(r.state_position_m[3 * row], r.state_position_m[3 * row + 1]);
+    if (r.state_body_id[row] == 0) u_end = to_track(x).x();
+    else end_position[r.state_body_id[row]] = x;
+  }
+  nlohmann::json channel = {{"beam_m", beam}};
+  if (std::isfinite(u_edge) && u_end > u_edge + 1.0) {
+    // The window as a polygon in the world: the strip between u_edge and u_end, as wide as the sheet could be.
+    const Polygon strip = {world(u_edge, -far), world(u_end, -far), world(u_end, far), world(u_edge, far)};
+    auto area_in_strip = [&](const Polygon& outline, const Vec2& at) {
+      double a = 0;
+      for (const Polygon& piece : polygon_intersection(placed(outline, at), strip)) a += signed_area(piece);
+      return a;
+    };
+    double before = 0, after = 0;
+    for (int b : tiles) before += area_in_strip(model.bodies[b].outline, model.bodies[b].initial_position.head<2>());
+    for (size_t g = 0; g < r.floe_id.size(); ++g) {
+      if (r.floe_level_ice.size() != r.floe_id.size() || !r.floe_level_ice[g]) continue;
+      const auto it = end_position.find(r.floe_id[g]);
+      if (it == end_position.end()) continue;  // broken up before the end
+      Polygon p;
+      for (int64_t i = r.floe_vertex_offset[g]; i < r.floe_vertex_offset[g + 1]; ++i)
+        p.emplace_back(r.floe_vertices_m[2 * i], r.floe_vertices_m[2 * i + 1]);
+      after += area_in_strip(p, it->second);
+    }
+    const double length = u_end - u_edge;
+    channel["from_m"] = u_edge;
+    channel["to_m"] = u_end;
+    channel["broken_area_m2"] = before - after;
+    channel["mean_width_m"] = (before - after) / length;
+    channel["width_over_beam"] = (before - after) / length / beam;
+  } else {
+    channel["note"] = "the vessel's centre of mass did not reach the sheet: no channel behind midship yet";
+  }
+  j["channel"] = channel;
+  return j;
+}
 
 std::vector<double> moving_average(const std::vector<double>& x, size_t n) {
   std::vector<double> y;
@@ -350,6 +425,7 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress, co
     if (b.kind != BodyKind::floe) continue;
     r.floe_id.push_back(b.id);
     r.floe_thickness_m.push_back(b.thickness_m);
+    r.floe_level_ice.push_back(b.fixed ? 1 : 0);
     for (const Vec2& p : b.outline) r.floe_vertices_m.insert(r.floe_vertices_m.end(), {p.x(), p.y()});
     r.floe_vertex_offset.push_back(static_cast<int64_t>(r.floe_vertices_m.size() / 2));
     r.floe_parent_id.push_back(b.parent_id);
@@ -521,6 +597,7 @@ nlohmann::json summarize(const Model& model, const Results& r) {
   s["removed_floe_ids"] = model.removed_floe_ids;
   s["small_floe_overlaps"] = model.small_overlaps;
   s["fracture"] = fracture_summary(o, r);
+  s["level_ice"] = level_ice_summary(model, r);
   const VesselParticulars& vp = model.vessel_info;
   s["vessel"] = {{"mass_kg", vp.mass_kg},
                  {"length_oa_m", vp.length_oa_m},

@@ -42,6 +42,11 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress = n
 // Summary statistics of the results (steady part from options.steady_start_s).
 nlohmann::json summarize(const Model& model, const Results& results);
 
+// Level ice (summary.json "level_ice"): the sheet's tiles and area at the start and the channel the vessel broke:
+// from the sheet's edge on its path to its centre of mass in the last frame (behind midship the channel is formed),
+// the sheet area lost there over that length is the channel's mean width, against the waterline beam.
+nlohmann::json level_ice_summary(const Model& model, const Results& results);
+
 // The stage: reads the inputs, builds the model, simulates, writes out_dir/results.h5 and out_dir/summary.json
 // atomically (nothing is written on error) and returns the report printed on stdout. Checkpoints go to
 // out_dir/checkpoint and are removed once the results are written; `resume` continues from the one there.

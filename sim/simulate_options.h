@@ -362,6 +362,18 @@ struct ContactOptions {
 // The simulation domain: optional fixed walls along the sides of a rectangle (a coast, fast ice or a basin), so
 // that floes driven by a current or wind pack against them instead of drifting away. Walls are static bodies with
 // rigid contacts (ice.mu_ice_ice); they are not written to the results.
+// A rectangle [x_min, y_min, x_max, y_max] in world metres, checked.
+inline Check<std::vector<double>> rectangle_m(bool may_be_empty) {
+  return [may_be_empty](const std::vector<double>& e) -> std::string {
+    if (e.empty()) return may_be_empty ? "" : "must be [x_min, y_min, x_max, y_max]";
+    if (e.size() != 4) return "must be [x_min, y_min, x_max, y_max]";
+    for (double x : e)
+      if (!std::isfinite(x)) return "must hold finite numbers";
+    if (!(e[2] > e[0] && e[3] > e[1])) return "needs x_max > x_min and y_max > y_min";
+    return "";
+  };
+}
+
 struct DomainOptions {
   std::vector<std::string> walls;   // any of "west", "east", "south", "north"
   std::vector<double> extent_m;     // [x_min, y_min, x_max, y_max]; empty: the floes file's extent [0, 0, w, h]
@@ -382,12 +394,7 @@ struct DomainOptions {
     v.field("extent_m", extent_m, "m",
             "domain rectangle [x_min, y_min, x_max, y_max] whose sides carry the walls; [] = the floes file's image "
             "extent [0, 0, width_m, height_m]",
-            Check<std::vector<double>>([](const std::vector<double>& e) -> std::string {
-              if (e.empty()) return "";
-              if (e.size() != 4) return "must be [] or [x_min, y_min, x_max, y_max]";
-              if (!(e[2] > e[0] && e[3] > e[1])) return "needs x_max > x_min and y_max > y_min";
-              return "";
-            }));
+            rectangle_m(true));
     v.field("wall_thickness_m", wall_thickness_m, "m", "thickness of each wall (outside the domain)", positive());
   }
 };
@@ -467,6 +474,71 @@ struct HealthOptions {
   }
 };
 
+// Open water cut out of a level ice sheet (a channel, or room for a pre-broken zone given as floes).
+struct LevelIceOpening {
+  std::vector<double> rect_m;
+  template <class V>
+  void visit(V& v) {
+    v.field("rect_m", rect_m, "m", "the opening [x_min, y_min, x_max, y_max]", rectangle_m(false));
+  }
+};
+
+// One point of a thickness that varies along x (the track): linear between points, constant beyond the ends.
+struct ThicknessPoint {
+  double x_m = 0;
+  double thickness_m = 1.0;
+  template <class V>
+  void visit(V& v) {
+    v.field("x_m", x_m, "m", "position along x", Check<double>([](const double& x) -> std::string {
+              return std::isfinite(x) ? "" : "must be finite";
+            }));
+    v.field("thickness_m", thickness_m, "m", "ice thickness there", positive());
+  }
+};
+
+// A level ice sheet (issue #10): a continuous sheet held by the ice around it, broken only by the fracture module.
+// It is cut into tiles of tile_m x tile_m on a grid centred on the sheet; each tile is one fixed body (a floe
+// of infinite mass, never awake: it costs nothing per step until the vessel or a moving floe touches it). A
+// wedge broken off a tile is a floe; what is left of the tile stays fixed (sim/model.h, Body::fixed). The sheet
+// may also come from the floes file (features with "kind": "level_ice"), tiled the same way.
+struct LevelIceOptions {
+  std::vector<double> extent_m;              // [] = no sheet from these options
+  double thickness_m = 1.0;
+  std::vector<ThicknessPoint> thickness_profile;  // [] = uniform thickness_m
+  std::vector<LevelIceOpening> openings;
+  double tile_m = 50.0;
+  template <class V>
+  void visit(V& v) {
+    v.field("extent_m", extent_m, "m",
+            "the sheet's rectangle [x_min, y_min, x_max, y_max]; [] = no sheet from these options (features of the "
+            "floes file with \"kind\": \"level_ice\" are sheets too)",
+            rectangle_m(true));
+    v.field("thickness_m", thickness_m, "m", "thickness of the sheet (when thickness_profile is empty)", positive());
+    v.list("thickness_profile", thickness_profile,
+           "thickness along x: [{\"x_m\", \"thickness_m\"}, ...] in increasing x, linear between points; each tile "
+           "takes the value at its centre (so tile_m sets the resolution)");
+    v.list("openings", openings, "open water cut out of the sheet: [{\"rect_m\": [x_min, y_min, x_max, y_max]}]");
+    v.field("tile_m", tile_m, "m",
+            "side of the square tiles the sheet is cut into (fixed bodies; a crack stops at a tile's side, so keep "
+            "it several times the ice's characteristic length)",
+            in_range(1, 1e4));
+    for (size_t i = 1; i < thickness_profile.size(); ++i)
+      if (!(thickness_profile[i].x_m > thickness_profile[i - 1].x_m))
+        v.problem("thickness_profile", "needs strictly increasing x_m (point " + std::to_string(i) + ")");
+  }
+  // The sheet's thickness at x (thickness_m, or the profile interpolated).
+  double thickness_at(double x) const {
+    const auto& p = thickness_profile;
+    if (p.empty()) return thickness_m;
+    if (x <= p.front().x_m) return p.front().thickness_m;
+    if (x >= p.back().x_m) return p.back().thickness_m;
+    size_t i = 1;
+    while (p[i].x_m < x) ++i;
+    const double s = (x - p[i - 1].x_m) / (p[i].x_m - p[i - 1].x_m);
+    return p[i - 1].thickness_m + s * (p[i].thickness_m - p[i - 1].thickness_m);
+  }
+};
+
 struct SimulateOptions {
   double time_step_s = 0.01;
   double duration_s = 100.0;
@@ -488,6 +560,7 @@ struct SimulateOptions {
   SleepOptions sleep;
   HealthOptions health;
   HullLoadOptions hull;
+  LevelIceOptions level_ice;
 
   template <class V>
   void visit(V& v) {
@@ -514,6 +587,7 @@ struct SimulateOptions {
     v.section("sleep", sleep, "sleeping of resting floes");
     v.section("health", health, "numerical health limits");
     v.section("hull", hull, "how the hull file is loaded (non-convex meshes)");
+    v.section("level_ice", level_ice, "a level ice sheet, broken by the fracture module (issue #10)");
     // Cross-field checks: whole numbers of steps, statistics window inside the run.
     if (time_step_s > 0 && duration_s > 0) {
       const double n = duration_s / time_step_s;

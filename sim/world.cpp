@@ -52,9 +52,10 @@ World::World(const Model& model) : model_(model), pool_(model.options.threads) {
   for (size_t b = 0; b < n; ++b) {
     state_.position[b] = model.bodies[b].initial_position;
     state_.orientation[b] = model.bodies[b].initial_orientation;
-    if (model.bodies[b].kind == BodyKind::wall) state_.awake[b] = 0;  // fixed: never integrated
+    if (is_fixed_body(model.bodies[b])) state_.awake[b] = 0;  // a wall or level ice: never integrated
     // An established drift: floes start with the current's velocity (horizontal).
-    if (model.bodies[b].kind == BodyKind::floe && o.water.enabled && o.water.floes_start_with_current)
+    if (model.bodies[b].kind == BodyKind::floe && !model.bodies[b].fixed && o.water.enabled &&
+        o.water.floes_start_with_current)
       state_.velocity[b] = Vec3(model.current.x(), model.current.y(), 0);
   }
   if (model.vessel >= 0) {
@@ -88,7 +89,7 @@ void World::sync() {
 }
 
 void World::wake(int body) {
-  if (model_.bodies[body].kind == BodyKind::wall || !state_.alive[body]) return;  // fixed or gone: never move
+  if (is_fixed_body(model_.bodies[body]) || !state_.alive[body]) return;  // fixed or gone: never move
   state_.awake[body] = 1;
   state_.still_time_s[body] = 0;
 }
@@ -322,7 +323,10 @@ void World::apply_fracture(FractureCut& cut) {
   ended_s_[parent] = t;
   collision_->remove_body(parent);
   const int first_new = static_cast<int>(model_.bodies.size());
-  for (const Polygon& piece : cut.pieces) {
+  for (size_t k = 0; k < cut.pieces.size(); ++k) {
+    const Polygon& piece = cut.pieces[k];
+    // Level ice: the wedge breaks free; what is left of the tile is still held by the sheet around it.
+    const bool fixed = parent_body.fixed && static_cast<int>(k) >= cut.wedge_pieces;
     if (is_brash(piece, h, min_area)) {
       // Brash (below the minimum area, or a sliver narrower than the ice is thick): a block, not a plate, that
       // would only add tiny masses and inertias to the solver's chains under the hull. Removed; its mass counted.
@@ -346,13 +350,14 @@ void World::apply_fracture(FractureCut& cut) {
     spec.created_s = t;
     spec.position = x + r;
     spec.orientation = q;
+    spec.fixed = fixed;
     model_.bodies.push_back(make_piece_body(spec, index, model_.options, model_.parts));
     grow_body_arrays();
     state_.position[index] = x + r;
     state_.orientation[index] = q;
     state_.velocity[index] = v + w.cross(r);
     state_.angular_velocity[index] = w;
-    state_.awake[index] = 1;
+    state_.awake[index] = fixed ? 0 : 1;
     solver_bodies_.inv_mass[index] = R * model_.bodies[index].inv_mass_added.asDiagonal() * R.transpose();
     solver_bodies_.inv_inertia_world[index] = R * model_.bodies[index].inv_inertia_added * R.transpose();
     e.child_ids.push_back(id);
@@ -371,6 +376,7 @@ Body make_piece_body(const PieceSpec& p, int body_index, const SimulateOptions& 
   b.created_s = p.created_s;
   b.initial_position = p.position;
   b.initial_orientation = p.orientation;
+  if (p.fixed) hold_fixed(b);
   return b;
 }
 
@@ -397,7 +403,7 @@ void World::stage_sleep() {
     state_.still_time_s[b] = slow ? state_.still_time_s[b] + dt : 0.0;
   }
   if (!sleep_allowed_) return;
-  // Islands (Box2D's rule): the awake bodies joined by this step's contacts (a fixed wall joins nothing). An island
+  // Islands (Box2D's rule): the awake bodies joined by this step's contacts (a wall or level ice joins nothing). An island
   // falls asleep as a whole once every floe in it has been slow for sleep.time_s, and never while the vessel is in
   // it; so floes resting against each other sleep too, and a sleeper touched by an awake body wakes (collide). A
   // partition does not depend on the order of the unions: deterministic.
@@ -407,7 +413,7 @@ void World::stage_sleep() {
   };
   for (int b : awake_list_) island_[b] = b;
   for (const Contact& c : contacts_) {
-    if (model_.bodies[c.body_a].kind == BodyKind::wall || model_.bodies[c.body_b].kind == BodyKind::wall) continue;
+    if (is_fixed_body(model_.bodies[c.body_a]) || is_fixed_body(model_.bodies[c.body_b])) continue;
     if (!state_.alive[c.body_a] || !state_.alive[c.body_b]) continue;  // broke up in this step
     const int ra = find(c.body_a), rb = find(c.body_b);
     if (ra != rb) island_[std::max(ra, rb)] = std::min(ra, rb);
@@ -489,6 +495,7 @@ void World::save(ByteWriter& w) const {
     w.pod(b.created_s);
     w.mat(b.initial_position);
     w.quat(b.initial_orientation);
+    w.pod<uint8_t>(b.fixed ? 1 : 0);
   }
   // 2. The state.
   const State& s = state_;
@@ -569,6 +576,7 @@ std::unique_ptr<World> World::restore(const Model& base, ByteReader& r) {
     p.created_s = r.pod<double>();
     r.mat(p.position);
     p.orientation = r.quat();
+    p.fixed = r.pod<uint8_t>() != 0;
     FLOESIM_REQUIRE(p.outline.size() >= 3 && signed_area(p.outline) > 0 && p.thickness_m > 0, r.what(),
                     ": damaged (piece ", p.id, " has no valid outline)");
     const int index = static_cast<int>(m.bodies.size());

@@ -146,7 +146,7 @@ class World {
 };
 
 // What makes a piece of a broken floe: its outline in its own body frame (centred on its centroid), thickness, id,
-// lineage and pose at birth. make_piece_body turns it into the body the world appends; the fracture stage and the
+// lineage, pose at birth, and whether it stays held by a level-ice sheet. make_piece_body turns it into the body the world appends; the fracture stage and the
 // restore from a checkpoint both use it, so they make the same body to the bit.
 struct PieceSpec {
   Polygon outline;
@@ -155,6 +155,7 @@ struct PieceSpec {
   double created_s = 0;
   Vec3 position = Vec3::Zero();
   Quat orientation = Quat::Identity();
+  bool fixed = false;  // level ice: the rest of a tile, still held by the sheet (hold_fixed)
 };
 Body make_piece_body(const PieceSpec& p, int body_index, const SimulateOptions& o, std::vector<ConvexPart>& parts);
 

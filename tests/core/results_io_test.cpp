@@ -194,7 +194,7 @@ TEST(ResultsIo, FractureEventsAndLineageRoundTrip) {
   const Results r = fractured_results();
   write_results(p, r);
   const Results b = read_results(p);
-  EXPECT_EQ(b.attributes["layout"], "floesim-results/4");
+  EXPECT_EQ(b.attributes["layout"], "floesim-results/5");
   EXPECT_EQ(b.floe_id, r.floe_id);
   EXPECT_EQ(b.floe_vertices_m, r.floe_vertices_m);
   EXPECT_EQ(b.floe_parent_id, r.floe_parent_id);
@@ -326,6 +326,31 @@ TEST(ResultsIo, LayoutThreeFilesReadWithNoFloeInContact) {
   fs::remove(p);
 }
 
+TEST(ResultsIo, LevelIceFlagRoundTripsAndLayoutFourFilesHaveNone) {
+  // Layout /5 records which floes are level ice tiles; a /4 file (today's writer, the dataset removed, the layout
+  // set back) has none; a /5 file without it is damaged and the error names it.
+  const fs::path p = fs::temp_directory_path() / "floesim_results_layout4.h5";
+  Results w = small_results(4);
+  w.floe_level_ice = {1};
+  write_results(p, w);
+  EXPECT_EQ(read_results(p).floe_level_ice, std::vector<int8_t>{1});
+  {
+    const hid_t f = H5Fopen(p.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(f, 0);
+    ASSERT_GE(H5Ldelete(f, "/geometry/floe_level_ice", H5P_DEFAULT), 0);
+    H5Fclose(f);
+  }
+  replace_attributes(p, {{"layout", "floesim-results/4"}, {"time_step_s", 0.01}});
+  EXPECT_EQ(read_results(p).floe_level_ice, std::vector<int8_t>{0});
+  replace_attributes(p, {{"layout", "floesim-results/5"}, {"time_step_s", 0.01}});
+  const std::string e = error_of([&] { read_results(p); });
+  EXPECT_NE(e.find("/geometry/floe_level_ice"), std::string::npos) << e;
+  // Written with a flag per floe or none (all 0), never with a wrong count.
+  w.floe_level_ice = {1, 0};
+  EXPECT_THROW(write_results(p, w), Error);
+  fs::remove(p);
+}
+
 TEST(ResultsIo, LayoutOneFilesFromBeforeFractureReadWithDefaults) {
   // A floesim-results/1 file: today's writer, then what /1 did not have removed and the layout set back.
   const fs::path p = fs::temp_directory_path() / "floesim_results_layout1.h5";
@@ -357,7 +382,7 @@ TEST(ResultsIo, LayoutOneFilesFromBeforeFractureReadWithDefaults) {
   // Rewritten, it becomes a file of the current layout with the same content.
   const fs::path q = fs::temp_directory_path() / "floesim_results_layout1_rewritten.h5";
   write_results(q, r);
-  EXPECT_EQ(read_results(q).attributes["layout"], "floesim-results/4");
+  EXPECT_EQ(read_results(q).attributes["layout"], "floesim-results/5");
   fs::remove(q);
 
   // A layout from the future is refused, naming it.

@@ -58,6 +58,32 @@ inline HullModel box_hull(double lx, double ly, double z0, double hz) {
   return h;
 }
 
+// A rectangular ramp as the vessel: the bow face of slope beta (from the horizontal) and width `width`, its stem
+// through (0, 0, 0) rising forward, 40 m long, from z = -5 to 3 m.
+inline HullModel ramp_hull(double beta_deg, double width) {
+  const double t = std::tan(beta_deg * kPi / 180);
+  // Profile in (x, z), CCW seen from +y... extruded along y; the stem passes through (0, 0) rising forward.
+  const std::vector<Vec2> profile = {{-40, -5}, {-5 / t, -5}, {3 / t, 3}, {-40, 3}};
+  TriMesh m;
+  for (double y : {-width / 2, width / 2})
+    for (const Vec2& q : profile) m.vertices.emplace_back(q.x(), y, q.y());
+  // Faces: sides y = -w/2 (0..3) and y = +w/2 (4..7), and the four quads between them.
+  auto quad = [&](int a, int b, int c, int d) {
+    m.triangles.push_back({a, b, c});
+    m.triangles.push_back({a, c, d});
+  };
+  quad(0, 1, 2, 3);
+  quad(4, 7, 6, 5);
+  for (int i = 0; i < 4; ++i) {
+    const int j = (i + 1) % 4;
+    quad(i, i + 4, j + 4, j);
+  }
+  HullModel h;
+  h.parts = {m};
+  h.surface = m;
+  return h;
+}
+
 // Runs f, expects floesim::Error whose message contains every piece.
 template <class F>
 void expect_error(F f, std::initializer_list<const char*> pieces) {

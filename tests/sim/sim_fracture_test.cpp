@@ -19,6 +19,7 @@ namespace floesim::sim {
 namespace {
 
 using testing::coarse_hull;
+using testing::ramp_hull;
 using testing::rect_floe;
 
 
@@ -179,31 +180,6 @@ TEST(Fracture, VerticalFaceNeverBendsASlopedFaceBendsBeforeSplitting) {
     EXPECT_NE(cuts[0].event.mode, kFractureSplitting) << "at " << mag << " N";
     break;
   }
-}
-
-// A rectangular ramp (the bow face of slope beta) as the vessel, driven into a floe: the whole chain.
-HullModel ramp_hull(double beta_deg, double width) {
-  const double t = std::tan(beta_deg * kPi / 180);
-  // Profile in (x, z), CCW seen from +y... extruded along y; the stem passes through (0, 0) rising forward.
-  const std::vector<Vec2> profile = {{-40, -5}, {-5 / t, -5}, {3 / t, 3}, {-40, 3}};
-  TriMesh m;
-  for (double y : {-width / 2, width / 2})
-    for (const Vec2& q : profile) m.vertices.emplace_back(q.x(), y, q.y());
-  // Faces: sides y = -w/2 (0..3) and y = +w/2 (4..7), and the four quads between them.
-  auto quad = [&](int a, int b, int c, int d) {
-    m.triangles.push_back({a, b, c});
-    m.triangles.push_back({a, c, d});
-  };
-  quad(0, 1, 2, 3);
-  quad(4, 7, 6, 5);
-  for (int i = 0; i < 4; ++i) {
-    const int j = (i + 1) % 4;
-    quad(i, i + 4, j + 4, j);
-  }
-  HullModel h;
-  h.parts = {m};
-  h.surface = m;
-  return h;
 }
 
 TEST(Fracture, RampDrivenIntoAFloeBreaksItAtTheTableLoad) {
