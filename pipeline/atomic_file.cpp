@@ -86,13 +86,16 @@ void ensure_directory(const std::filesystem::path& dir) {
   // A folder that exists may still refuse files (read-only mount, permissions): say so now, before hours of work
   // whose result could not be written.
   const std::filesystem::path probe = dir / (".tmp-" + std::to_string(::getpid()) + "-write-probe");
+  register_temporary(probe);  // a stop signal in between removes it too
   const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-  if (fd < 0 && errno != EEXIST)
-    throw Error(dir.string() + ": cannot write in the output directory: " + write_failure_reason(errno));
+  const int err = errno;
   if (fd >= 0) {
     ::close(fd);
     ::unlink(probe.c_str());
   }
+  unregister_temporary(probe);
+  if (fd < 0 && err != EEXIST)
+    throw Error(dir.string() + ": cannot write in the output directory: " + write_failure_reason(err));
 }
 
 }  // namespace floesim

@@ -249,6 +249,7 @@ struct Test {
   std::string video_frames;
   std::mt19937 rng;
   Figures f;
+  std::string last_kill_;  // the last kill, for the message of a recovery that fails
 
   std::vector<std::string> run_args(bool resume) const {
     std::vector<std::string> a = {(bin / "floesim").string(), "run", case_dir.string(), "--out", run.string()};
@@ -318,6 +319,7 @@ struct Test {
     }
     ++f.kills;
     ++f.per_kill[how];
+    last_kill_ = std::string(kill_name(how)) + " during " + (at.empty() ? "no stage" : at);
     ++f.per_stage[at.empty() ? "between stages" : at];
     if (how == Kill::sigint) {
       kill(pid, SIGINT);
@@ -394,7 +396,15 @@ struct Test {
     const std::string log = read_text(work / "recovery.log");
     if (rc != 0) {
       ++f.recovery_failed;
-      f.problems.push_back("the run after a kill failed (exit " + std::to_string(rc) + "):\n" + log);
+      // What else ran then (to look into it): the processes of floesim's stages and ninja on this machine.
+      std::string ps;
+      if (FILE* p = popen("ps -eo pid,ppid,pgid,sid,etimes,args | grep -E 'floesim|ninja' | grep -v grep", "r")) {
+        char buf[512];
+        while (std::fgets(buf, sizeof buf, p)) ps += buf;
+        pclose(p);
+      }
+      f.problems.push_back("the run after a kill (" + last_kill_ + ") failed (exit " + std::to_string(rc) + "):\n" +
+                           log + "processes:\n" + ps);
       return;
     }
     if (log.find("--resume: continuing from the checkpoint") != std::string::npos) ++f.resumed_from_checkpoint;
@@ -418,8 +428,13 @@ struct Test {
 
   void iteration(int i) {
     fs::remove_all(run);  // a fresh run folder, at the reference's path (artefacts name their folder)
-    const std::string target = kStages[static_cast<size_t>(i) % kStages.size()];
-    const Kill how = static_cast<Kill>(i % 3);
+    std::string target = kStages[static_cast<size_t>(i) % kStages.size()];
+    Kill how = static_cast<Kill>(i % 3);
+    if (const char* only = std::getenv("KILL_TEST_ONLY")) {  // STAGE:MODE (0 SIGINT, 1 SIGKILL runner, 2 all): a
+      const std::string o = only;                             // scenario repeated, to look into a failure
+      target = o.substr(0, o.find(':'));
+      how = static_cast<Kill>(std::stoi(o.substr(o.find(':') + 1)));
+    }
     kill_run(false, target, how);
     if (std::getenv("KILL_TEST_VERBOSE")) std::cout << "    target " << target << ", " << kill_name(how) << "\n";
     // Now and then the recovery itself is stopped too (at a random moment of the whole run), then run again.
