@@ -126,6 +126,15 @@ nlohmann::json keyed(nlohmann::json p) {
 
 std::string checkpoint_key(const nlohmann::json& provenance) { return sha256_bytes(keyed(provenance).dump()); }
 
+void remove_checkpoint(const fs::path& dir) {
+  // checkpoint.bin first: a kill during the removal then leaves no checkpoint rather than one naming chunks that
+  // are gone (the order of a folder's entries is the file system's).
+  std::error_code ec;
+  fs::remove(dir / "checkpoint.bin", ec);
+  fs::remove(dir / "checkpoint.json", ec);
+  fs::remove_all(dir, ec);
+}
+
 Checkpointer::Checkpointer(fs::path dir, nlohmann::json provenance)
     : dir_(std::move(dir)), provenance_(std::move(provenance)), key_(checkpoint_key(provenance_)) {
   // Temporaries of a checkpoint write that was killed (one simulate runs in a folder at a time).
@@ -213,7 +222,8 @@ void Checkpointer::save(const World& world, const Results& r, const RecorderSums
     ensure_directory(dir_);
     if (!replaced_old_) {
       // A fresh run's first checkpoint replaces whatever checkpoint the folder held.
-      for (const auto& e : fs::directory_iterator(dir_)) fs::remove_all(e.path());
+      remove_checkpoint(dir_);
+      ensure_directory(dir_);
       replaced_old_ = true;
     }
     const long step = world.state().step;

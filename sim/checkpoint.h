@@ -42,6 +42,10 @@ struct RecorderSums {
 // The key of a run from its provenance (see above).
 std::string checkpoint_key(const nlohmann::json& provenance);
 
+// Removes a checkpoint folder, checkpoint.bin first (whenever the removal is cut short, what is left is either a
+// whole checkpoint or none).
+void remove_checkpoint(const std::filesystem::path& dir);
+
 class Checkpointer {
  public:
   // `dir`: OUT/checkpoint; `provenance`: the stage's (make_provenance), whose key identifies the run.

@@ -668,8 +668,7 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   // 3. Artefacts, atomically; then the checkpoint has served.
   write_results(out_dir / "results.h5", results);
   write_text_atomic(out_dir / "summary.json", summary.dump(2) + "\n");
-  std::error_code ec;
-  fs::remove_all(checkpoints.dir, ec);
+  remove_checkpoint(checkpoints.dir);
 
   // 4. The report (wall time lives here, not in the artefacts).
   std::ostringstream rep;
