@@ -12,6 +12,7 @@
 
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
+#include "pipeline/ice_resistance.h"
 #include "pipeline/provenance.h"
 #include "pipeline/units.h"
 #include "render/gnuplot.h"
@@ -352,6 +353,48 @@ void fracture_counts(const Json& s, const fs::path& file, MemberResult& m) {
   }
 }
 
+// Level ice: both formulas at the member's mean speed, for its hull and the sheet's ice as the summary gives it
+// (the area-weighted mean thickness). A hull the formulas cannot take (a bulb: Lindqvist refuses phi >= 90 deg) or a
+// hull.json without particulars leaves them NaN with the reason; the member stays ok.
+void level_ice_reference(const Json& s, const PlanMember& pm, MemberResult& m) {
+  m.lindqvist_kN = m.riska_kN = m.channel_width_over_beam = kNaN;
+  if (!s.contains("level_ice") || !s["level_ice"].is_object() || !s["level_ice"].contains("ice")) return;
+  m.level_ice = true;
+  const Json& li = s["level_ice"];
+  if (li.contains("channel") && li["channel"].is_object() && li["channel"].contains("width_over_beam") &&
+      li["channel"]["width_over_beam"].is_number())
+    m.channel_width_over_beam = li["channel"]["width_over_beam"].get<double>();
+  try {
+    fs::path hull_json;
+    for (const PlanStage& st : pm.stages)
+      if (st.name == "hull")
+        for (const fs::path& o : st.outputs)
+          if (o.extension() == ".obj") hull_json = fs::path(o).replace_extension(".json");
+    FLOESIM_REQUIRE(!hull_json.empty(), "the plan gives member ", pm.id, " no hull stage with an OBJ");
+    const Json& ice = li["ice"];
+    auto num = [&](const char* key) {
+      FLOESIM_REQUIRE(ice.contains(key) && ice[key].is_number(), pm.summary.string(), ": level_ice.ice.", key,
+                      " is missing or not a number");
+      return ice[key].get<double>();
+    };
+    LevelIce l;
+    l.thickness_m = num("thickness_m");
+    l.flexural_strength_pa = num("flexural_strength_pa");
+    l.youngs_modulus_pa = num("youngs_modulus_pa");
+    l.poisson_ratio = num("poisson_ratio");
+    l.ice_density_kg_m3 = num("ice_density_kg_m3");
+    l.water_density_kg_m3 = num("water_density_kg_m3");
+    l.gravity_mps2 = num("gravity_mps2");
+    l.friction = num("mu_ice_structure");
+    const IceHull hull = read_ice_hull(hull_json);
+    m.lindqvist_kN = lindqvist(hull, l, m.mean_speed_mps).total_n / 1000.0;
+    m.riska_kN = riska(hull, l.thickness_m, m.mean_speed_mps).total_n / 1000.0;
+  } catch (const Error& e) {
+    m.lindqvist_kN = m.riska_kN = kNaN;
+    m.reference_error = e.what();
+  }
+}
+
 MemberResult gather_member(const PlanMember& pm, SteadyResistance& series) {
   MemberResult m;
   m.id = pm.id;
@@ -373,6 +416,7 @@ MemberResult gather_member(const PlanMember& pm, SteadyResistance& series) {
     m.mean_resistance_kN = summary_number(s, "mean_surge_ice_resistance_N", pm.summary) / 1000.0;
     m.mean_speed_mps = summary_number(s, "mean_vessel_speed_mps", pm.summary);
     fracture_counts(s, pm.summary, m);
+    level_ice_reference(s, pm, m);
     const Results r = read_results(pm.results, /*with_states=*/false);
     series = steady_resistance(r, pm.results.string());
     m.series = resistance_stats(series);
@@ -384,6 +428,7 @@ MemberResult gather_member(const PlanMember& pm, SteadyResistance& series) {
 
   // 3. Failed: why. The first stage (in run order) that did not make all its outputs and left a log says it.
   m.mean_resistance_kN = m.mean_speed_mps = kNaN;
+  m.lindqvist_kN = m.riska_kN = m.channel_width_over_beam = kNaN;
   m.fracture_bending = m.fracture_radial = m.fracture_splitting = 0;
   m.series = ResistanceStats{};
   m.series.mean_kN = m.series.batch_means_se_kN = m.series.peak_kN = kNaN;
@@ -422,6 +467,9 @@ const std::vector<std::string> kResultColumns = {
     "mean_surge_ice_resistance_kN", "batch_means_se_kN", "mean_speed_mps",   "peak_0.5s_resistance_kN",
     "fracture_bending",             "fracture_radial",   "fracture_splitting", "wall_s",
     "status",                       "error"};
+// Level ice sweeps (a member's summary has level_ice.ice): PHYSICS.md §6's formulas at the member's mean speed.
+const std::vector<std::string> kLevelIceColumns = {"lindqvist_kN",  "riska_kN", "ratio_to_lindqvist",
+                                                   "ratio_to_riska", "channel_width_over_beam", "reference_error"};
 
 std::string fmt(const char* f, double a) {
   char b[64];
@@ -570,6 +618,52 @@ void draw_axis_plot(const SweepPlan& plan, const GatherResult& g, size_t k, Plot
   f.draw(body.str(), data.str());
 }
 
+// Level ice: each member's mean resistance with its 95 % interval (1.96 batch-means standard errors) against its
+// mean speed, a colour per sheet thickness (the axis "simulate.level_ice.thickness_m" if the sweep has it, else
+// one colour), with Lindqvist (solid) and Riska (dashed) at the same speeds.
+void draw_level_ice_plot(const SweepPlan& plan, const GatherResult& g, PlotFiles& f) {
+  const std::string hkey = "simulate.level_ice.thickness_m";
+  std::vector<std::string> groups;
+  std::vector<std::vector<const MemberResult*>> members;
+  for (size_t i = 0; i < g.members.size(); ++i) {
+    const MemberResult& m = g.members[i];
+    if (!m.ok || !m.level_ice) continue;
+    const Json& axes = plan.members[i].axes;
+    const std::string label = axes.contains(hkey) ? "h = " + value_text(axes[hkey]) + " m" : "level ice";
+    const size_t k = std::find(groups.begin(), groups.end(), label) - groups.begin();
+    if (k == groups.size()) groups.push_back(label), members.emplace_back();
+    members[k].push_back(&m);
+  }
+  double to_unit = 1;
+  const ForceUnit unit = plot_unit(g, &to_unit);
+  std::ostringstream data, plot;
+  for (size_t k = 0; k < groups.size(); ++k) {
+    std::sort(members[k].begin(), members[k].end(),
+              [](auto* a, auto* b) { return a->mean_speed_mps < b->mean_speed_mps; });
+    if (k > 0) data << "\n\n";
+    for (const MemberResult* m : members[k]) {
+      const double hw = 1.96 * m->series.batch_means_se_kN;
+      data << fmt("%.10g", m->mean_speed_mps) << ' ' << fmt("%.10g", to_unit * m->mean_resistance_kN) << ' '
+           << fmt("%.10g", to_unit * (m->mean_resistance_kN - hw)) << ' '
+           << fmt("%.10g", to_unit * (m->mean_resistance_kN + hw)) << ' ' << fmt("%.10g", to_unit * m->lindqvist_kN)
+           << ' ' << fmt("%.10g", to_unit * m->riska_kN) << '\n';
+    }
+    plot << (k == 0 ? "plot data" : ", \\\n  data") << " index " << k << " using 1:2:3:4 with yerrorlines lc rgb '"
+         << colour(k) << "' lw 2 pt 7 ps 1.2 title " << gnuplot_quoted("simulated, " + groups[k])
+         << ", \\\n  data index " << k << " using 1:5 with lines lc rgb '" << colour(k)
+         << "' lw 1.5 dt 1 title 'Lindqvist', \\\n  data index " << k << " using 1:6 with lines lc rgb '"
+         << colour(k) << "' lw 1.5 dt 2 title 'Riska'";
+  }
+  std::ostringstream body;
+  body << "set title " << gnuplot_quoted(plan.name + ": level-ice resistance against Lindqvist and Riska")
+       << " noenhanced font ',14'\n"
+       << "set xlabel 'Mean speed (m/s)'\n"
+       << "set ylabel 'Mean ice resistance (" << unit.name << "), 95 % interval (batch means)'\n"
+       << "set xrange [0:*]\nset yrange [0:*]\n"
+       << plot.str();
+  f.draw(body.str(), data.str());
+}
+
 // A pure ensemble: each member's mean resistance, and the ensemble mean with its 95 % interval as a band.
 void draw_ensemble_plot(const SweepPlan& plan, const GatherResult& g, PlotFiles& f) {
   const ConfidenceInterval& ci = g.grid_points.front().ci;
@@ -681,6 +775,12 @@ GatherResult gather_sweep(const SweepPlan& plan, const fs::path& plan_file, cons
     if (g.members.back().ok && !first_ok) first_ok = &g.members.back(), first_series = std::move(s);
   }
 
+  // Level ice: the formulas beside the simulated means (columns only when a member ran in level ice).
+  const bool level_ice = std::any_of(g.members.begin(), g.members.end(), [](const MemberResult& m) {
+    return m.level_ice;
+  });
+  if (level_ice) g.columns.insert(g.columns.end(), kLevelIceColumns.begin(), kLevelIceColumns.end());
+
   // 3. Ensemble statistics per grid point, over its ok members (the ensemble members are independent runs).
   for (const PlanGridPoint& p : plan.grid_points) {
     GridPointResult gp;
@@ -735,6 +835,11 @@ GatherResult gather_sweep(const SweepPlan& plan, const fs::path& plan_file, cons
                                number_text(m.mean_speed_mps), number_text(m.series.peak_kN),
                                count(m.fracture_bending), count(m.fracture_radial), count(m.fracture_splitting),
                                number_text(m.wall_s), m.ok ? "ok" : "failed", csv_field(m.error, true)});
+    const double to_l = m.mean_resistance_kN / m.lindqvist_kN, to_r = m.mean_resistance_kN / m.riska_kN;
+    if (level_ice)
+      cells.insert(cells.end(), {number_text(m.lindqvist_kN), number_text(m.riska_kN), number_text(to_l),
+                                 number_text(to_r), number_text(m.channel_width_over_beam),
+                                 csv_field(m.reference_error, true)});
     for (size_t c = 0; c < cells.size(); ++c) csv << (c ? "," : "") << cells[c];
     csv << '\n';
     row["mean_surge_ice_resistance_kN"] = json_number(m.mean_resistance_kN);
@@ -747,6 +852,14 @@ GatherResult gather_sweep(const SweepPlan& plan, const fs::path& plan_file, cons
     row["wall_s"] = json_number(m.wall_s);
     row["status"] = m.ok ? "ok" : "failed";
     row["error"] = m.error;
+    if (level_ice) {
+      row["lindqvist_kN"] = json_number(m.lindqvist_kN);
+      row["riska_kN"] = json_number(m.riska_kN);
+      row["ratio_to_lindqvist"] = json_number(to_l);
+      row["ratio_to_riska"] = json_number(to_r);
+      row["channel_width_over_beam"] = json_number(m.channel_width_over_beam);
+      row["reference_error"] = m.reference_error;
+    }
     // Not a CSV column: how the standard error and the peak were taken from the series.
     if (m.ok)
       row["steady_series"] = {{"steady_start_s", m.series.steady_start_s},
@@ -791,6 +904,10 @@ GatherResult gather_sweep(const SweepPlan& plan, const fs::path& plan_file, cons
       if (!stems.insert(stem).second) stem += "_" + std::to_string(k);  // two keys that differ only in punctuation
       plots.push_back(std::make_unique<PlotFiles>(out_dir, stem));
       draw_axis_plot(plan, g, k, *plots.back());
+    }
+    if (level_ice) {
+      plots.push_back(std::make_unique<PlotFiles>(out_dir, "level_ice_resistance"));
+      draw_level_ice_plot(plan, g, *plots.back());
     }
     plots.push_back(std::make_unique<PlotFiles>(out_dir, "running_mean"));
     draw_running_mean(*first_ok, first_series, *plots.back());

@@ -118,6 +118,11 @@ struct MemberResult {
   int64_t fracture_bending = 0, fracture_radial = 0, fracture_splitting = 0;
   ResistanceStats series;          // from results.h5
   double wall_s = 0;               // sum of the stages' wall_ms / 1000; NaN if none was recorded
+  // Level ice (issue #10; summary.json has level_ice.ice): Lindqvist's and Riska's resistance (PHYSICS.md §6) for
+  // the member's hull (its hull stage's hull.json), ice and mean speed, and the channel's width over the beam.
+  bool level_ice = false;
+  double lindqvist_kN = 0, riska_kN = 0, channel_width_over_beam = 0;  // NaN when not known
+  std::string reference_error;     // why the formulas could not be evaluated ("" if they were)
 };
 
 struct GridPointResult {

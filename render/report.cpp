@@ -453,6 +453,8 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
     // A user's mesh: how it was placed and where it floats (floesim-hull's report).
     if (const Json* pl = find(h, {"placement"})) body << scalar_rows(*pl, "placement.");
     if (const Json* wl = find(h, {"waterline"})) body << scalar_rows(*wl, "waterline.");
+    // The angles and lengths the level-ice resistance formulas take (floesim-resistance).
+    if (const Json* pa = find(h, {"particulars"})) body << scalar_rows(*pa, "particulars.");
     body << scalar_rows(h);
   } else if (fs::exists(run_dir / "config/hull.json")) {
     pg.missing.push_back("hull/hull.json (hull particulars)");

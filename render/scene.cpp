@@ -137,6 +137,7 @@ struct FloeDraw {
   GLint ring_first = 0, ring_count = 0;  // outline of the top face (line loop)
   double radius = 0;                     // bounding sphere about the centre of mass
   float shade = 1;                       // the per-floe shade of its top colour (also applied to contact_colour)
+  bool sheet = false;                    // a tile of level ice: never lit as "in contact" (a whole tile would be)
 };
 
 // One camera's rectangle in the output frame (pixels, top-left origin): the whole frame, or a half of a split one.
@@ -293,6 +294,7 @@ struct SceneRenderer::Impl {
       const float t[3] = {top[0] * shade, top[1] * shade, top[2] * shade};
       FloeDraw& f = floes[g];
       f.shade = shade;
+      f.sheet = sheet;
       f.first = vertex_count();
       const double zt = h / 2, zb = -h / 2;
       const Vec3 up(0, 0, 1);
@@ -583,7 +585,7 @@ struct SceneRenderer::Impl {
           batch_col.insert(batch_col.end(), rgba, rgba + 4);
         }
       };
-      const bool touching = o.show_contact && r.state_in_contact[row] != 0;
+      const bool touching = o.show_contact && !f.sheet && r.state_in_contact[row] != 0;
       emit(f.first, f.top_count, rot.col(2), touching ? contact : nullptr);
       // Sides facing away from the camera are hidden by the slab itself: dropping them here halves the side
       // triangles (and in the top view, looking straight down, all of them).

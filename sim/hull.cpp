@@ -19,6 +19,7 @@
 #include "pipeline/error.h"
 #include "pipeline/provenance.h"
 #include "pipeline/geometry2d.h"
+#include "sim/hull_particulars.h"
 
 namespace floesim::sim {
 
@@ -95,6 +96,7 @@ class IcebreakerGeometry {
     z_keel_ = -o.draught_m;
     z_deck_ = o.depth_m - o.draught_m;
     tan_stem_ = std::tan(deg(o.stem_angle_deg));
+    tan_entrance_ = std::tan(deg(o.entrance_angle_deg));
     // Forefoot: where the spoon meets the keel. Kept in the forward half, so a very low stem angle still leaves a
     // parallel body (the spoon then ends below the deck in a flat, vertical stem face).
     x_forefoot_ = std::max(x_fwd_ - o.depth_m / tan_stem_, 0.0);
@@ -107,6 +109,7 @@ class IcebreakerGeometry {
   double x_fwd() const { return x_fwd_; }
   double z_deck() const { return z_deck_; }
   double x_reamer() const { return x_reamer_; }
+  bool wedge_bow() const { return o_.entrance_angle_deg < 90.0; }
 
   Station at(double x) const {
     const HullGeneratorOptions& o = o_;
@@ -178,9 +181,55 @@ class IcebreakerGeometry {
     return pts;
   }
 
+  // The whole section at x (both sides, a ring) of the wedge bow: the section above cut by the two planes
+  //   |y| <= (x_s(z) - x) tan(alpha),  x_s(z) = x_forefoot + (z - z_keel) / tan(stem),
+  // which contain the stem line x_s(z) (the spoon's centreline) and meet the waterline at alpha to the centreline.
+  // A plane through a line rising at the stem angle phi whose waterline makes alpha with the centreline slopes at
+  // arctan(tan(phi) / sin(alpha)) across its waterline: Lindqvist's normal flare psi, exactly. Where the planes cut,
+  // the stem stays the spoon's line (they meet the centreline on it) and the sections become V-shaped.
+  std::vector<Eigen::Vector2d> wedge_section(double x) const {
+    const std::vector<Eigen::Vector2d> half = half_section(x);
+    std::vector<Eigen::Vector2d> ring(half.begin(), half.end());
+    for (auto it = half.rbegin(); it != half.rend(); ++it) ring.emplace_back(-it->x(), it->y());
+    for (const double side : {1.0, -1.0}) {
+      auto outside = [&](const Eigen::Vector2d& p) {  // > 0 beyond the plane on this side
+        return side * p.x() - (x_forefoot_ + (p.y() - z_keel_) / tan_stem_ - x) * tan_entrance_;
+      };
+      std::vector<Eigen::Vector2d> in;
+      in.swap(ring);
+      for (size_t i = 0; i < in.size(); ++i) {  // Sutherland-Hodgman against one plane
+        const Eigen::Vector2d &p = in[i], &q = in[(i + 1) % in.size()];
+        const double fp = outside(p), fq = outside(q);
+        if (fp <= 0) ring.push_back(p);
+        if ((fp < 0 && fq > 0) || (fp > 0 && fq < 0)) ring.push_back(p + (fp / (fp - fq)) * (q - p));
+      }
+    }
+    // Drop repeated and collinear points (a point on the centreline in the middle of the flat bottom or the deck
+    // edge), so that the convex parts are built from the section's corners only.
+    const double tol = 1e-9 * std::max(1.0, o_.length_m);
+    std::vector<Eigen::Vector2d> out;
+    for (const Eigen::Vector2d& p : ring)
+      if (out.empty() || (p - out.back()).norm() > tol) out.push_back(p);
+    while (out.size() > 1 && (out.front() - out.back()).norm() <= tol) out.pop_back();
+    for (bool again = out.size() >= 3; again && out.size() >= 3;) {
+      again = false;
+      for (size_t i = 0; i < out.size(); ++i) {
+        const Eigen::Vector2d &a = out[(i + out.size() - 1) % out.size()], &b = out[i], &c = out[(i + 1) % out.size()];
+        const Eigen::Vector2d u = b - a, w = c - b;
+        if (std::abs(u.x() * w.y() - u.y() * w.x()) <= tol * (u.norm() + w.norm())) {
+          out.erase(out.begin() + static_cast<long>(i));
+          again = true;
+          break;
+        }
+      }
+    }
+    if (out.empty()) out.emplace_back(0.0, z_deck_);  // the stem head, lost to round-off: keep its point
+    return out;
+  }
+
  private:
   HullGeneratorOptions o_;
-  double x_aft_, x_fwd_, z_keel_, z_deck_, tan_stem_, x_forefoot_, x_reamer_, x_shoulder_, x_run_;
+  double x_aft_, x_fwd_, z_keel_, z_deck_, tan_stem_, tan_entrance_, x_forefoot_, x_reamer_, x_shoulder_, x_run_;
 };
 
 // ---- mesh topology -----------------------------------------------------------------------------------------------
@@ -330,6 +379,15 @@ std::vector<TriMesh> generate_hull(const HullGeneratorOptions& o) {
   std::vector<std::vector<Vec3>> stations(n + 1);
   for (int i = 0; i <= n; ++i) {
     const double x = grid(xs[i]);
+    if (g.wedge_bow()) {  // the whole section, cut by the wedge planes; its points on the centreline taken once
+      for (const auto& p : g.wedge_section(x)) stations[i].emplace_back(x, grid(p.x()), grid(p.y()));
+      auto less = [](const Vec3& a, const Vec3& b) {
+        return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+      };
+      std::sort(stations[i].begin(), stations[i].end(), less);
+      stations[i].erase(std::unique(stations[i].begin(), stations[i].end()), stations[i].end());
+      continue;
+    }
     for (const auto& p : g.half_section(x)) {
       const double y = grid(p.x()), z = grid(p.y());
       stations[i].emplace_back(x, y, z);
@@ -456,6 +514,25 @@ nlohmann::json hydrostatics_json(const Hydrostatics& h, double rho_w) {
           {"centre_of_buoyancy_m", {h.centre_of_buoyancy.x(), h.centre_of_buoyancy.y(), h.centre_of_buoyancy.z()}}};
 }
 
+// The particulars the ice-resistance formulas take, measured from `surface`, into the sidecar and the summary. A hull
+// whose bow cannot be measured (a catamaran has no stem on its centreline) is still written: the sidecar then holds
+// "particulars": null and the reason, which floesim-resistance reports.
+void add_particulars(const TriMesh& surface, const std::string& where, nlohmann::json& side, std::ostream& sum) {
+  try {
+    const HullParticulars p = measure_particulars(surface, where);
+    side["particulars"] = particulars_json(p);
+    sum << "  ice particulars      L " << fmt_num(p.length_m) << " m, B " << fmt_num(p.beam_m) << " m, T "
+        << fmt_num(p.draught_m) << " m; stem angle phi " << fmt_num(p.stem_angle_deg, 4) << " deg, entrance angle alpha "
+        << fmt_num(p.entrance_angle_deg, 4) << " deg (at B/4), normal flare psi " << fmt_num(p.normal_flare_deg, 4)
+        << " deg; phi at B/4 " << fmt_num(p.bow_angle_b4_deg, 4) << " deg; parallel midbody "
+        << fmt_num(p.parallel_midbody_m, 4) << " m, bow length " << fmt_num(p.bow_length_m, 4) << " m\n";
+  } catch (const Error& e) {
+    side["particulars"] = nullptr;
+    side["particulars_error"] = e.what();
+    sum << "  ice particulars      not measured: " << e.what() << "\n";
+  }
+}
+
 }  // namespace
 
 std::string write_generated_hull(const HullGeneratorOptions& o, const fs::path& out_obj, const fs::path& config_file) {
@@ -472,7 +549,7 @@ std::string write_generated_hull(const HullGeneratorOptions& o, const fs::path& 
        << " z = 0; origin midship on the centreline\n"
        << "length_m " << o.length_m << ", beam_m " << o.beam_m << ", reamer_beam_m " << o.reamer_beam_m
        << ", draught_m " << o.draught_m << ", depth_m " << o.depth_m << ", stem_angle_deg " << o.stem_angle_deg
-       << ", sections " << o.sections << "\n"
+       << ", entrance_angle_deg " << o.entrance_angle_deg << ", sections " << o.sections << "\n"
        << "volume below z = 0: " << fmt_num(h.volume_m3) << " m^3; displacement " << fmt_num(h.displacement_t)
        << " t at rho_w = " << rho_w << " kg/m^3\n"
        << "waterplane area " << fmt_num(h.waterplane_area_m2) << " m^2, LCB " << fmt_num(h.lcb_m) << " m, KB "
@@ -490,6 +567,8 @@ std::string write_generated_hull(const HullGeneratorOptions& o, const fs::path& 
   side["triangles"] = nt;
   side["extent_m"] = {{"x", {b.lo.x(), b.hi.x()}}, {"y", {b.lo.y(), b.hi.y()}}, {"z", {b.lo.z(), b.hi.z()}}};
   side["hydrostatics"] = hydrostatics_json(h, rho_w);
+  std::ostringstream particulars_text;
+  add_particulars(merge(parts), "the generated hull", side, particulars_text);
 
   fs::path sidecar = out_obj;
   sidecar.replace_extension(".json");
@@ -511,6 +590,7 @@ std::string write_generated_hull(const HullGeneratorOptions& o, const fs::path& 
       << "  LCB                  " << fmt_num(h.lcb_m) << " m (x of the centre of buoyancy; + is forward of midship)\n"
       << "  KB                   " << fmt_num(h.kb_m) << " m\n"
       << "  wetted surface       " << fmt_num(h.wetted_surface_m2) << " m^2\n";
+  sum << particulars_text.str();
   return sum.str();
 }
 
@@ -971,18 +1051,6 @@ void require_floating(const HullModel& hull, const std::string& where) {
 
 namespace {
 
-// Lowest z of the mesh's section at x (where triangle edges cross the plane x = const); +inf if none.
-double lowest_z_at(const TriMesh& m, double x) {
-  double lo = std::numeric_limits<double>::infinity();
-  for (const auto& t : m.triangles)
-    for (int k = 0; k < 3; ++k) {
-      const Vec3 &a = m.vertices[t[k]], &b = m.vertices[t[(k + 1) % 3]];
-      if ((a.x() - x) * (b.x() - x) > 0 || a.x() == b.x()) continue;
-      lo = std::min(lo, a.z() + (b.z() - a.z()) * ((x - a.x()) / (b.x() - a.x())));
-    }
-  return lo;
-}
-
 // Mass in the unit that reads best: kg for a model, t for a ship.
 std::string mass_text(double kg) { return kg < 1e4 ? fmt_num(kg, 4) + " kg" : fmt_num(kg / 1000.0, 5) + " t"; }
 
@@ -1082,6 +1150,9 @@ std::string write_imported_hull(const HullImportOptions& o, const fs::path& out_
                        {"draught_mid_wl_m", draught_mid},
                        {"draught_max_m", h.draught_m}};
   side["hydrostatics"] = hydrostatics_json(h, rho);
+  // The particulars of the mesh as read and placed (the reference), not of its convex parts.
+  std::ostringstream particulars_text;
+  add_particulars(m.mesh, mesh_file.string(), side, particulars_text);
   {  // what the loader did, one line per entry (placement, meshes, total)
     nlohmann::json lines = nlohmann::json::array();
     std::istringstream rep(m.report);
@@ -1114,7 +1185,7 @@ std::string write_imported_hull(const HullImportOptions& o, const fs::path& out_
       << " m at the deepest point\n"
       << "  waterplane area      " << fmt_num(h.waterplane_area_m2) << " m^2, LCB " << fmt_num(h.lcb_m) << " m, KB "
       << fmt_num(h.kb_m) << " m, wetted surface " << fmt_num(h.wetted_surface_m2) << " m^2\n"
-      << "loader:\n";
+      << particulars_text.str() << "loader:\n";
   std::istringstream rep(m.report);
   for (std::string line; std::getline(rep, line);) sum << "  " << line << "\n";
   return sum.str();

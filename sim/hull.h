@@ -19,6 +19,7 @@ struct HullGeneratorOptions {
   double draught_m = 8.0;            // design draught
   double depth_m = 14.0;             // keel to deck
   double stem_angle_deg = 22.0;      // bow stem angle to the waterline (Oden's broad bow is very flat)
+  double entrance_angle_deg = 90.0;  // waterline entrance angle; 90: the spoon bow, square across (Oden's)
   int sections = 30;                 // convex parts along the length (20..40)
   template <class V>
   void visit(V& v) {
@@ -28,6 +29,11 @@ struct HullGeneratorOptions {
     v.field("draught_m", draught_m, "m", "design draught", positive());
     v.field("depth_m", depth_m, "m", "keel to deck (> draught_m)", positive());
     v.field("stem_angle_deg", stem_angle_deg, "deg", "stem angle to the waterline", in_range(5, 80));
+    v.field("entrance_angle_deg", entrance_angle_deg, "deg",
+            "waterline entrance angle alpha: below 90 the bow is cut by two planes through the stem line, each meeting "
+            "the waterline at alpha to the centreline (a wedge bow, normal flare arctan(tan(stem) / sin(alpha))); "
+            "90 = the spoon bow, its waterline square across",
+            in_range(10, 90));
     v.field("sections", sections, "-", "number of convex parts", int_in_range(4, 64));
     if (reamer_beam_m < beam_m) v.problem("reamer_beam_m", "must be >= beam_m");
     if (depth_m <= draught_m) v.problem("depth_m", "must be > draught_m");

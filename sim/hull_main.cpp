@@ -1,6 +1,6 @@
 // floesim-hull: writes the parametric icebreaker (Oden's main particulars by default), or places and decomposes a
-// user's mesh (a config with "file"), as an OBJ of convex parts with a JSON sidecar of particulars, hydrostatics and
-// provenance.
+// user's mesh (a config with "file"), as an OBJ of convex parts with a JSON sidecar of particulars, hydrostatics,
+// the angles and lengths the ice-resistance formulas take (measured from the mesh) and provenance.
 #include <iostream>
 
 #include <CLI/CLI.hpp>
@@ -10,9 +10,11 @@
 #include "sim/hull.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"Writes a hull as an OBJ of convex parts (one object per part) plus FILE.json with its hydrostatics:\n"
-               "the parametric icebreaker (config: generator options), or a user's mesh placed in the hull frame\n"
-               "and cut into convex parts (config with \"file\": the case's hull section).",
+  CLI::App app{"Writes a hull as an OBJ of convex parts (one object per part) plus FILE.json with its hydrostatics\n"
+               "and the particulars the ice-resistance formulas take (stem angle, entrance angle, flare, L, B, T,\n"
+               "parallel midbody, bow length; measured from the mesh): the parametric icebreaker (config: generator\n"
+               "options), or a user's mesh placed in the hull frame and cut into convex parts (config with \"file\":\n"
+               "the case's hull section).",
                "floesim-hull"};
   std::string config, out;
   bool help_config = false, check_config = false;

@@ -181,6 +181,19 @@ nlohmann::json level_ice_summary(const Model& model, const Results& r) {
       for (const Vec2& p : piece) u_edge = std::min(u_edge, to_track(p).x());
   }
   j["sheet_area_start_m2"] = sheet_area;
+  // The sheet's ice as the level-ice resistance formulas take it (PHYSICS.md §6; a sweep's gather evaluates them
+  // beside the simulated mean): the area-weighted mean thickness of the sheet and the material of the run.
+  double h_area = 0;
+  for (int b : tiles) h_area += model.bodies[b].thickness_m * model.bodies[b].section_area;
+  const SimulateOptions& o = model.options;
+  j["ice"] = {{"thickness_m", h_area / sheet_area},
+              {"flexural_strength_pa", o.fracture.flexural_strength_pa},
+              {"youngs_modulus_pa", o.fracture.youngs_modulus_pa},
+              {"poisson_ratio", o.fracture.poisson_ratio},
+              {"ice_density_kg_m3", o.ice.density_kg_m3},
+              {"water_density_kg_m3", o.water.density_kg_m3},
+              {"gravity_mps2", o.water.gravity_mps2},
+              {"mu_ice_structure", o.ice.mu_ice_structure}};
   // The vessel at the end (last frame) and the tiles alive then.
   const size_t last = r.frames() - 1;
   double u_end = -std::numeric_limits<double>::infinity();
@@ -220,6 +233,25 @@ nlohmann::json level_ice_summary(const Model& model, const Results& r) {
     channel["note"] = "the vessel's centre of mass did not reach the sheet: no channel behind midship yet";
   }
   j["channel"] = channel;
+  // The mean surge ice resistance over the steady part, split by what the hull touched: the sheet's tiles (breaking
+  // its edge: crushing until the wedges fail in bending) and the floes and broken pieces (clearing, turning and
+  // submerging them, with their friction).
+  if (!r.series.count("time_s") || !r.series.count("ice_load") || !r.series.count("ice_load_level_ice")) return j;
+  const auto& t = r.get("time_s");
+  const auto& all = r.get("ice_load");
+  const auto& sheet = r.get("ice_load_level_ice");
+  double sum_all = 0, sum_sheet = 0, n = 0;
+  for (size_t i = 0; i < t.size(); ++i) {
+    if (t[i] < model.options.steady_start_s - 0.5 * model.options.time_step_s) continue;
+    sum_all -= all[6 * i];
+    sum_sheet -= sheet[6 * i];
+    n += 1;
+  }
+  if (n > 0)
+    j["resistance_split"] = {{"from_s", model.options.steady_start_s},
+                             {"breaking_sheet_N", sum_sheet / n},
+                             {"clearing_pieces_N", (sum_all - sum_sheet) / n},
+                             {"breaking_share", sum_all != 0 ? sum_sheet / sum_all : 0.0}};
   return j;
 }
 
@@ -285,6 +317,7 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress, co
   auto& c_ice = *col["ice_load"];
   auto& c_ice_rigid = *col["ice_load_rigid"];
   auto& c_ice_compliant = *col["ice_load_compliant"];
+  auto& c_ice_level_ice = *col["ice_load_level_ice"];
   auto& c_hydro = *col["hydro_load"];
   auto& c_wind = *col["wind_load"];
   auto& c_prop = *col["propulsion_load"];
@@ -352,6 +385,7 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress, co
       push_body_wrench(c_ice, R, rep.ice_load);
       push_body_wrench(c_ice_rigid, R, rep.ice_load_rigid);
       push_body_wrench(c_ice_compliant, R, rep.ice_load_compliant);
+      push_body_wrench(c_ice_level_ice, R, rep.ice_load_level_ice);
       push_body_wrench(c_hydro, R, rep.hydro_load);
       push_body_wrench(c_wind, R, rep.wind_load);
       push_body_wrench(c_prop, R, rep.propulsion_load);

@@ -246,7 +246,8 @@ void World::stage_relax() {
                                    o.relax_iterations, o.tolerance_mps, &pool_);
   store_impulses(model_, state_, contacts_);
   report_.contacts = static_cast<int>(contacts_.size());
-  report_.vessel_contacts = vessel_ice_load(contacts_, &report_.ice_load_rigid, &report_.ice_load_compliant);
+  report_.vessel_contacts = vessel_ice_load(contacts_, &report_.ice_load_rigid, &report_.ice_load_compliant,
+                                            &report_.ice_load_level_ice);
   report_.ice_load = report_.ice_load_rigid;
   report_.ice_load += report_.ice_load_compliant;
   // The solver's error on the recorded load (solver.reference_sweeps, a diagnostic): the relax pass continued on
@@ -264,9 +265,11 @@ void World::stage_relax() {
   }
 }
 
-int World::vessel_ice_load(const std::vector<Contact>& contacts, Wrench* rigid, Wrench* compliant) const {
+int World::vessel_ice_load(const std::vector<Contact>& contacts, Wrench* rigid, Wrench* compliant,
+                           Wrench* level_ice) const {
   // Contact loads on the vessel: impulse / dt, about its centre of mass (lever arms of the solve), split by contact
-  // law (the seed filters compliant loads over 0.5 s and rigid ones over 20 s, PHYSICS.md §5).
+  // law (the seed filters compliant loads over 0.5 s and rigid ones over 20 s, PHYSICS.md §5); and, if asked, the
+  // part from level ice tiles (breaking the sheet's edge, against clearing the pieces).
   const int vessel = model_.vessel;
   const double dt = model_.options.time_step_s;
   int n = 0;
@@ -278,6 +281,7 @@ int World::vessel_ice_load(const std::vector<Contact>& contacts, Wrench* rigid, 
     if (c.body_b == vessel) w.add_at(p, c.rb);
     else w.add_at(-p, c.ra);
     *(c.type == ContactType::rigid ? rigid : compliant) += w;
+    if (level_ice && model_.bodies[c.body_a == vessel ? c.body_b : c.body_a].fixed) *level_ice += w;
   }
   return n;
 }
@@ -421,8 +425,17 @@ void World::stage_sleep() {
   for (int b : awake_list_) island_ok_[b] = 1;
   for (int b : awake_list_)
     if (b == model_.vessel || state_.still_time_s[b] < s.time_s) island_ok_[find(b)] = 0;
+  // Far astern (sleep.freeze_astern_m): asleep at any speed; the island rule above no longer applies to it.
+  const int vessel = model_.vessel;
+  const bool freeze = s.freeze_astern_m > 0 && vessel >= 0;
+  const Vec3 heading = freeze ? Vec3(state_.orientation[vessel] * Vec3::UnitX()) : Vec3::UnitX();
+  auto far_astern = [&](int b) {
+    const Vec3 d = state_.position[b] - state_.position[vessel];
+    return d.dot(heading) < 0 && d.head<2>().norm() > s.freeze_astern_m;
+  };
   for (int b : awake_list_) {
-    if (b == model_.vessel || !state_.alive[b] || !island_ok_[find(b)]) continue;
+    if (b == model_.vessel || !state_.alive[b]) continue;
+    if (!island_ok_[find(b)] && !(freeze && far_astern(b))) continue;
     state_.awake[b] = 0;
     state_.velocity[b].setZero();
     state_.angular_velocity[b].setZero();

@@ -49,6 +49,7 @@ struct StepReport {
   // not measured. The solver's error on the recorded load.
   double surge_load_error_n = 0;
   Wrench ice_load, ice_load_rigid, ice_load_compliant;
+  Wrench ice_load_level_ice;  // part of ice_load from contacts with level ice tiles (breaking the sheet's edge)
   Wrench hydro_load, wind_load, propulsion_load;
   double thrust_n = 0;
 };
@@ -109,9 +110,10 @@ class World {
   void stage_relax();
   void stage_fracture();
   void stage_sleep();
-  // Sums the contact loads on the vessel (world frame, about its centre of mass) by contact law; returns how many
-  // contacts touch it.
-  int vessel_ice_load(const std::vector<Contact>& contacts, Wrench* rigid, Wrench* compliant) const;
+  // Sums the contact loads on the vessel (world frame, about its centre of mass) by contact law, and the part from
+  // level ice tiles if `level_ice` is given; returns how many contacts touch it.
+  int vessel_ice_load(const std::vector<Contact>& contacts, Wrench* rigid, Wrench* compliant,
+                      Wrench* level_ice = nullptr) const;
   // Replaces the floe of `cut` by its pieces (bodies appended at the floe's pose and velocity field) and records
   // the event.
   void apply_fracture(FractureCut& cut);

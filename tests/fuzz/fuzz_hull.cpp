@@ -1,7 +1,9 @@
-// Hull meshes through the loader (sim/hull.h load_hull: assimp, welding, orientation, convexity, slicing). The
+// Hull meshes through the loader (sim/hull.h load_hull: assimp, welding, orientation, convexity, slicing) and the
+// measurement of their particulars for the ice-resistance formulas (sim/hull_particulars.h). The
 // input is written to a file with the extension FUZZ_HULL_EXT (".obj", ".stl", ".ply"), as a user's mesh would be.
 #include "fuzz_util.h"
 #include "sim/hull.h"
+#include "sim/hull_particulars.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const auto file = floesim::fuzz::temp_file(FUZZ_HULL_EXT);
@@ -9,7 +11,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   floesim::fuzz::expect_ok_or_error([&] {
     floesim::sim::HullLoadOptions o;
     o.slices = 6;  // fewer sections than the default 24: faster per input, the same code paths
-    (void)floesim::sim::load_hull(file, o);
+    const floesim::sim::HullModel h = floesim::sim::load_hull(file, o);
+    (void)floesim::sim::measure_particulars(h.mesh, "fuzz input");
   });
   return 0;
 }

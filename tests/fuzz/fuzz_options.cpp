@@ -12,6 +12,7 @@
 #include "render/report.h"
 #include "sim/hull.h"
 #include "sim/identify.h"
+#include "sim/resistance.h"
 #include "sim/shipdata.h"
 #include "sim/simulate_options.h"
 
@@ -42,6 +43,7 @@ void read_all(const floesim::Json& j, const std::string& file, const std::string
   read_one<sim::HullLoadOptions>(j, file, path);
   read_one<sim::IdentifyOptions>(j, file, path);
   read_one<sim::ShipDataOptions>(j, file, path);
+  read_one<sim::IceResistanceOptions>(j, file, path);
   read_one<render::RenderOptions>(j, file, path);
   read_one<render::PlotOptions>(j, file, path);
   read_one<render::ReportOptions>(j, file, path);

@@ -443,6 +443,64 @@ fs::path write_constant_member(const fs::path& root, const std::string& id, size
   return root / "members" / id;
 }
 
+TEST(Gather, LevelIceMembersGetLindqvistAndRiskaOfPhysicsWorkedExamples) {
+  // Two level-ice members at 2 m/s (one axis: the sheet's thickness) whose hull.json holds the particulars of
+  // PHYSICS.md §6's worked examples (L 100, B 20, T 7 m, phi = alpha = 30 deg, L_par 50, L_bow 25 m) and whose
+  // summaries give §6.1's ice (sigma_b 0.5 MPa, E 2 GPa, mu 0.1): at h = 1 m Lindqvist's R_ice is 1028.7 kN and
+  // Riska's R 943.6 kN (the printed worked examples); a member without level ice leaves the columns empty.
+  const fs::path root = fs::temp_directory_path() / "floesim_gather_level_ice";
+  fs::remove_all(root);
+  const char* hkey = "simulate.level_ice.thickness_m";
+  Json members = Json::array();
+  for (const char* id : {"g000-e00", "g001-e00"}) {
+    const bool level = std::string(id) == "g000-e00";
+    Json m = plan_member(root, {id, level ? 0u : 1u, 0, {{hkey, level ? 1.0 : 2.0}}, Json::object()});
+    const fs::path d = root / "members" / id;
+    m["stages"].push_back({{"name", "hull"}, {"outputs", {(d / "hull" / "hull.obj").string()}}});
+    touch(d / "hull" / "hull.obj");
+    touch(d / "hull" / "hull.json",
+          Json{{"particulars", {{"length_m", 100}, {"beam_m", 20}, {"draught_m", 7}, {"stem_angle_deg", 30},
+                                {"entrance_angle_deg", 30}, {"parallel_midbody_m", 50}, {"bow_length_m", 25}}}}
+              .dump());
+    Json summary = {{"mean_surge_ice_resistance_N", 900000.0}, {"mean_vessel_speed_mps", 2.0}};
+    if (level)
+      summary["level_ice"] = {{"tiles_start", 4},
+                              {"channel", {{"width_over_beam", 1.25}}},
+                              {"ice", {{"thickness_m", 1.0}, {"flexural_strength_pa", 5e5}, {"youngs_modulus_pa", 2e9},
+                                       {"poisson_ratio", 0.3}, {"ice_density_kg_m3", 900.0},
+                                       {"water_density_kg_m3", 1025.0}, {"gravity_mps2", 9.81},
+                                       {"mu_ice_structure", 0.1}}}};
+    write_summary(d, summary);
+    write_member_results(d / "sim" / "results.h5", std::vector<double>(400, 900.0), 0.05, 5.0);
+    members.push_back(m);
+  }
+  const Json plan = {{"format", kSweepPlanFormat},
+                     {"name", "level-ice-test"},
+                     {"sweep_file", (root / "sweep.json").string()},
+                     {"axes", Json::array({{{"key", hkey}, {"values", {1.0, 2.0}}}})},
+                     {"ensemble", {{"size", 1}, {"vary", Json::array()}}},
+                     {"grid_points", Json::array({{{"index", 0}, {"axes", {{hkey, 1.0}}}},
+                                                  {{"index", 1}, {"axes", {{hkey, 2.0}}}}})},
+                     {"members", members}};
+  std::ofstream(root / "plan.json") << plan.dump(2);
+  gather_sweep(root / "plan.json", root / "out");
+  const auto rows = read_csv(root / "out" / "sweep.csv");
+  ASSERT_EQ(rows.size(), 3u);
+  auto col = [&](size_t r, const std::string& name) {
+    const size_t c = std::find(rows[0].begin(), rows[0].end(), name) - rows[0].begin();
+    EXPECT_LT(c, rows[0].size()) << name;
+    return c < rows[r].size() ? rows[r][c] : std::string("?");
+  };
+  EXPECT_NEAR(std::stod(col(1, "lindqvist_kN")), 1028.7, 0.05);
+  EXPECT_NEAR(std::stod(col(1, "riska_kN")), 943.6, 0.05);
+  EXPECT_NEAR(std::stod(col(1, "ratio_to_lindqvist")), 900.0 / 1028.7, 1e-4);
+  EXPECT_EQ(col(1, "channel_width_over_beam"), "1.25");
+  EXPECT_EQ(col(2, "lindqvist_kN"), "");
+  EXPECT_EQ(col(2, "status"), "ok");
+  EXPECT_TRUE(fs::exists(root / "out" / "level_ice_resistance.png"));
+  fs::remove_all(root);
+}
+
 TEST(Gather, TwoAxesWithCategoriesAndAPureEnsembleArePlotted) {
   const fs::path dir = fresh_dir("gather_shapes");
   {

@@ -173,6 +173,28 @@ TEST(VideoViews, AFloeInContactWithTheVesselShowsTheContactColourOnlyInThatFrame
   EXPECT_GE(off[2], 0.92 * input[2] - 2) << off;
 }
 
+TEST(VideoViews, LevelIceIsOneSheetNeverLitAsInContact) {
+  // The same floe in contact in frame 3, flagged as a tile of level ice: it keeps the input colour at full shade
+  // (the sheet's tiles share one shade), in contact or not.
+  Synthetic syn = default_synthetic();
+  syn.floes[0].contact_frames = {3};
+  Results r = make_results(syn);
+  r.floe_level_ice.assign(r.floe_id.size(), 0);
+  r.floe_level_ice[0] = 1;
+  ASSERT_EQ(r.floe_id[0], 1);
+  RenderOptions o = small("top");
+  o.strip_chart = false;
+  o.top_width_m = 300;
+  SceneRenderer scene(r, o, "synthetic");
+  cv::Mat img;
+  const cv::Vec3d input = bgr(o.floe_top_colour);
+  for (size_t k : {2, 3}) {
+    scene.render(k, img);
+    const cv::Vec3d c = patch(img, top_view_pixel(r, o, k, 60, 0));
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(c[i], input[i], 2) << "frame " << k << ", channel " << i << ": " << c;
+  }
+}
+
 TEST(VideoViews, SideViewShowsAFloeUnderTheHullBelowTheWaterlineAndTheSunlitHull) {
   // Frame 5: the vessel (box hull 50 x 12 x 8 m, centre at z = 0) at x = 10 m. A 10 x 10 m floe, 3 m thick, pushed
   // under it: centre 10 m ahead of the vessel's centre, 8 m down (z -9.5 .. -6.5 m, below the keel at -4 m).

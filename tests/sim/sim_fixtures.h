@@ -1,6 +1,7 @@
 // Synthetic inputs with known answers for the simulation tests: rectangular floes, a coarse generated hull,
 // options with the pieces of physics a test needs switched on.
 #pragma once
+#include <cmath>
 #include <filesystem>
 #include <initializer_list>
 #include <string>
@@ -82,6 +83,25 @@ inline HullModel ramp_hull(double beta_deg, double width) {
   h.parts = {m};
   h.surface = m;
   return h;
+}
+
+// l_c for the defaults (E = 5 GPa, nu = 0.3, h = 1 m, rho_w g = 1025 x 9.81): (D / rho_w g)^(1/4) by hand.
+inline double lc_by_hand(double h) {
+  const double D = 5e9 * h * h * h / (12 * (1 - 0.3 * 0.3));
+  return std::pow(D / (1025 * 9.81), 0.25);
+}
+
+// PHYSICS.md §2.1 wedge table, P_f / (theta sigma_f h^2) and R_b / l_c, read linearly between alpha = 0.1, 0.2 and
+// 0.3 (the fracture and level-ice tests' expected loads, never the module's own table).
+inline double table_pf(double alpha) {
+  const double a[] = {0.1, 0.2, 0.3}, p[] = {0.223, 0.265, 0.305};
+  const int k = alpha < 0.2 ? 0 : 1;
+  return p[k] + (alpha - a[k]) / (a[k + 1] - a[k]) * (p[k + 1] - p[k]);
+}
+inline double table_rb(double alpha) {
+  const double a[] = {0.1, 0.2, 0.3}, r[] = {0.50, 0.61, 0.67};
+  const int k = alpha < 0.2 ? 0 : 1;
+  return r[k] + (alpha - a[k]) / (a[k + 1] - a[k]) * (r[k + 1] - r[k]);
 }
 
 // Runs f, expects floesim::Error whose message contains every piece.

@@ -19,27 +19,11 @@ namespace floesim::sim {
 namespace {
 
 using testing::coarse_hull;
+using testing::lc_by_hand;
 using testing::ramp_hull;
 using testing::rect_floe;
-
-
-// l_c for the defaults (E = 5 GPa, nu = 0.3, h = 1 m, rho_w g = 1025 x 9.81): (D / rho_w g)^(1/4) by hand.
-double lc_by_hand(double h) {
-  const double D = 5e9 * h * h * h / (12 * (1 - 0.3 * 0.3));
-  return std::pow(D / (1025 * 9.81), 0.25);
-}
-
-// PHYSICS.md §2.1 wedge table, P_f / (theta sigma_f h^2) and R_b / l_c, at alpha = 0.1 and 0.2 and 0.3.
-double table_pf(double alpha) {
-  const double a[] = {0.1, 0.2, 0.3}, p[] = {0.223, 0.265, 0.305};
-  const int k = alpha < 0.2 ? 0 : 1;
-  return p[k] + (alpha - a[k]) / (a[k + 1] - a[k]) * (p[k + 1] - p[k]);
-}
-double table_rb(double alpha) {
-  const double a[] = {0.1, 0.2, 0.3}, r[] = {0.50, 0.61, 0.67};
-  const int k = alpha < 0.2 ? 0 : 1;
-  return r[k] + (alpha - a[k]) / (a[k + 1] - a[k]) * (r[k + 1] - r[k]);
-}
+using testing::table_pf;
+using testing::table_rb;
 
 // A model with the coarse hull far away (body 0, the structure) and the given floes; fracture at fixed theta.
 struct Rig {

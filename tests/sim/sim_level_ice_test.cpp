@@ -18,7 +18,9 @@ namespace floesim::sim {
 namespace {
 
 using testing::coarse_hull;
+using testing::lc_by_hand;
 using testing::ramp_hull;
+using testing::table_pf;
 
 std::vector<int> tiles_of(const Model& m) {
   std::vector<int> t;
@@ -104,17 +106,6 @@ TEST(LevelIce, SheetAtRestCostsNothingAndNeverMoves) {
   }
 }
 
-// l_c for E = 5 GPa, nu = 0.3, h = 1 m by hand; the §2.1 wedge table at alpha 0.1 .. 0.3 read linearly.
-double lc_by_hand(double h) {
-  const double D = 5e9 * h * h * h / (12 * (1 - 0.3 * 0.3));
-  return std::pow(D / (1025 * 9.81), 0.25);
-}
-double table_pf(double alpha) {
-  const double a[] = {0.1, 0.2, 0.3}, p[] = {0.223, 0.265, 0.305};
-  const int k = alpha < 0.2 ? 0 : 1;
-  return p[k] + (alpha - a[k]) / (a[k + 1] - a[k]) * (p[k + 1] - p[k]);
-}
-
 TEST(LevelIce, RampBreaksTheSheetAtTheTableLoadAndTheSheetStaysPut) {
   // The fracture tests' ramp (a 30 deg face 0.2 l_c wide) driven at 0.1 m/s into the edge of a sheet: one tile of
   // 200 m x 200 m (tile_m larger than the sheet).
@@ -137,6 +128,8 @@ TEST(LevelIce, RampBreaksTheSheetAtTheTableLoadAndTheSheetStaysPut) {
   for (int k = 0; k < 3000 && world.fracture_events().empty(); ++k) {
     world.step();
     ASSERT_EQ(world.state().position[tile], model.bodies[tile].initial_position) << "the sheet moved at step " << k;
+    // Only the sheet is touched: its part of the vessel's ice load is the whole of it.
+    ASSERT_EQ(world.report().ice_load_level_ice.force, world.report().ice_load.force) << "step " << k;
   }
   ASSERT_EQ(world.fracture_events().size(), 1u) << "no fracture in 30 s";
   const FractureEvent& e = world.fracture_events()[0];
@@ -235,6 +228,31 @@ TEST(LevelIce, ChannelWidthIsTheSheetAreaLostBehindMidshipOverItsLength) {
   EXPECT_NEAR(ch["width_over_beam"].get<double>(), 20.0 / m.vessel_info.beam_wl_m, 1e-12);
 }
 
+TEST(LevelIce, FloesFarAsternSleepAtAnySpeed) {
+  // sleep.freeze_astern_m = 150: of three floes drifting at 0.5 m/s, the one 300 m astern of the vessel falls asleep
+  // after one step, the ones 100 m astern and 300 m ahead keep moving.
+  SimulateOptions o = testing::floe_options();
+  o.sleep.enabled = true;
+  o.sleep.freeze_astern_m = 150;
+  o.vessel.x_m = 0;
+  FloeField f;
+  f.floes = {testing::rect_floe(1, -310, 40, 20, 20, 1.0), testing::rect_floe(2, -110, 40, 20, 20, 1.0),
+             testing::rect_floe(3, 290, 40, 20, 20, 1.0)};
+  const HullModel hull = coarse_hull();
+  const Model m = build_model(f, &hull, o);
+  World w(m);
+  for (int b = 1; b <= 3; ++b) {
+    w.wake(b);
+    w.mutable_state().velocity[b] = Vec3(0, 0.5, 0);
+  }
+  w.step();
+  EXPECT_EQ(w.state().awake[1], 0);
+  EXPECT_EQ(w.state().velocity[1], Vec3::Zero());
+  EXPECT_EQ(w.state().awake[2], 1);
+  EXPECT_EQ(w.state().awake[3], 1);
+  EXPECT_GT(w.state().velocity[2].y(), 0.4);
+}
+
 TEST(LevelIce, BadInputNamesTheKeyAndTheFix) {
   const std::vector<std::pair<std::string, std::string>> bad = {
       {R"({"level_ice": {"extent_m": [0, 0, 100]}})", "level_ice.extent_m"},
@@ -248,6 +266,7 @@ TEST(LevelIce, BadInputNamesTheKeyAndTheFix) {
       {R"({"level_ice": {"thickness_profile": [{"x_m": 0, "thickness_m": -1}]}})",
        "level_ice.thickness_profile[0].thickness_m"},
       {R"({"level_ice": {"sheet": 1}})", "sheet"},
+      {R"({"sleep": {"freeze_astern_m": -1}})", "sleep.freeze_astern_m"},
   };
   for (const auto& [text, key] : bad) {
     try {
