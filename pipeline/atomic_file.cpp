@@ -1,6 +1,7 @@
 #include "pipeline/atomic_file.h"
 
 #include <fcntl.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -22,6 +23,13 @@ std::string write_failure_reason(int err) {
     case ENOTDIR: return r + " (a file stands where a folder of the path should be: choose another path)";
     default: return r;
   }
+}
+
+std::string cut_short_reason(const std::filesystem::path& dir) {
+  struct statvfs st;
+  const bool full = ::statvfs(dir.empty() ? "." : dir.c_str(), &st) == 0 &&
+                    static_cast<double>(st.f_bavail) * static_cast<double>(st.f_frsize) < (1 << 20);
+  return full ? write_failure_reason(ENOSPC) : std::string("is the disk full?");
 }
 
 AtomicFile::AtomicFile(std::filesystem::path final_path) : final_(std::move(final_path)) {

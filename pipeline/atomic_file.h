@@ -42,4 +42,9 @@ void ensure_directory(const std::filesystem::path& dir);
 // what to do about it, for error messages.
 std::string write_failure_reason(int err);
 
+// Why a file another program wrote in `dir` (gnuplot, the video encoder, which do not report write errors) came out
+// cut short: the full disk, said as write_failure_reason(ENOSPC) does, when less than 1 MiB is left there; else a
+// question.
+std::string cut_short_reason(const std::filesystem::path& dir);
+
 }  // namespace floesim

@@ -11,6 +11,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
 #include "pipeline/interrupt.h"
 
@@ -75,10 +76,10 @@ void run_gnuplot(const fs::path& script, const fs::path& log, const std::vector<
     // SVG that ends.
     if (image.extension() == ".png")
       FLOESIM_REQUIRE(!cv::imread(image.string(), cv::IMREAD_UNCHANGED).empty(), what,
-                      ": gnuplot's PNG does not decode (is the disk full?)");
+                      ": gnuplot's PNG does not decode: ", cut_short_reason(image.parent_path()));
     if (image.extension() == ".svg")
-      FLOESIM_REQUIRE(read_text(image).find("</svg>") != std::string::npos, what,
-                      ": gnuplot's SVG is cut short (is the disk full?)");
+      FLOESIM_REQUIRE(read_text(image).find("</svg>") != std::string::npos, what, ": gnuplot's SVG is cut short: ",
+                      cut_short_reason(image.parent_path()));
   }
 }
 

@@ -1,8 +1,5 @@
 #include "render/video.h"
 
-#include <sys/statvfs.h>
-
-#include <cerrno>
 #include <chrono>
 
 #include <opencv2/imgcodecs.hpp>
@@ -68,15 +65,10 @@ RenderStats render_video(const Results& r, const RenderOptions& o, const fs::pat
     // MP4 without its index, which does not open).
     cv::VideoCapture back(video.tmp().string(), cv::CAP_FFMPEG);
     const double frames = back.isOpened() ? back.get(cv::CAP_PROP_FRAME_COUNT) : -1;
-    if (frames != static_cast<double>(n)) {
-      struct statvfs fsst;
-      const bool full = ::statvfs(video.tmp().parent_path().c_str(), &fsst) == 0 &&
-                        static_cast<double>(fsst.f_bavail) * static_cast<double>(fsst.f_frsize) < 1 << 20;
+    if (frames != static_cast<double>(n))
       throw Error(out_mp4.string() + ": the encoded video does not read back (" +
                   (frames < 0 ? std::string("it does not open") : std::to_string(static_cast<long>(frames)) +
-                   " frames of " + std::to_string(n)) + "): " +
-                  (full ? write_failure_reason(ENOSPC) : std::string("is the disk full?")));
-    }
+                   " frames of " + std::to_string(n)) + "): " + cut_short_reason(video.tmp().parent_path()));
   }
 
   st.frames = n;
