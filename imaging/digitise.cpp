@@ -108,19 +108,19 @@ cv::Mat render_overlay(const cv::Mat& gray, const FloeField& floes, double s) {
 
 namespace {
 void write_json_tmp(const AtomicFile& f, const nlohmann::json& j) {
-  std::ofstream out(f.tmp(), std::ios::binary);
-  out << j.dump(1) << "\n";
-  out.flush();
-  FLOESIM_REQUIRE(static_cast<bool>(out), f.path().string(), ": write failed (is the directory writable?)");
+  write_file_checked(f.tmp(), j.dump(1) + "\n", f.path());
 }
 void write_png_tmp(const AtomicFile& f, const cv::Mat& img) {
+  // Encoded in memory, then written with every write checked: imwrite does not report a full disk.
+  std::vector<uchar> png;
   bool ok = false;
   try {
-    ok = cv::imwrite(f.tmp().string(), img);
+    ok = cv::imencode(".png", img, png);
   } catch (const cv::Exception& e) {
-    throw Error(f.path().string() + ": cannot write: " + e.what());
+    throw Error(f.path().string() + ": cannot encode the image: " + e.what());
   }
-  FLOESIM_REQUIRE(ok, f.path().string(), ": cannot write (is the directory writable?)");
+  FLOESIM_REQUIRE(ok, f.path().string(), ": cannot encode the image as PNG");
+  write_file_checked(f.tmp(), std::string(png.begin(), png.end()), f.path());
 }
 }  // namespace
 
@@ -186,12 +186,7 @@ DigitiseResult run_digitise(const DigitiseRequest& req) {
   write_png_tmp(fsd_png, plot_size_distribution(res.stats, "floe size distribution of " +
                                                                req.image.filename().string() + ": " +
                                                                std::to_string(res.floes.floes.size()) + " floes"));
-  {
-    std::ofstream out(fsd_csv.tmp(), std::ios::binary);
-    out << size_distribution_csv(res.stats);
-    out.flush();
-    FLOESIM_REQUIRE(static_cast<bool>(out), fsd_csv.path().string(), ": write failed (is the directory writable?)");
-  }
+  write_file_checked(fsd_csv.tmp(), size_distribution_csv(res.stats), fsd_csv.path());
   if (res.score) {
     nlohmann::json sj = res.score->to_json();
     sj["provenance"] = prov;

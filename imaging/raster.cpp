@@ -5,6 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
 
 namespace floesim::imaging {
@@ -75,13 +76,16 @@ void write_labels_png(const std::filesystem::path& tmp, const cv::Mat& labels32,
                   "digitise the image in tiles");
   cv::Mat u16;
   labels32.convertTo(u16, CV_16U);
+  // Encoded in memory, then written with every write checked: imwrite does not report a full disk.
+  std::vector<uchar> png;
   bool ok = false;
   try {
-    ok = cv::imwrite(tmp.string(), u16);
+    ok = cv::imencode(".png", u16, png);
   } catch (const cv::Exception& e) {
-    throw Error(final_name + ": cannot write the label image: " + e.what());
+    throw Error(final_name + ": cannot encode the label image: " + e.what());
   }
-  FLOESIM_REQUIRE(ok, final_name, ": cannot write the label image (is the directory writable?)");
+  FLOESIM_REQUIRE(ok, final_name, ": cannot encode the label image as PNG");
+  write_file_checked(tmp, std::string(png.begin(), png.end()), final_name);
 }
 
 }  // namespace floesim::imaging

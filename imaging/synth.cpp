@@ -340,8 +340,12 @@ SynthResult run_synth(const SynthOptions& o, const std::filesystem::path& out_di
   SynthResult res = synthesize(o);
   ensure_directory(out_dir);
   AtomicFile image(out_dir / "image.png"), labels(out_dir / "truth_labels.png");
-  FLOESIM_REQUIRE(cv::imwrite(image.tmp().string(), res.image), image.path().string(),
-                  ": cannot write the image (is the directory writable?)");
+  {
+    // Encoded in memory, then written with every write checked: imwrite does not report a full disk.
+    std::vector<uchar> png;
+    FLOESIM_REQUIRE(cv::imencode(".png", res.image, png), image.path().string(), ": cannot encode the image as PNG");
+    write_file_checked(image.tmp(), std::string(png.begin(), png.end()), image.path());
+  }
   write_labels_png(labels.tmp(), res.truth_labels, labels.path().string());
 
   res.truth.provenance = make_provenance("floesim-synth", {}, options_to_json(o));
@@ -351,11 +355,7 @@ SynthResult run_synth(const SynthOptions& o, const std::filesystem::path& out_di
                                      {"rejected_floes", res.rejected_floes},   {"hidden_floes", res.hidden_floes},
                                      {"brash_fragments", res.brash_fragments}, {"ponds", res.ponds}};
   AtomicFile truth(out_dir / "truth.geojson");
-  {
-    std::ofstream out(truth.tmp(), std::ios::binary);
-    out << floes_to_geojson(res.truth).dump(1) << "\n";
-    FLOESIM_REQUIRE(static_cast<bool>(out), truth.path().string(), ": write failed (disk full?)");
-  }
+  write_file_checked(truth.tmp(), floes_to_geojson(res.truth).dump(1) + "\n", truth.path());
   image.commit();
   labels.commit();
   truth.commit();

@@ -3,6 +3,7 @@
 #include <hdf5.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -114,6 +115,11 @@ hid_t h5type<int32_t>() { return H5T_NATIVE_INT32; }
 template <>
 hid_t h5type<int64_t>() { return H5T_NATIVE_INT64; }
 
+// Why HDF5 could not write: the system's reason (its file driver leaves errno set), with the fix.
+std::string h5_write_reason() {
+  return errno != 0 ? write_failure_reason(errno) : std::string("the disk is full, or the folder is not writable?");
+}
+
 template <class T>
 void write_ds(hid_t loc, const std::string& name, const std::vector<T>& data, size_t cols, const std::string& file) {
   FLOESIM_REQUIRE(cols > 0 && data.size() % cols == 0, file, ": internal: dataset ", name, " has ", data.size(),
@@ -130,10 +136,10 @@ void write_ds(hid_t loc, const std::string& name, const std::vector<T>& data, si
     H5Pset_deflate(plist, 1);
   }
   H5Id ds(H5Dcreate2(loc, name.c_str(), h5type<T>(), space, H5P_DEFAULT, plist, H5P_DEFAULT), H5Dclose);
-  FLOESIM_REQUIRE(ds.id >= 0, file, ": cannot create dataset ", name);
+  FLOESIM_REQUIRE(ds.id >= 0, file, ": cannot create dataset ", name, ": ", h5_write_reason());
   if (!data.empty())
     FLOESIM_REQUIRE(H5Dwrite(ds, h5type<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) >= 0, file,
-                    ": cannot write dataset ", name, " (disk full?)");
+                    ": cannot write dataset ", name, ": ", h5_write_reason());
 }
 
 // The most rows of `row_bytes` a file can hold: deflate compresses at most 1032:1, plus room for HDF5's fill
@@ -315,13 +321,14 @@ void write_results(const std::filesystem::path& path, const Results& r) {
 
   AtomicFile out(path);
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are reported by us, with context
+  errno = 0;
   {
     // H5F_LIBVER_LATEST would embed nothing time-dependent either, but the default keeps files readable by
     // older tools; object modification times are off so that identical runs give identical bytes.
     H5Id fcpl(H5Pcreate(H5P_FILE_CREATE), H5Pclose);
     H5Pset_obj_track_times(fcpl, false);
     H5Id fid(H5Fcreate(out.tmp().c_str(), H5F_ACC_TRUNC, fcpl, H5P_DEFAULT), H5Fclose);
-    FLOESIM_REQUIRE(fid.id >= 0, file, ": cannot create (is the directory writable?)");
+    FLOESIM_REQUIRE(fid.id >= 0, file, ": cannot create: ", h5_write_reason());
     H5Id gcpl(H5Pcreate(H5P_GROUP_CREATE), H5Pclose);
     H5Pset_obj_track_times(gcpl, false);
     for (const char* g : {"/series", "/frames", "/states", "/geometry", "/fracture"}) {
@@ -354,8 +361,8 @@ void write_results(const std::filesystem::path& path, const Results& r) {
     H5Tset_size(st, text.size() + 1);
     H5Id sp(H5Screate(H5S_SCALAR), H5Sclose);
     H5Id at(H5Acreate2(fid, "floesim", st, sp, H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
-    FLOESIM_REQUIRE(H5Awrite(at, st, text.c_str()) >= 0, file, ": cannot write the attributes");
-    FLOESIM_REQUIRE(H5Fflush(fid, H5F_SCOPE_GLOBAL) >= 0, file, ": flush failed (disk full?)");
+    FLOESIM_REQUIRE(H5Awrite(at, st, text.c_str()) >= 0, file, ": cannot write the attributes: ", h5_write_reason());
+    FLOESIM_REQUIRE(H5Fflush(fid, H5F_SCOPE_GLOBAL) >= 0, file, ": writing failed: ", h5_write_reason());
   }
   out.commit();
 }

@@ -522,9 +522,7 @@ struct PlotFiles {
     run_gnuplot(script.tmp(), log.tmp(), {png.tmp(), svg.tmp()}, png.path().string());
   }
   static void write_text_atomic_tmp(const AtomicFile& f, const std::string& text) {
-    std::ofstream os(f.tmp(), std::ios::binary);
-    os << text;
-    FLOESIM_REQUIRE(os.flush(), f.tmp().string(), ": write failed (disk full?)");
+    write_file_checked(f.tmp(), text, f.path());
   }
 };
 

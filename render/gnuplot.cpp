@@ -9,7 +9,11 @@
 #include <fstream>
 #include <sstream>
 
+#include <opencv2/imgcodecs.hpp>
+
+#include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
+#include "pipeline/interrupt.h"
 
 extern char** environ;
 
@@ -42,9 +46,11 @@ int run_program(const std::vector<std::string>& args, const fs::path& log) {
   const int rc = posix_spawn(&pid, args[0].c_str(), &fa, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&fa);
   FLOESIM_REQUIRE(rc == 0, "cannot start ", args[0], ": ", std::strerror(rc));
+  register_child(pid);  // killed by the stop-signal handler before it removes the files gnuplot writes
   int status = 0;
   while (waitpid(pid, &status, 0) < 0)
     FLOESIM_REQUIRE(errno == EINTR, "waiting for ", args[0], " failed: ", std::strerror(errno));
+  unregister_child(pid);
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
 }
 
@@ -66,6 +72,14 @@ void run_gnuplot(const fs::path& script, const fs::path& log, const std::vector<
     std::error_code ec;
     FLOESIM_REQUIRE(fs::file_size(image, ec) > 0 && !ec, "gnuplot wrote no image drawing ", what, ":\n",
                     read_text(log));
+    // gnuplot may exit 0 after a failed write (a full disk): the image must be whole, a PNG that decodes, an
+    // SVG that ends.
+    if (image.extension() == ".png")
+      FLOESIM_REQUIRE(!cv::imread(image.string(), cv::IMREAD_UNCHANGED).empty(), what,
+                      ": gnuplot's PNG does not decode: ", cut_short_reason(image.parent_path()));
+    if (image.extension() == ".svg")
+      FLOESIM_REQUIRE(read_text(image).find("</svg>") != std::string::npos, what, ": gnuplot's SVG is cut short: ",
+                      cut_short_reason(image.parent_path()));
   }
 }
 

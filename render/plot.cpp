@@ -153,15 +153,15 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
 
   // 5. CSVs: every sample, and every fracture event (force on the floe in the world frame, as recorded).
   {
-    std::ofstream os(csv.tmp());
+    std::ostringstream os;
     os << "time_s,ice_resistance_kN,moving_average_kN\n";  // average empty where its window is cut
     for (size_t i = 0; i < t.size(); ++i)
       os << fmt("%.10g", t[i]) << ',' << fmt("%.10g", res[i]) << ','
          << (i >= f0 && i < f1 ? fmt("%.10g", ma[i]) : std::string()) << '\n';
-    FLOESIM_REQUIRE(os.flush(), csv.path().string(), ": write failed (disk full?)");
+    write_file_checked(csv.tmp(), os.str(), csv.path());
   }
   {
-    std::ofstream os(events_csv.tmp());
+    std::ostringstream os;
     os << "time_s,mode,parent_id,at_structure,force_x_n,force_y_n,force_z_n,threshold_n,children\n";
     for (size_t k = 0; k < events; ++k) {
       os << fmt("%.10g", r.fracture_time_s[k]) << ',' << fracture_mode_name(r.fracture_mode[k]) << ','
@@ -173,7 +173,7 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
         os << (c > r.fracture_child_offset[k] ? " " : "") << r.fracture_child_id[c];
       os << '\n';
     }
-    FLOESIM_REQUIRE(os.flush(), events_csv.path().string(), ": write failed (disk full?)");
+    write_file_checked(events_csv.tmp(), os.str(), events_csv.path());
   }
 
   // 6. Plot data (decimated to ~2 points per pixel column) and the script, in the unit that suits the loads' size
@@ -191,7 +191,7 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
   auto load = [&](double x_kN) { return load_number(x_kN * to_unit) + " " + unit.name; };
   const size_t bins = static_cast<size_t>(o.width_px);
   {
-    std::ofstream os(data.tmp());
+    std::ostringstream os;
     write_decimated(os, t, in_unit(res), bins);
     os << "\n\n";
     const std::vector<double> tm(t.begin() + static_cast<long>(f0), t.begin() + static_cast<long>(f1)),
@@ -207,7 +207,7 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
       os << "\n\n";
       for (double te : *times) os << fmt("%.9g", te) << '\n';
     }
-    FLOESIM_REQUIRE(os.flush(), data.tmp().string(), ": write failed (disk full?)");
+    write_file_checked(data.tmp(), os.str(), data.path());
   }
   // Rigid contacts give single-step spikes one or two orders of magnitude above the average; "auto" keeps the
   // average readable (top at 3 x its peak, or the raw peak if lower) and says how high the cut-off spikes go.
@@ -280,9 +280,7 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
        << "set output " << quoted(svg.tmp().string()) << "\n"
        << "replot\n"
        << "unset output\n";
-    std::ofstream os(script.tmp());
-    os << gp.str();
-    FLOESIM_REQUIRE(os.flush(), script.tmp().string(), ": write failed (disk full?)");
+    write_file_checked(script.tmp(), gp.str(), script.path());
   }
 
   // 7. gnuplot, checked: exit status, and both images non-empty.
@@ -315,7 +313,7 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
       {"files", {"surge_ice_load.png", "surge_ice_load.svg", "surge_ice_load.csv", "fracture_events.csv"}},
       {"provenance", provenance},
   };
-  write_text_atomic(side.tmp(), j.dump(2) + "\n");
+  write_file_checked(side.tmp(), j.dump(2) + "\n", side.path());
   png.commit();
   svg.commit();
   csv.commit();
@@ -370,7 +368,7 @@ IdentifiedPlotSummary plot_identified_load(const fs::path& identify_dir, const P
   AtomicFile data(out_dir / "identified_load.plot-data.txt"), script(out_dir / "identified_load.plot.gp"),
       log(out_dir / "identified_load.gnuplot.log");
   {
-    std::ofstream os(data.tmp());
+    std::ostringstream os;
     for (size_t i = 0; i < t.size(); ++i)
       os << fmt("%.9g", t[i]) << ' ' << fmt("%.9g", ident[i]) << ' '
          << (s.known ? fmt("%.9g", known[i]) : std::string("NaN")) << '\n';
@@ -379,7 +377,7 @@ IdentifiedPlotSummary plot_identified_load(const fs::path& identify_dir, const P
        << fmt("%.9g", s.mean_known_kN * to_unit) << '\n'
        << fmt("%.9g", std::min(w1, t.back())) << ' ' << fmt("%.9g", s.mean_identified_kN * to_unit) << ' '
        << fmt("%.9g", s.mean_known_kN * to_unit) << '\n';
-    FLOESIM_REQUIRE(os.flush(), data.tmp().string(), ": write failed (disk full?)");
+    write_file_checked(data.tmp(), os.str(), data.path());
   }
   double lo = 0, hi = 0;
   for (double x : ident) lo = std::min(lo, x), hi = std::max(hi, x);
@@ -412,9 +410,9 @@ IdentifiedPlotSummary plot_identified_load(const fs::path& identify_dir, const P
     gp << "\nset terminal svg size " << o.width_px << "," << o.height_px
        << " dynamic enhanced font 'DejaVu Sans,11' background rgb 'white'\n"
        << "set output " << quoted(svg.tmp().string()) << "\nreplot\nunset output\n";
-    std::ofstream os(script.tmp());
+    std::ostringstream os;
     os << gp.str();
-    FLOESIM_REQUIRE(os.flush(), script.tmp().string(), ": write failed (disk full?)");
+    write_file_checked(script.tmp(), os.str(), script.path());
   }
   run_gnuplot(script.tmp(), log.tmp(), {png.tmp(), svg.tmp()}, png.path().string());
   png.commit();

@@ -7,6 +7,7 @@
 
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
+#include "pipeline/interrupt.h"
 #include "pipeline/provenance.h"
 #include "render/scene.h"
 
@@ -39,7 +40,10 @@ RenderStats render_video(const Results& r, const RenderOptions& o, const fs::pat
   st.gl_renderer = scene.gl_renderer();
   double render_s = 0, encode_s = 0;
   cv::Mat frame;
+  // SIGINT/SIGTERM stop the loop between two frames; the temporary video is then removed (pipeline/interrupt.h).
+  InterruptPolling polling;
   for (size_t k = 0; k < n; ++k) {
+    check_interrupt();
     const auto t0 = clock::now();
     scene.render(k, frame);
     const auto t1 = clock::now();
@@ -56,6 +60,16 @@ RenderStats render_video(const Results& r, const RenderOptions& o, const fs::pat
   std::error_code ec;
   FLOESIM_REQUIRE(fs::file_size(video.tmp(), ec) > 0 && !ec, out_mp4.string(),
                   ": the encoder wrote nothing (disk full?)");
+  {
+    // The encoder does not report write errors: the file must read back with every frame (a full disk leaves an
+    // MP4 without its index, which does not open).
+    cv::VideoCapture back(video.tmp().string(), cv::CAP_FFMPEG);
+    const double frames = back.isOpened() ? back.get(cv::CAP_PROP_FRAME_COUNT) : -1;
+    if (frames != static_cast<double>(n))
+      throw Error(out_mp4.string() + ": the encoded video does not read back (" +
+                  (frames < 0 ? std::string("it does not open") : std::to_string(static_cast<long>(frames)) +
+                   " frames of " + std::to_string(n)) + "): " + cut_short_reason(video.tmp().parent_path()));
+  }
 
   st.frames = n;
   st.render_ms_per_frame = 1000 * render_s / static_cast<double>(n);
@@ -81,7 +95,7 @@ RenderStats render_video(const Results& r, const RenderOptions& o, const fs::pat
   fs::path sidecar = out_mp4;
   sidecar.replace_extension(".json");
   AtomicFile side_file(sidecar);
-  write_text_atomic(side_file.tmp(), side.dump(2) + "\n");
+  write_file_checked(side_file.tmp(), side.dump(2) + "\n", sidecar);
   video.commit();
   side_file.commit();
   return st;
@@ -104,13 +118,16 @@ void render_still(const fs::path& results, const fs::path& config, size_t frame,
   scene.render(frame, img);
   ensure_directory(out_image.parent_path());
   AtomicFile f(out_image);
+  // Encoded in memory, then written with every write checked: imwrite does not report a full disk.
+  std::vector<uchar> bytes;
   bool ok = false;
   try {
-    ok = cv::imwrite(f.tmp().string(), img);
+    ok = cv::imencode(out_image.extension().string(), img, bytes);
   } catch (const cv::Exception&) {
     ok = false;
   }
-  FLOESIM_REQUIRE(ok, out_image.string(), ": cannot write the image (use .png or .jpg; is the directory writable?)");
+  FLOESIM_REQUIRE(ok, out_image.string(), ": cannot encode the image (use .png or .jpg)");
+  write_file_checked(f.tmp(), std::string(bytes.begin(), bytes.end()), out_image);
   f.commit();
 }
 

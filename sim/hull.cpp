@@ -406,8 +406,7 @@ std::vector<TriMesh> generate_hull(const HullGeneratorOptions& o) {
 void write_obj(const fs::path& file, const std::vector<TriMesh>& parts, const std::string& header) {
   AtomicFile f(file);
   {
-    std::ofstream out(f.tmp(), std::ios::binary);
-    if (!out) throw Error(file.string() + ": cannot write (is the directory writable?)");
+    std::ostringstream out;
     std::istringstream h(header);
     for (std::string line; std::getline(h, line);) out << "# " << line << "\n";
     int base = 1;
@@ -422,8 +421,7 @@ void write_obj(const fs::path& file, const std::vector<TriMesh>& parts, const st
       for (const auto& t : parts[k].triangles) out << "f " << t[0] + base << " " << t[1] + base << " " << t[2] + base << "\n";
       base += static_cast<int>(parts[k].vertices.size());
     }
-    out.flush();
-    if (!out) throw Error(file.string() + ": write failed (disk full?)");
+    write_file_checked(f.tmp(), out.str(), file);  // every write checked: a full disk is an error, named
   }
   f.commit();
 }

@@ -11,9 +11,11 @@
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
 #include "pipeline/floes_io.h"
+#include "pipeline/interrupt.h"
 #include "pipeline/provenance.h"
 #include "pipeline/units.h"
 #include "sim/fracture_laws.h"
+#include "sim/checkpoint.h"
 #include "sim/world.h"
 
 namespace floesim::sim {
@@ -295,11 +297,10 @@ constexpr ScalarSeries kScalarSeries[] = {
 
 }  // namespace
 
-Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
+Results simulate(const Model& model, RunStats& stats, std::ostream* progress, const CheckpointPlan* checkpoints) {
   FLOESIM_REQUIRE(model.vessel >= 0, "simulate: the model has no vessel");
   const SimulateOptions& o = model.options;
   const long steps = o.steps(), every = o.output_every();
-  World world(model);
   Results r;
   // Direct references to the series columns: no map look-up per step, one reservation up front.
   std::map<std::string, std::vector<double>*> col;
@@ -332,83 +333,126 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
   r.state_in_contact.reserve(frames * nb);
   std::vector<int8_t> pressed;  // per body: pressed against the vessel in this step (frames only)
 
+  // The world: fresh, or continued from a checkpoint (sim/checkpoint.h) with the results recorded up to it.
+  RecorderSums sums;
+  std::unique_ptr<Checkpointer> cp;
+  std::unique_ptr<World> world;
+  const long checkpoint_every = o.checkpoint_every();
+  if (checkpoints) {
+    cp = std::make_unique<Checkpointer>(checkpoints->dir, checkpoints->provenance);
+    if (checkpoints->resume) world = cp->resume(model, r, sums, progress);
+    else cp->start_fresh(r, progress);
+  }
+  if (!world) world = std::make_unique<World>(model);
+  const long first = world->state().step + 1;
+  stats.resumed_at_step = first - 1;
+
   const auto t0 = std::chrono::steady_clock::now();
-  double record_s = 0, awake_sum = 0, contact_sum = 0, iter_sum = 0, pair_sum = 0, hit_sum = 0, edge_sum = 0;
-  double crush_sum = 0;
+  auto wall_now = [&] { return sums.wall_s + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   const int v = model.vessel;
-  for (long k = 1; k <= steps; ++k) {
-    world.step();
-    const auto tr = std::chrono::steady_clock::now();
-    const State& s = world.state();
-    const StepReport& rep = world.report();
-    const Mat3 R = s.orientation[v].toRotationMatrix();
-    const Quat& q = s.orientation[v];
-    const Vec3 vb = R.transpose() * s.velocity[v], wb = R.transpose() * s.angular_velocity[v];
-    c_time.push_back(s.time_s);
-    c_pos.insert(c_pos.end(), {s.position[v].x(), s.position[v].y(), s.position[v].z()});
-    c_quat.insert(c_quat.end(), {q.w(), q.x(), q.y(), q.z()});
-    c_vel.insert(c_vel.end(), {vb.x(), vb.y(), vb.z()});
-    c_omega.insert(c_omega.end(), {wb.x(), wb.y(), wb.z()});
-    push_body_wrench(c_ice, R, rep.ice_load);
-    push_body_wrench(c_ice_rigid, R, rep.ice_load_rigid);
-    push_body_wrench(c_ice_compliant, R, rep.ice_load_compliant);
-    push_body_wrench(c_ice_level_ice, R, rep.ice_load_level_ice);
-    push_body_wrench(c_hydro, R, rep.hydro_load);
-    push_body_wrench(c_wind, R, rep.wind_load);
-    push_body_wrench(c_prop, R, rep.propulsion_load);
-    for (size_t i = 0; i < c_scalar.size(); ++i) c_scalar[i]->push_back(kScalarSeries[i].get(rep));
-    awake_sum += rep.awake_floes;
-    contact_sum += rep.contacts;
-    iter_sum += rep.solve.iterations;
-    pair_sum += world.collision_stats().broadphase_pairs;
-    hit_sum += world.collision_stats().narrowphase_hits;
-    edge_sum += world.collision_stats().edge_contacts;
-    crush_sum += world.collision_stats().crushing_contacts;
-    // Frames at t = k * output_interval (k >= 1): the bodies alive, vessel first (body id 0), pieces in the order
-    // they were made.
-    if (k % every == 0) {
-      r.frame_time_s.push_back(s.time_s);
-      const Model& wm = world.model();
-      // Floes the vessel pressed on in this step: a vessel contact that carried a normal impulse (speculative
-      // contacts that stayed open carry none). Read only: the results stay what they were without this.
-      pressed.assign(wm.bodies.size(), 0);
-      for (const Contact& c : world.contacts())
-        if (c.pn > 0 && (c.body_a == v || c.body_b == v)) pressed[size_t(c.body_a == v ? c.body_b : c.body_a)] = 1;
-      for (size_t b = 0; b < wm.bodies.size(); ++b) {
-        const Body& body = wm.bodies[b];
-        if (body.kind == BodyKind::wall || !s.alive[b]) continue;  // walls are fixed: not in the results layout
-        r.state_body_id.push_back(body.kind == BodyKind::vessel ? 0 : body.id);
-        const Vec3& x = s.position[b];
-        const Quat& qb = s.orientation[b];
-        r.state_position_m.insert(r.state_position_m.end(), {x.x(), x.y(), x.z()});
-        r.state_quaternion.insert(r.state_quaternion.end(), {qb.w(), qb.x(), qb.y(), qb.z()});
-        r.state_in_contact.push_back(pressed[b]);
+  {
+    // SIGINT/SIGTERM stop the loop between two steps (pipeline/interrupt.h); with checkpoints on, the step reached
+    // is checkpointed first, so that --resume loses nothing.
+    InterruptPolling polling;
+    for (long k = first; k <= steps; ++k) {
+      if (interrupt_signal()) {
+        std::string where;
+        if (cp && checkpoint_every > 0 && world->state().step > cp->last_step()) {
+          sums.wall_s = wall_now();
+          cp->save(*world, r, sums);
+        }
+        if (cp && cp->last_step() > 0) {
+          std::ostringstream os;
+          os << "checkpoint at t = " << world->state().time_s << " s in " << cp->dir().string()
+             << ": --resume continues from it";
+          where = os.str();
+        }
+        throw Interrupted(interrupt_signal(), where);
       }
-      r.frame_offset.push_back(static_cast<int64_t>(r.state_body_id.size()));
-    }
-    record_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - tr).count();
-    if (progress && (k * 10) % steps < 10 && k != steps) {
-      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      *progress << "  t = " << std::fixed << std::setprecision(1) << s.time_s << " s  (" << (k * 100) / steps
-                << " %, " << std::setprecision(1) << wall << " s wall, awake floes " << rep.awake_floes
-                << ", contacts " << rep.contacts << ")" << std::defaultfloat << std::endl;
+      World& w = *world;
+      w.step();
+      const auto tr = std::chrono::steady_clock::now();
+      const State& s = w.state();
+      const StepReport& rep = w.report();
+      const Mat3 R = s.orientation[v].toRotationMatrix();
+      const Quat& q = s.orientation[v];
+      const Vec3 vb = R.transpose() * s.velocity[v], wb = R.transpose() * s.angular_velocity[v];
+      c_time.push_back(s.time_s);
+      c_pos.insert(c_pos.end(), {s.position[v].x(), s.position[v].y(), s.position[v].z()});
+      c_quat.insert(c_quat.end(), {q.w(), q.x(), q.y(), q.z()});
+      c_vel.insert(c_vel.end(), {vb.x(), vb.y(), vb.z()});
+      c_omega.insert(c_omega.end(), {wb.x(), wb.y(), wb.z()});
+      push_body_wrench(c_ice, R, rep.ice_load);
+      push_body_wrench(c_ice_rigid, R, rep.ice_load_rigid);
+      push_body_wrench(c_ice_compliant, R, rep.ice_load_compliant);
+      push_body_wrench(c_ice_level_ice, R, rep.ice_load_level_ice);
+      push_body_wrench(c_hydro, R, rep.hydro_load);
+      push_body_wrench(c_wind, R, rep.wind_load);
+      push_body_wrench(c_prop, R, rep.propulsion_load);
+      for (size_t i = 0; i < c_scalar.size(); ++i) c_scalar[i]->push_back(kScalarSeries[i].get(rep));
+      sums.awake += rep.awake_floes;
+      sums.contacts += rep.contacts;
+      sums.iterations += rep.solve.iterations;
+      sums.pairs += w.collision_stats().broadphase_pairs;
+      sums.touching += w.collision_stats().narrowphase_hits;
+      sums.edges += w.collision_stats().edge_contacts;
+      sums.crushing += w.collision_stats().crushing_contacts;
+      // Frames at t = k * output_interval (k >= 1): the bodies alive, vessel first (body id 0), pieces in the order
+      // they were made.
+      if (k % every == 0) {
+        r.frame_time_s.push_back(s.time_s);
+        const Model& wm = w.model();
+        // Floes the vessel pressed on in this step: a vessel contact that carried a normal impulse (speculative
+        // contacts that stayed open carry none). Read only: the results stay what they were without this.
+        pressed.assign(wm.bodies.size(), 0);
+        for (const Contact& c : w.contacts())
+          if (c.pn > 0 && (c.body_a == v || c.body_b == v)) pressed[size_t(c.body_a == v ? c.body_b : c.body_a)] = 1;
+        for (size_t b = 0; b < wm.bodies.size(); ++b) {
+          const Body& body = wm.bodies[b];
+          if (body.kind == BodyKind::wall || !s.alive[b]) continue;  // walls are fixed: not in the results layout
+          r.state_body_id.push_back(body.kind == BodyKind::vessel ? 0 : body.id);
+          const Vec3& x = s.position[b];
+          const Quat& qb = s.orientation[b];
+          r.state_position_m.insert(r.state_position_m.end(), {x.x(), x.y(), x.z()});
+          r.state_quaternion.insert(r.state_quaternion.end(), {qb.w(), qb.x(), qb.y(), qb.z()});
+          r.state_in_contact.push_back(pressed[b]);
+        }
+        r.frame_offset.push_back(static_cast<int64_t>(r.state_body_id.size()));
+      }
+      sums.record_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - tr).count();
+      // A checkpoint every checkpoint_interval_s of simulated time (not after the last step: the results follow).
+      if (cp && checkpoint_every > 0 && k % checkpoint_every == 0 && k < steps) {
+        const double before = sums.wall_s;
+        sums.wall_s = wall_now();
+        const auto tc = std::chrono::steady_clock::now();
+        cp->save(w, r, sums);
+        stats.checkpoint_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - tc).count();
+        ++stats.checkpoints;
+        sums.wall_s = before;
+      }
+      if (progress && (k * 10) % steps < 10 && k != steps) {
+        *progress << "  t = " << std::fixed << std::setprecision(1) << s.time_s << " s  (" << (k * 100) / steps
+                  << " %, " << std::setprecision(1) << wall_now() << " s wall, awake floes " << rep.awake_floes
+                  << ", contacts " << rep.contacts << ")" << std::defaultfloat << std::endl;
+      }
     }
   }
-  stats.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  for (int i = 0; i < kStageCount; ++i) stats.stage_s[i] = world.stage_seconds()[i];
-  stats.stage_s[kStageCount] = record_s;
+  const World& world_end = *world;
+  stats.wall_s = wall_now();
+  for (int i = 0; i < kStageCount; ++i) stats.stage_s[i] = world_end.stage_seconds()[i];
+  stats.stage_s[kStageCount] = sums.record_s;
   stats.steps = steps;
-  stats.mean_awake_floes = awake_sum / steps;
-  stats.mean_contacts = contact_sum / steps;
-  stats.mean_iterations = iter_sum / steps;
-  stats.mean_pairs = pair_sum / steps;
-  stats.mean_touching = hit_sum / steps;
-  stats.mean_edge_pairs = edge_sum / steps;
-  stats.mean_crushing_pairs = crush_sum / steps;
+  stats.mean_awake_floes = sums.awake / steps;
+  stats.mean_contacts = sums.contacts / steps;
+  stats.mean_iterations = sums.iterations / steps;
+  stats.mean_pairs = sums.pairs / steps;
+  stats.mean_touching = sums.touching / steps;
+  stats.mean_edge_pairs = sums.edges / steps;
+  stats.mean_crushing_pairs = sums.crushing / steps;
 
   // Geometry: the outline of every floe that ever existed (pieces included) in its body frame, with its thickness
   // and lineage; the hull surface in the vessel body frame.
-  const Model& wm = world.model();
+  const Model& wm = world_end.model();
   r.floe_vertex_offset.push_back(0);
   for (size_t k = 0; k < wm.bodies.size(); ++k) {
     const Body& b = wm.bodies[k];
@@ -422,9 +466,9 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress) {
     r.floe_generation.push_back(b.generation);
     r.floe_origin_mode.push_back(b.origin_mode);
     r.floe_created_s.push_back(b.created_s);
-    r.floe_ended_s.push_back(world.ended_s()[k]);
+    r.floe_ended_s.push_back(world_end.ended_s()[k]);
   }
-  record_fracture_events(world.fracture_events(), r);
+  record_fracture_events(world_end.fracture_events(), r);
   const TriMesh& hull = model.bodies[v].buoyancy_mesh;
   for (const Vec3& p : hull.vertices) r.hull_vertices_m.insert(r.hull_vertices_m.end(), {p.x(), p.y(), p.z()});
   for (const auto& t : hull.triangles) r.hull_triangles.insert(r.hull_triangles.end(), {t[0], t[1], t[2]});
@@ -606,7 +650,7 @@ nlohmann::json summarize(const Model& model, const Results& r) {
 }
 
 std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, const fs::path& config_file,
-                         const fs::path& out_dir) {
+                         const fs::path& out_dir, bool resume) {
   // 1. Inputs: options (strict), thrust series path relative to the config file, floes, hull.
   const Json cfg = load_json_file(config_file);
   SimulateOptions o = read_options<SimulateOptions>(cfg, config_file.string());
@@ -640,19 +684,25 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
       << " m, GM_T " << model.vessel_info.gm_transverse_m << " m\n";
   std::cout << out.str() << std::flush;
 
-  // 2. Simulate (throws on numerical failure: nothing is written).
-  RunStats stats;
-  Results results = simulate(model, stats, &std::cout);
+  // 2. Simulate (throws on numerical failure: nothing is written), with checkpoints in out_dir/checkpoint. The
+  // output folder is checked first: a run of hours must not end at a folder it cannot write.
+  ensure_directory(out_dir);
   const Json prov = make_provenance("floesim-simulate", inputs, options_to_json(o));
+  CheckpointPlan checkpoints;
+  checkpoints.dir = out_dir / "checkpoint";
+  checkpoints.provenance = prov;
+  checkpoints.resume = resume;
+  RunStats stats;
+  Results results = simulate(model, stats, &std::cout, &checkpoints);
   results.attributes["provenance"] = prov;
   nlohmann::json summary = summarize(model, results);
   summary["settings"] = options_to_json(o);
   summary["provenance"] = prov;
 
-  // 3. Artefacts, atomically.
-  ensure_directory(out_dir);
+  // 3. Artefacts, atomically; then the checkpoint has served.
   write_results(out_dir / "results.h5", results);
   write_text_atomic(out_dir / "summary.json", summary.dump(2) + "\n");
+  remove_checkpoint(checkpoints.dir);
 
   // 4. The report (wall time lives here, not in the artefacts).
   std::ostringstream rep;
@@ -660,6 +710,12 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   rep << std::fixed << std::setprecision(2);
   rep << "floes " << model.floe_count() << ", steps " << stats.steps << ", wall " << stats.wall_s << " s, "
       << ms << " ms/step, " << o.duration_s / stats.wall_s << " simulated s per wall s\n";
+  if (stats.resumed_at_step > 0)
+    rep << "resumed at step " << stats.resumed_at_step << " (t = " << stats.resumed_at_step * o.time_step_s
+        << " s); the wall time includes the run before\n";
+  if (stats.checkpoints > 0)
+    rep << stats.checkpoints << " checkpoints written (every " << o.checkpoint_interval_s << " s of simulated time), "
+        << 1e3 * stats.checkpoint_s / stats.checkpoints << " ms each on average\n";
   rep << "mean awake floes " << stats.mean_awake_floes << ", mean contacts " << stats.mean_contacts
       << ", mean solver sweeps " << stats.mean_iterations << "\n";
   rep << "mean part pairs per step: " << stats.mean_pairs << " from the broad phase, " << stats.mean_touching

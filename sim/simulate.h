@@ -18,12 +18,26 @@ struct RunStats {
   double mean_pairs = 0, mean_touching = 0, mean_edge_pairs = 0;  // broad-phase pairs, touching pairs, edge ones
   double mean_crushing_pairs = 0;  // touching pairs with a compliant (crushing) contact
   long steps = 0;
+  long resumed_at_step = 0;        // the checkpoint this process continued from (0: from the start)
+  int checkpoints = 0;             // written by this process
+  double checkpoint_s = 0;         // their wall time
+};
+
+// Checkpoints of a run (sim/checkpoint.h): where, and whether to continue from the one there.
+struct CheckpointPlan {
+  std::filesystem::path dir;         // OUT/checkpoint
+  nlohmann::json provenance;         // the stage's provenance: identifies the run (its inputs and settings)
+  bool resume = false;               // continue from the checkpoint in dir (if there is one of this run)
 };
 
 // Simulates the model for options.duration_s and records every series per step, the body states at
 // t = k * output_interval_s (k = 1..N, exactly duration / output_interval frames) and the geometry.
 // `progress` (may be null) receives a line every 10 % of the run. Needs a vessel in the model.
-Results simulate(const Model& model, RunStats& stats, std::ostream* progress = nullptr);
+// With `checkpoints`, writes a checkpoint every options.checkpoint_interval_s of simulated time (if > 0) and when
+// stopped by a signal, and resumes from one if asked: the results are the same to the bit either way.
+// SIGINT/SIGTERM stop it between two steps with Interrupted (pipeline/interrupt.h).
+Results simulate(const Model& model, RunStats& stats, std::ostream* progress = nullptr,
+                 const CheckpointPlan* checkpoints = nullptr);
 
 // Summary statistics of the results (steady part from options.steady_start_s).
 nlohmann::json summarize(const Model& model, const Results& results);
@@ -34,9 +48,11 @@ nlohmann::json summarize(const Model& model, const Results& results);
 nlohmann::json level_ice_summary(const Model& model, const Results& results);
 
 // The stage: reads the inputs, builds the model, simulates, writes out_dir/results.h5 and out_dir/summary.json
-// atomically (nothing is written on error) and returns the report printed on stdout.
+// atomically (nothing is written on error) and returns the report printed on stdout. Checkpoints go to
+// out_dir/checkpoint and are removed once the results are written; `resume` continues from the one there.
 std::string run_simulate(const std::filesystem::path& floes_file, const std::filesystem::path& hull_file,
-                         const std::filesystem::path& config_file, const std::filesystem::path& out_dir);
+                         const std::filesystem::path& config_file, const std::filesystem::path& out_dir,
+                         bool resume = false);
 
 // Centred moving average of x with a window of n samples (n odd or even: n samples ending n/2 after the centre);
 // only the positions where the window fits are returned.

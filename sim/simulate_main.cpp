@@ -12,11 +12,14 @@ int main(int argc, char** argv) {
                "drag, ITTC-57 resistance, propulsion) and writes DIR/results.h5 and DIR/summary.json.",
                "floesim-simulate"};
   std::string floes, hull, config, out;
-  bool help_config = false, check_config = false;
+  bool help_config = false, check_config = false, resume = false;
   app.add_option("--floes", floes, "floe field GeoJSON (floesim-digitise output)");
   app.add_option("--hull", hull, "hull mesh (OBJ of convex parts, e.g. floesim-hull output)");
   app.add_option("--config", config, "JSON object of simulate options (see --help-config)");
   app.add_option("--out", out, "output directory");
+  app.add_flag("--resume", resume,
+               "continue from the checkpoint in DIR/checkpoint (checkpoint_interval_s) if it is of the same inputs "
+               "and settings (else an error says what differs); without one, start from t = 0");
   app.add_flag("--check-config", check_config, "read and check --config (strictly, as a run would), write nothing");
   app.add_flag("--help-config", help_config, "print the simulate options as a Markdown table and exit");
   return floesim::run_stage(app, argc, argv, [&] {
@@ -32,6 +35,6 @@ int main(int argc, char** argv) {
     }
     if (floes.empty() || hull.empty() || config.empty() || out.empty())
       throw floesim::Error("--floes, --hull, --config and --out are all required (see --help)");
-    std::cout << floesim::sim::run_simulate(floes, hull, config, out);
+    std::cout << floesim::sim::run_simulate(floes, hull, config, out, resume);
   });
 }

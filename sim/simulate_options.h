@@ -554,6 +554,10 @@ struct SimulateOptions {
   double output_interval_s = 0.2;
   double steady_start_s = 20.0;   // statistics of the summary start here (skip the start-up transient)
   int threads = 1;
+  // Simulated time between checkpoints (sim/checkpoint.h); 0 = none. 10 s: a checkpoint costs milliseconds to a
+  // fraction of a second (the world's state plus the results recorded since the last one, written once), while
+  // 10 s of a large field take minutes of wall time; a stopped run then loses at most that much.
+  double checkpoint_interval_s = 10.0;
   IceOptions ice;
   WaterOptions water;
   VesselOptions vessel;
@@ -577,6 +581,10 @@ struct SimulateOptions {
             non_negative());
     v.field("threads", threads, "-", "worker threads for the per-body force and narrow-phase stages",
             int_in_range(1, 64));
+    v.field("checkpoint_interval_s", checkpoint_interval_s, "s",
+            "simulated time between checkpoints in OUT/checkpoint (a whole number of time steps; 0 = none); "
+            "--resume continues from the last one with byte-identical results",
+            non_negative());
     v.section("ice", ice, "ice material");
     v.section("water", water, "water, gravity and current");
     v.section("vessel", vessel, "vessel start, mass, resistance, propulsion, steering");
@@ -609,10 +617,18 @@ struct SimulateOptions {
         v.problem("output_interval_s", "must divide duration_s (frames are stored at k x output_interval_s)");
     }
     if (steady_start_s >= duration_s) v.problem("steady_start_s", "must be < duration_s");
+    if (time_step_s > 0 && checkpoint_interval_s > 0) {
+      const double n = checkpoint_interval_s / time_step_s;
+      if (checkpoint_interval_s < time_step_s * (1 - 1e-9))
+        v.problem("checkpoint_interval_s", "must be 0 (no checkpoints) or >= time_step_s");
+      else if (std::abs(n - std::round(n)) > 1e-6 * std::max(1.0, n))
+        v.problem("checkpoint_interval_s", "must be a whole number of time steps");
+    }
   }
 
   long steps() const { return std::lround(duration_s / time_step_s); }
   long output_every() const { return std::lround(output_interval_s / time_step_s); }
+  long checkpoint_every() const { return std::lround(checkpoint_interval_s / time_step_s); }  // 0: none
 };
 
 }  // namespace floesim::sim

@@ -32,6 +32,7 @@ bool finite(const Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y())
 
 World::World(const Model& model) : model_(model), pool_(model.options.threads) {
   const size_t n = model.bodies.size();
+  base_bodies_ = n;
   const SimulateOptions& o = model.options;
   // Floes rest only in still water and air (a current or wind drives every floe, and in vacuum nothing holds
   // them): only then do they start asleep at their hydrostatic equilibrium, and only then may they fall asleep.
@@ -341,17 +342,20 @@ void World::apply_fracture(FractureCut& cut) {
     for (const Vec2& p : piece) local.push_back(p - c);
     const int id = next_floe_id_++;
     const int index = static_cast<int>(model_.bodies.size());
-    Body b = make_floe_body(local, h, id, index, Vec2::Zero(), model_.options, model_.parts);
-    b.parent_id = parent_body.id;
-    b.generation = parent_body.generation + 1;
-    b.origin_mode = e.mode;
-    b.created_s = t;
     // The piece where it was in the floe, with the floe's velocity field v + w x r (momentum kept exactly).
     const Vec3 r = R * Vec3(c.x(), c.y(), 0);
-    b.initial_position = x + r;
-    b.initial_orientation = q;
-    if (fixed) hold_fixed(b);
-    model_.bodies.push_back(std::move(b));
+    PieceSpec spec;
+    spec.outline = std::move(local);
+    spec.thickness_m = h;
+    spec.id = id;
+    spec.parent_id = parent_body.id;
+    spec.generation = parent_body.generation + 1;
+    spec.origin_mode = e.mode;
+    spec.created_s = t;
+    spec.position = x + r;
+    spec.orientation = q;
+    spec.fixed = fixed;
+    model_.bodies.push_back(make_piece_body(spec, index, model_.options, model_.parts));
     grow_body_arrays();
     state_.position[index] = x + r;
     state_.orientation[index] = q;
@@ -366,6 +370,18 @@ void World::apply_fracture(FractureCut& cut) {
   brash_mass_kg_ += e.brash_mass_kg;
   collision_->add_bodies(state_, first_new);
   events_.push_back(std::move(e));
+}
+
+Body make_piece_body(const PieceSpec& p, int body_index, const SimulateOptions& o, std::vector<ConvexPart>& parts) {
+  Body b = make_floe_body(p.outline, p.thickness_m, p.id, body_index, Vec2::Zero(), o, parts);
+  b.parent_id = p.parent_id;
+  b.generation = p.generation;
+  b.origin_mode = p.origin_mode;
+  b.created_s = p.created_s;
+  b.initial_position = p.position;
+  b.initial_orientation = p.orientation;
+  if (p.fixed) hold_fixed(b);
+  return b;
 }
 
 void World::stage_sleep() {
@@ -443,6 +459,227 @@ Vec3 World::linear_momentum() const {
   for (size_t b = 0; b < model_.bodies.size(); ++b)
     if (state_.alive[b]) p += model_.bodies[b].mass_kg * state_.velocity[b];
   return p;
+}
+
+}  // namespace floesim::sim
+
+namespace floesim::sim {
+
+namespace {
+
+void put_vec3s(ByteWriter& w, const std::vector<Vec3>& v) {
+  w.size(v.size());
+  for (const Vec3& x : v) w.mat(x);
+}
+void get_vec3s(ByteReader& r, std::vector<Vec3>& v) {
+  v.resize(r.size(3 * sizeof(double)));
+  for (Vec3& x : v) r.mat(x);
+}
+void put_mat3s(ByteWriter& w, const std::vector<Mat3>& v) {
+  w.size(v.size());
+  for (const Mat3& x : v) w.mat(x);
+}
+void get_mat3s(ByteReader& r, std::vector<Mat3>& v) {
+  v.resize(r.size(9 * sizeof(double)));
+  for (Mat3& x : v) r.mat(x);
+}
+
+// The per-body arrays of a state must match the body table; a checkpoint that says otherwise is damaged.
+void require_bodies(const ByteReader& r, size_t got, size_t bodies, const char* what) {
+  FLOESIM_REQUIRE(got == bodies, r.what(), ": damaged (", what, " for ", got, " bodies, the world has ", bodies, ")");
+}
+
+}  // namespace
+
+void World::save(ByteWriter& w) const {
+  // 1. The body table as built (a check) and the pieces appended since, as what made them.
+  w.size(base_bodies_);
+  w.size(model_.parts.size());
+  w.size(model_.bodies.size() - base_bodies_);
+  for (size_t k = base_bodies_; k < model_.bodies.size(); ++k) {
+    const Body& b = model_.bodies[k];
+    w.size(b.outline.size());
+    for (const Vec2& p : b.outline) w.mat(p);
+    w.pod(b.thickness_m);
+    w.pod<int32_t>(b.id);
+    w.pod<int32_t>(b.parent_id);
+    w.pod<int32_t>(b.generation);
+    w.pod<int32_t>(b.origin_mode);
+    w.pod(b.created_s);
+    w.mat(b.initial_position);
+    w.quat(b.initial_orientation);
+    w.pod<uint8_t>(b.fixed ? 1 : 0);
+  }
+  // 2. The state.
+  const State& s = state_;
+  w.pod(s.time_s);
+  w.pod<int64_t>(s.step);
+  put_vec3s(w, s.position);
+  w.size(s.orientation.size());
+  for (const Quat& q : s.orientation) w.quat(q);
+  put_vec3s(w, s.velocity);
+  put_vec3s(w, s.angular_velocity);
+  w.vec(s.awake);
+  w.vec(s.alive);
+  w.vec(s.still_time_s);
+  w.size(s.contact_cache.size());
+  for (const CachedContact& c : s.contact_cache) {
+    for (int i : {c.body_a, c.part_a, c.body_b, c.part_b, c.row}) w.pod<int32_t>(i);
+    w.mat(c.local_a);
+    w.mat(c.impulse);
+    w.pod<uint8_t>(static_cast<uint8_t>(c.type));
+    w.mat(c.crush_normal_a);
+    w.mat(c.crush_point_a);
+    w.mat(c.crush_point_b);
+  }
+  w.pod(s.speed_error_integral);
+  w.pod(s.heading_ref_rad);
+  // 3. What else carries over: mass matrices as the solver saw them, jets, the fracture record, moved bodies.
+  put_mat3s(w, solver_bodies_.inv_mass);
+  put_mat3s(w, solver_bodies_.inv_inertia_world);
+  w.size(jets_.size());
+  for (const PropellerJet& j : jets_) {
+    w.mat(j.origin);
+    w.mat(j.dir);
+    w.pod(j.efflux_mps);
+    w.pod(j.excess_mps);
+    w.pod(j.d0_m);
+  }
+  w.size(events_.size());
+  for (const FractureEvent& e : events_) {
+    w.pod(e.time_s);
+    w.pod<int32_t>(e.parent_id);
+    w.pod<int32_t>(e.mode);
+    w.pod<uint8_t>(e.at_structure ? 1 : 0);
+    w.mat(e.force_n);
+    w.pod(e.threshold_n);
+    w.mat(e.point_m);
+    w.pod(e.width_m);
+    w.pod(e.theta_rad);
+    w.pod(e.lc_m);
+    w.pod(e.rb_m);
+    w.pod(e.brash_mass_kg);
+    std::vector<int32_t> children(e.child_ids.begin(), e.child_ids.end());
+    w.vec(children);
+  }
+  w.vec(ended_s_);
+  w.pod(brash_mass_kg_);
+  w.pod<int32_t>(next_floe_id_);
+  w.pod<int32_t>(floes_alive_);
+  std::vector<int32_t> moved(moved_.begin(), moved_.end());
+  w.vec(moved);
+  for (double t : stage_seconds_) w.pod(t);
+}
+
+std::unique_ptr<World> World::restore(const Model& base, ByteReader& r) {
+  // 1. The body table: the model as built must be the one saved (same inputs), then the pieces are remade.
+  const size_t base_bodies = r.size(), parts = r.size(), pieces = r.size(1);
+  FLOESIM_REQUIRE(base_bodies == base.bodies.size(), r.what(), ": made for a model of ", base_bodies,
+                  " bodies, the inputs give ", base.bodies.size(), " (other inputs?)");
+  Model m = base;
+  for (size_t k = 0; k < pieces; ++k) {
+    PieceSpec p;
+    p.outline.resize(r.size(2 * sizeof(double)));
+    for (Vec2& v : p.outline) r.mat(v);
+    p.thickness_m = r.pod<double>();
+    p.id = r.pod<int32_t>();
+    p.parent_id = r.pod<int32_t>();
+    p.generation = r.pod<int32_t>();
+    p.origin_mode = r.pod<int32_t>();
+    p.created_s = r.pod<double>();
+    r.mat(p.position);
+    p.orientation = r.quat();
+    p.fixed = r.pod<uint8_t>() != 0;
+    FLOESIM_REQUIRE(p.outline.size() >= 3 && signed_area(p.outline) > 0 && p.thickness_m > 0, r.what(),
+                    ": damaged (piece ", p.id, " has no valid outline)");
+    const int index = static_cast<int>(m.bodies.size());
+    m.bodies.push_back(make_piece_body(p, index, m.options, m.parts));
+  }
+  FLOESIM_REQUIRE(m.parts.size() == parts, r.what(), ": the remade body table has ", m.parts.size(),
+                  " convex parts, the saved one had ", parts, " (other inputs, or another build of floesim?)");
+  auto w = std::make_unique<World>(m);
+  w->base_bodies_ = base_bodies;
+  const size_t n = m.bodies.size();
+  // 2. The state.
+  State& s = w->state_;
+  s.time_s = r.pod<double>();
+  s.step = static_cast<long>(r.pod<int64_t>());
+  get_vec3s(r, s.position);
+  require_bodies(r, s.position.size(), n, "positions");
+  s.orientation.resize(r.size(4 * sizeof(double)));
+  for (Quat& q : s.orientation) q = r.quat();
+  require_bodies(r, s.orientation.size(), n, "orientations");
+  get_vec3s(r, s.velocity);
+  require_bodies(r, s.velocity.size(), n, "velocities");
+  get_vec3s(r, s.angular_velocity);
+  require_bodies(r, s.angular_velocity.size(), n, "angular velocities");
+  s.awake = r.vec<uint8_t>();
+  require_bodies(r, s.awake.size(), n, "awake flags");
+  s.alive = r.vec<uint8_t>();
+  require_bodies(r, s.alive.size(), n, "alive flags");
+  s.still_time_s = r.vec<double>();
+  require_bodies(r, s.still_time_s.size(), n, "still times");
+  s.contact_cache.resize(r.size(1));
+  for (CachedContact& c : s.contact_cache) {
+    for (int* i : {&c.body_a, &c.part_a, &c.body_b, &c.part_b, &c.row}) *i = r.pod<int32_t>();
+    r.mat(c.local_a);
+    r.mat(c.impulse);
+    c.type = static_cast<ContactType>(r.pod<uint8_t>());
+    r.mat(c.crush_normal_a);
+    r.mat(c.crush_point_a);
+    r.mat(c.crush_point_b);
+    FLOESIM_REQUIRE(c.body_a >= 0 && c.body_b >= 0 && static_cast<size_t>(c.body_a) < n &&
+                        static_cast<size_t>(c.body_b) < n && c.part_a >= 0 && c.part_b >= 0 &&
+                        static_cast<size_t>(c.part_a) < parts && static_cast<size_t>(c.part_b) < parts,
+                    r.what(), ": damaged (a cached contact names a body or part that does not exist)");
+  }
+  s.speed_error_integral = r.pod<double>();
+  s.heading_ref_rad = r.pod<double>();
+  // 3. The rest.
+  get_mat3s(r, w->solver_bodies_.inv_mass);
+  require_bodies(r, w->solver_bodies_.inv_mass.size(), n, "inverse masses");
+  get_mat3s(r, w->solver_bodies_.inv_inertia_world);
+  require_bodies(r, w->solver_bodies_.inv_inertia_world.size(), n, "inverse inertias");
+  w->jets_.resize(r.size(1));
+  for (PropellerJet& j : w->jets_) {
+    r.mat(j.origin);
+    r.mat(j.dir);
+    j.efflux_mps = r.pod<double>();
+    j.excess_mps = r.pod<double>();
+    j.d0_m = r.pod<double>();
+  }
+  w->events_.resize(r.size(1));
+  for (FractureEvent& e : w->events_) {
+    e.time_s = r.pod<double>();
+    e.parent_id = r.pod<int32_t>();
+    e.mode = r.pod<int32_t>();
+    e.at_structure = r.pod<uint8_t>() != 0;
+    r.mat(e.force_n);
+    e.threshold_n = r.pod<double>();
+    r.mat(e.point_m);
+    e.width_m = r.pod<double>();
+    e.theta_rad = r.pod<double>();
+    e.lc_m = r.pod<double>();
+    e.rb_m = r.pod<double>();
+    e.brash_mass_kg = r.pod<double>();
+    const std::vector<int32_t> children = r.vec<int32_t>();
+    e.child_ids.assign(children.begin(), children.end());
+  }
+  w->ended_s_ = r.vec<double>();
+  require_bodies(r, w->ended_s_.size(), n, "end times");
+  w->brash_mass_kg_ = r.pod<double>();
+  w->next_floe_id_ = r.pod<int32_t>();
+  w->floes_alive_ = r.pod<int32_t>();
+  const std::vector<int32_t> moved = r.vec<int32_t>();
+  for (int32_t b : moved)
+    FLOESIM_REQUIRE(b >= 0 && static_cast<size_t>(b) < n, r.what(), ": damaged (a moved body does not exist)");
+  w->moved_.assign(moved.begin(), moved.end());
+  for (double& t : w->stage_seconds_) t = r.pod<double>();
+  // 4. The broad phase from the restored poses and awake flags, without the bodies that have left the world.
+  w->collision_ = std::make_unique<CollisionWorld>(w->model_, w->state_, w->pool_);
+  for (size_t b = 0; b < n; ++b)
+    if (!s.alive[b]) w->collision_->remove_body(static_cast<int>(b));
+  return w;
 }
 
 }  // namespace floesim::sim

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/binary.h"
 #include "sim/collision.h"
 #include "sim/forces.h"
 #include "sim/fracture.h"
@@ -89,6 +90,18 @@ class World {
   double kinetic_energy() const;
   Vec3 linear_momentum() const;
 
+  // Checkpoints (sim/checkpoint.h). save() writes everything of the world that carries over from one step to the
+  // next: the pieces fracture appended to the body table (as what made them: outline, thickness, id, lineage, pose
+  // at birth), the state (poses, velocities, awake, alive and still times, the warm-start cache with the crushed
+  // depths, the controllers' integrals), the solver's mass matrices, the last step's propeller jets (they wake
+  // sleepers in the next collide), the fracture record and the bodies that moved last (the next broad-phase
+  // refresh), and the wall time per stage. restore() rebuilds the same world from `base`, the model as
+  // build_model made it from the same inputs: the pieces are remade by the function the fracture stage uses, and
+  // the collision world is rebuilt from the poses (its pairs do not depend on its trees' history: exact boxes,
+  // pairs sorted). The restored world steps on bit for bit as the saved one would have.
+  void save(ByteWriter& w) const;
+  static std::unique_ptr<World> restore(const Model& base, ByteReader& r);
+
  private:
   void stage_collide();
   void stage_forces();
@@ -131,6 +144,21 @@ class World {
   int next_floe_id_ = 1;            // ids of new pieces: above every id the world has seen, never reused
   int floes_alive_ = 0;             // floe bodies alive (changes only in the fracture stage)
   std::array<double, kStageCount> stage_seconds_{};
+  size_t base_bodies_ = 0;          // bodies of the model as built; pieces come after them
 };
+
+// What makes a piece of a broken floe: its outline in its own body frame (centred on its centroid), thickness, id,
+// lineage, pose at birth, and whether it stays held by a level-ice sheet. make_piece_body turns it into the body the world appends; the fracture stage and the
+// restore from a checkpoint both use it, so they make the same body to the bit.
+struct PieceSpec {
+  Polygon outline;
+  double thickness_m = 0;
+  int id = 0, parent_id = -1, generation = 0, origin_mode = 0;
+  double created_s = 0;
+  Vec3 position = Vec3::Zero();
+  Quat orientation = Quat::Identity();
+  bool fixed = false;  // level ice: the rest of a tile, still held by the sheet (hold_fixed)
+};
+Body make_piece_body(const PieceSpec& p, int body_index, const SimulateOptions& o, std::vector<ConvexPart>& parts);
 
 }  // namespace floesim::sim

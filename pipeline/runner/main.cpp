@@ -19,6 +19,9 @@ int main(int argc, char** argv) {
   run->add_option("--bin", o.bin_dir, "folder of the stage executables (default: beside floesim)");
   run->add_option("-j,--jobs", o.jobs, "stages run in parallel (default: ninja's choice)");
   run->add_flag("-n,--dry-run", o.dry_run, "show what would run, run nothing");
+  run->add_flag("--resume", o.resume,
+                "continue the simulation from its last checkpoint (simulate.checkpoint_interval_s) if one of the same "
+                "inputs exists; the results are byte-identical to a run never stopped");
   floesim::runner::SweepOptions so;
   std::string sweep_run_dir;
   auto* sweep = app.add_subcommand(
@@ -28,6 +31,7 @@ int main(int argc, char** argv) {
   sweep->add_option("--bin", so.bin_dir, "folder of the stage executables (default: beside floesim)");
   sweep->add_option("-j,--jobs", so.jobs, "stages run in parallel here (default: ninja's choice)");
   sweep->add_flag("-n,--dry-run", so.dry_run, "plan and check every member's settings, show what would run");
+  sweep->add_flag("--resume", so.resume, "members' simulations continue from their last checkpoints (as run --resume)");
   sweep->add_flag("--yes", so.yes, "run a sweep of more than 64 members");
   sweep->add_flag("--slurm", so.slurm, "submit to SLURM (sbatch job arrays, one per stage level) instead");
   sweep->add_flag("--wait", so.wait, "with --slurm: wait until the cluster has finished and gathered");

@@ -56,6 +56,7 @@ std::string shell_quote(const std::string& s) {
 std::string shell_command(const PlannedStage& s) {
   std::string cmd = shell_quote(s.exe.string());
   for (const std::string& a : s.args) cmd += " " + shell_quote(a);
+  if (s.resumable) cmd += " ${FLOESIM_RESUME:+--resume}";  // POSIX sh: the word only when the variable is set
   return cmd;
 }
 
@@ -261,6 +262,7 @@ CasePlan plan_case(const Json& c, const std::string& where, const fs::path& case
                            "floesim-simulate");
     st->args = {"--floes", floes_file.string(), "--hull", hull_obj.string(), "--config", st->config.string(),
                 "--out", st->dir.string()};
+    st->resumable = true;
     plan.results = st->outputs[0];
     plan.summary = st->outputs[1];
     plan.artefacts.push_back({"simulate", "sim/results.h5", "time series and floe states (HDF5)"});
@@ -384,10 +386,12 @@ std::string stage_script(const std::vector<PlannedStage>& stages, size_t k, Stag
     if (depends) dirty.insert(dirty.end(), stages[j].outputs.begin(), stages[j].outputs.end());
   }
   const PlannedStage& s = stages[k];
+  // AtomicFile's temporaries (".tmp-<pid>-<name>") a killed run of this stage left; the glob stays unquoted.
+  const std::string stale = " " + shell_quote(s.dir.string()) + "/.tmp-*";
   if (output == StageOutput::console) {
     std::string rm = "rm -f";
     for (auto& p : dirty) rm += " " + shell_quote(p.string());
-    return rm + " && " + shell_command(s);
+    return rm + stale + " && " + shell_command(s);
   }
   // A sweep's stage is shared by members that come and go: the list of what lies downstream of it is a file
   // beside it (written with its settings), so that a new member does not change its command and rerun it.
@@ -396,11 +400,13 @@ std::string stage_script(const std::vector<PlannedStage>& stages, size_t k, Stag
   write_if_changed(s.dir / "downstream.txt", list);
   const std::string log = shell_quote((s.dir / "log.txt").string()), wall = shell_quote((s.dir / "wall_ms").string());
   const std::string rm = "tr '\\n' '\\0' < " + shell_quote((s.dir / "downstream.txt").string()) +
-                         " | xargs -0 rm -f && rm -f " + wall;
-  // POSIX sh: the wall time from date +%s%N (GNU date: nanoseconds), written after the stage whatever its outcome.
+                         " | xargs -0 rm -f && rm -f " + wall + stale;
+  // POSIX sh: the wall time from date +%s%N (GNU date: nanoseconds), written after the stage whatever its outcome,
+  // under a temporary name renamed into place (a kill never leaves an empty wall_ms that gather would misread).
+  const std::string wall_tmp = shell_quote((s.dir / ".tmp-0-wall_ms").string());
   return rm + " && t0=$(date +%s%N) && { " + shell_command(s) + " > " + log +
-         " 2>&1; rc=$?; echo $(( ($(date +%s%N) - t0) / 1000000 )) > " + wall + "; [ $rc -eq 0 ] || { tail -n 15 " +
-         log + " >&2; exit $rc; }; }";
+         " 2>&1; rc=$?; echo $(( ($(date +%s%N) - t0) / 1000000 )) > " + wall_tmp + " && mv -f " + wall_tmp + " " +
+         wall + "; [ $rc -eq 0 ] || { tail -n 15 " + log + " >&2; exit $rc; }; }";
 }
 
 void write_ninja(const fs::path& file, const std::string& header, const std::vector<PlannedStage>& stages,

@@ -27,6 +27,10 @@ struct PlannedStage {
   std::vector<std::filesystem::path> outputs;  // files it writes (the first is its main artefact)
   std::filesystem::path exe;
   std::vector<std::string> args;        // command-line arguments (unquoted)
+  // The stage continues from its checkpoint when the runner is asked to (`floesim run --resume`): its command
+  // passes --resume when FLOESIM_RESUME is set in the environment. Through the environment, not the command text,
+  // so that ninja (which reruns a stage whose command changed) sees the same command with and without --resume.
+  bool resumable = false;
 };
 
 // Where a stage's outputs and settings file go, from its name and content key.
@@ -60,7 +64,8 @@ enum class StageOutput {
 };
 
 // The shell command that runs stage k of `stages`: first removes its outputs and those of every stage downstream
-// of them (a failed stage then leaves nothing that looks complete), then runs it. `logged` keeps that list in
+// of them (a failed stage then leaves nothing that looks complete) and the temporary files a killed run of it left
+// in its folder (pipeline/atomic_file.h; one stage instance runs at a time in a folder), then runs it. `logged` keeps that list in
 // DIR/downstream.txt (written here), out of the command: a sweep's shared stage keeps its command, and so is not
 // rerun, when members are added downstream of it.
 std::string stage_script(const std::vector<PlannedStage>& stages, size_t k, StageOutput output);

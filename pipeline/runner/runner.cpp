@@ -1,17 +1,25 @@
 #include "pipeline/runner/runner.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
+#include <csignal>
+#include <cstring>
 #include <cstdio>
 #include <fstream>
+#include <algorithm>
 #include <map>
 #include <iostream>
 #include <sstream>
 
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
+#include "pipeline/interrupt.h"
 #include "pipeline/options.h"
 #include "pipeline/runner/plan.h"
 
@@ -73,28 +81,181 @@ std::vector<StageTiming> stage_timings(const fs::path& run_dir, const std::vecto
   return out;
 }
 
-int run_case(const RunOptions& o) {
-  const CasePlan plan = prepare_run(o);
-  // Outputs newer than this ran in this invocation (minus a margin for file systems with coarse times).
-  const auto started = fs::file_time_type::clock::now() - std::chrono::milliseconds(5);
-  const fs::path run = fs::absolute(o.run_dir);
-  std::vector<std::string> args = {FLOESIM_NINJA, "-C", run.string(), "-f", "build.ninja"};
-  if (o.jobs > 0) args.push_back("-j" + std::to_string(o.jobs));
-  if (o.dry_run) args.push_back("-n");
+namespace {
+
+// The children of `pid`: /proc/PID/task/*/children where the kernel has it, else a scan of /proc/*/stat.
+std::vector<pid_t> children_of(pid_t pid) {
+  std::vector<pid_t> out;
+  std::error_code ec;
+  const fs::path tasks = "/proc/" + std::to_string(pid) + "/task";
+  bool have = false;
+  for (const auto& t : fs::directory_iterator(tasks, ec)) {
+    std::ifstream in(t.path() / "children");
+    if (!in) continue;
+    have = true;
+    for (long c; in >> c;) out.push_back(static_cast<pid_t>(c));
+  }
+  if (have) return out;
+  for (const auto& e : fs::directory_iterator("/proc", ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.empty() || name.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream in(e.path() / "stat");
+    std::string stat;
+    std::getline(in, stat);
+    const size_t close = stat.rfind(')');  // the command name may hold spaces and parentheses
+    if (close == std::string::npos) continue;
+    std::istringstream is(stat.substr(close + 1));
+    char state = 0;
+    long ppid = 0;
+    if (is >> state >> ppid && ppid == pid) out.push_back(static_cast<pid_t>(std::stol(name)));
+  }
+  return out;
+}
+
+// The descendants of `pid` down to its grandchildren (ninja -> sh -> stage).
+std::vector<pid_t> descendants(pid_t pid) {
+  std::vector<pid_t> out = children_of(pid);
+  const size_t n = out.size();
+  for (size_t i = 0; i < n; ++i)
+    for (pid_t g : children_of(out[i])) out.push_back(g);
+  return out;
+}
+
+// The names of the stages running under ninja.
+std::vector<std::string> running_stage_names(pid_t ninja, const std::vector<PlannedStage>& stages) {
+  std::vector<std::string> names;
+  for (const PlannedStage* s : running_stages(ninja, stages)) names.push_back(s->name);
+  return names;
+}
+
+std::string join_names(const std::vector<std::string>& v) {
+  std::string out;
+  for (size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + v[i];
+  return out;
+}
+
+}  // namespace
+
+std::vector<const PlannedStage*> running_stages(pid_t ninja, const std::vector<PlannedStage>& stages) {
+  std::vector<const PlannedStage*> out;
+  for (pid_t p : descendants(ninja)) {
+    std::ifstream in("/proc/" + std::to_string(p) + "/cmdline", std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    const std::string cmd = ss.str();
+    for (const PlannedStage& s : stages)
+      if (cmd.find(s.exe.string()) != std::string::npos && cmd.find(s.dir.string()) != std::string::npos &&
+          std::find(out.begin(), out.end(), &s) == out.end())
+        out.push_back(&s);
+  }
+  return out;
+}
+
+int lock_run_folder(const fs::path& run_dir) {
+  ensure_directory(run_dir);
+  const fs::path lock = run_dir / ".floesim.lock";
+  // Not O_CLOEXEC: ninja and the stages inherit the lock and hold it until the last of them has ended.
+  const int fd = ::open(lock.c_str(), O_RDWR | O_CREAT, 0644);
+  FLOESIM_REQUIRE(fd >= 0, lock.string(), ": cannot create the run's lock file: ", write_failure_reason(errno));
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    std::cerr << "floesim: waiting for " << run_dir.string()
+              << ": another floesim run is writing there, or the stages of one that was stopped are still ending "
+                 "(Ctrl-C to give up)\n";
+    while (::flock(fd, LOCK_EX) != 0) {
+      FLOESIM_REQUIRE(errno == EINTR, lock.string(), ": cannot lock: ", std::strerror(errno));
+      if (interrupt_signal()) {
+        ::close(fd);
+        throw Interrupted(interrupt_signal(), "while waiting for " + run_dir.string() + "; nothing was run");
+      }
+    }
+  }
+  return fd;
+}
+
+int run_ninja_child(const std::vector<std::string>& args,
+                    const std::vector<std::pair<std::string, std::string>>& env,
+                    const std::vector<PlannedStage>& stages, std::vector<std::string>* running) {
+  std::vector<std::string> a = args;
   std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
+  for (auto& x : a) argv.push_back(x.data());
   argv.push_back(nullptr);
   std::cout.flush();
+  std::cerr.flush();
+  const pid_t parent = ::getpid();
   const pid_t pid = fork();
   FLOESIM_REQUIRE(pid >= 0, "cannot start ninja: fork failed");
   if (pid == 0) {
+    // If the runner dies without passing a signal on (SIGKILL), ninja is told to stop (and tells the stages).
+    ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (::getppid() != parent) _exit(128 + SIGTERM);  // the runner died before prctl
+    for (const auto& [k, v] : env) ::setenv(k.c_str(), v.c_str(), 1);
     execv(argv[0], argv.data());
     std::cerr << "floesim: cannot execute " << argv[0] << " (is ninja-build installed?)\n";
     _exit(127);
   }
+  register_child(pid);
+  // Wait, looking every 0.1 s at which stages run (two small /proc reads), so that a stop signal can be reported
+  // with the stage it stopped even when that stage ends at once: the last look before the signal is the fallback.
   int status = 0;
-  waitpid(pid, &status, 0);
-  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 1;
+  bool looked = false;
+  std::vector<std::string> before;
+  for (;;) {
+    const pid_t r = ::waitpid(pid, &status, WNOHANG);
+    if (r == pid || (r < 0 && errno != EINTR)) break;
+    if (running && !interrupt_signal()) {
+      before = running_stage_names(pid, stages);
+    } else if (running && !looked) {
+      // The handler has passed the signal on to ninja, which passes it on to the stages and waits for them.
+      *running = running_stage_names(pid, stages);
+      if (running->empty()) *running = before;
+      looked = true;
+    }
+    const timespec tick = {0, 100'000'000};
+    ::nanosleep(&tick, nullptr);  // a signal ends the sleep early
+  }
+  unregister_child(pid);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+int run_case(const RunOptions& o) {
+  // A stop signal is passed on to ninja and the stages, and this process reports it once they have ended.
+  InterruptPolling polling;
+  const fs::path run = fs::absolute(o.run_dir);
+  const int lock = lock_run_folder(run);  // held until the process ends (and by ninja and the stages)
+  (void)lock;
+  const CasePlan plan = prepare_run(o);
+  // Temporaries of the runner's own files (config/, build.ninja) that a killed run left; each stage removes its own.
+  remove_stale_temporaries(run);
+  remove_stale_temporaries(run / "config");
+  // Outputs newer than this ran in this invocation (minus a margin for file systems with coarse times).
+  const auto started = fs::file_time_type::clock::now() - std::chrono::milliseconds(5);
+  std::vector<std::string> args = {FLOESIM_NINJA, "-C", run.string(), "-f", "build.ninja"};
+  if (o.jobs > 0) args.push_back("-j" + std::to_string(o.jobs));
+  if (o.dry_run) args.push_back("-n");
+  std::vector<std::pair<std::string, std::string>> env;
+  if (o.resume) env.push_back({"FLOESIM_RESUME", "1"});
+  std::vector<std::string> running;
+  const int code = interrupt_signal() ? 128 + interrupt_signal() : run_ninja_child(args, env, plan.stages, &running);
+  if (const int sig = interrupt_signal()) {
+    remove_stale_temporaries(run);
+    remove_stale_temporaries(run / "config");
+    std::string resume_note;
+    for (const PlannedStage& s : plan.stages)
+      if (s.resumable && fs::exists(s.dir / "checkpoint" / "checkpoint.json")) {
+        std::string at;
+        try {
+          const Json cp = load_json_file(s.dir / "checkpoint" / "checkpoint.json");
+          at = " at t = " + cp.at("time_s").dump() + " s";
+        } catch (const std::exception&) {
+        }
+        resume_note = " (add --resume to continue the simulation from its checkpoint" + at + ")";
+      }
+    std::cerr << "floesim: interrupted by " << signal_name(sig)
+              << (running.empty() ? std::string(" between stages") : " during stage " + join_names(running))
+              << "; nothing half-written left; rerun to continue: floesim run " << o.case_dir.string() << " --out "
+              << o.run_dir.string() << resume_note << "\n";
+    return 128 + sig;
+  }
   if (code != 0) {
     std::cerr << "floesim: the run stopped at a failed stage (see its message above). Its artefacts and those "
                  "downstream of it were removed. Stage settings come from "

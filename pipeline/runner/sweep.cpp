@@ -1,12 +1,16 @@
 #include "pipeline/runner/sweep.h"
 
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <set>
@@ -14,8 +18,10 @@
 
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
+#include "pipeline/interrupt.h"
 #include "pipeline/options.h"
 #include "pipeline/runner/plan.h"
+#include "pipeline/runner/runner.h"
 
 #ifndef FLOESIM_NINJA
 #define FLOESIM_NINJA "ninja"
@@ -63,9 +69,13 @@ Child spawn_piped(const std::vector<std::string>& args, const std::vector<std::p
   for (auto& s : a) argv.push_back(s.data());
   argv.push_back(nullptr);
   std::cout.flush();
+  const pid_t parent = getpid();
   const pid_t pid = fork();
   FLOESIM_REQUIRE(pid >= 0, "cannot start ", args[0], ": fork failed");
   if (pid == 0) {
+    // If the runner is killed outright, the child is told to stop (ninja passes it on to the stages).
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(128 + SIGTERM);
     dup2(fd[1], 1);
     dup2(fd[1], 2);
     close(fd[0]);
@@ -76,6 +86,7 @@ Child spawn_piped(const std::vector<std::string>& args, const std::vector<std::p
     _exit(127);
   }
   close(fd[1]);
+  register_child(pid);  // a stop signal is passed on to it (pipeline/interrupt.h)
   return {pid, fdopen(fd[0], "r")};
 }
 
@@ -83,8 +94,21 @@ Child spawn_piped(const std::vector<std::string>& args, const std::vector<std::p
 int wait_child(Child& c) {
   std::fclose(c.out);
   int status = 0;
-  waitpid(c.pid, &status, 0);
+  while (waitpid(c.pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  unregister_child(c.pid);
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+// One line from a child's pipe; false at its end. A stop signal (EINTR) does not end it: the child is told too,
+// and its last lines still come; `on_signal` (if any) runs at once, while the child's children are still stopping.
+bool read_line(FILE* in, char* line, int size, const std::function<void()>& on_signal = {}) {
+  for (;;) {
+    if (std::fgets(line, size, in)) return true;
+    if (!std::ferror(in) || errno != EINTR) return false;
+    std::clearerr(in);
+    if (on_signal) on_signal();
+  }
 }
 
 // Runs a program and collects its output.
@@ -92,8 +116,7 @@ Output run_capture(const std::vector<std::string>& args) {
   Child c = spawn_piped(args);
   Output out;
   char buf[4096];
-  size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, c.out)) > 0) out.text.append(buf, n);
+  while (read_line(c.out, buf, sizeof buf)) out.text += buf;
   out.code = wait_child(c);
   return out;
 }
@@ -227,7 +250,8 @@ void write_sweep_files(const Sweep& s, const std::vector<Member>& members, const
 }
 
 // Ninja, keep going past failures (-k 0), with a progress line from NINJA_STATUS and the members' final outputs.
-int run_ninja(const fs::path& run, int jobs, const std::vector<Member>& members, const SweepPlan& p) {
+int run_ninja(const fs::path& run, int jobs, const std::vector<Member>& members, const SweepPlan& p,
+              std::vector<std::string>* interrupted_stages) {
   std::vector<std::string> args = {FLOESIM_NINJA, "-C", run.string(), "-f", "build.ninja", "-k", "0"};
   if (jobs > 0) args.push_back("-j" + std::to_string(jobs));
   Child ninja = spawn_piped(args, {{"NINJA_STATUS", "[%f/%t %r] "}});  // finished / total edges, running
@@ -243,10 +267,25 @@ int run_ninja(const fs::path& run, int jobs, const std::vector<Member>& members,
         if (!fs::exists(o)) return false;
     return true;
   };
-  while (std::fgets(line, sizeof line, in)) {
+  std::vector<std::string> before;  // the stages running at the last status line before a stop signal
+  auto running_now = [&] {
+    std::vector<std::string> out;
+    for (const PlannedStage* st : running_stages(ninja.pid, p.stages)) out.push_back(st->dir.filename().string());
+    return out;
+  };
+  bool looked = false;
+  const auto look = [&] {  // the stages a stop signal reaches, seen as soon as it arrives
+    if (!interrupt_signal() || looked) return;
+    *interrupted_stages = running_now();
+    if (interrupted_stages->empty()) *interrupted_stages = before;
+    looked = true;
+  };
+  while (read_line(in, line, sizeof line, look)) {
+    look();
     std::string l(line);
     int finished = -1, total = 0, running = 0;
     if (std::sscanf(l.c_str(), "[%d/%d %d]", &finished, &total, &running) == 3) {
+      if (!interrupt_signal()) before = running_now();
       int done = 0, failed = 0;
       for (size_t m = 0; m < members.size(); ++m) {
         bool f = false;
@@ -281,6 +320,7 @@ int run_ninja(const fs::path& run, int jobs, const std::vector<Member>& members,
     if (tty) std::cout << "\n";
     std::cout << l << std::flush;
   }
+  if (interrupt_signal() && !looked) *interrupted_stages = before;
   const int code = wait_child(ninja);
   int done = 0;
   for (size_t m = 0; m < members.size(); ++m) done += member_done(m);
@@ -650,6 +690,8 @@ std::vector<Member> expand_members(const Sweep& s, const Json& base_case) {
 }
 
 int run_sweep(const SweepOptions& o) {
+  // A stop signal is passed on to the children (ninja, and through it the stages); this process reports it.
+  InterruptPolling polling;
   const Sweep s = read_sweep(o.sweep_dir);
   const Json base = load_json_file(s.base_dir / "case.json");
   const std::vector<Member> members = expand_members(s, base);
@@ -660,7 +702,10 @@ int run_sweep(const SweepOptions& o) {
   const fs::path run = fs::absolute(o.run_dir);
   const fs::path bin = o.bin_dir.empty() ? self_dir() : fs::absolute(o.bin_dir);
   const SweepPlan p = plan_members(s, members, run, bin);
-  check_stage_settings(s, members, p);
+  check_stage_settings(s, members, p);  // writes nothing in the run folder
+  // One writer at a time in the run folder (see lock_run_folder), taken before anything is written there.
+  const int lock = lock_run_folder(run);
+  (void)lock;
   write_report_config(s, base, bin, run);
 
   write_sweep_files(s, members, p, run);
@@ -684,12 +729,27 @@ int run_sweep(const SweepOptions& o) {
     std::cout << r.text;
     return r.code;
   }
+  // Members' simulations continue from their checkpoints: FLOESIM_RESUME reaches the stage commands through ninja
+  // here, and through sbatch's exported environment on a cluster.
+  if (o.resume) setenv("FLOESIM_RESUME", "1", 1);
   if (o.slurm) {
     submit_slurm(s, run, bin, p, o.wait);
     if (!o.wait) return 0;
     return report_failures(members, p) ? 1 : 0;
   }
-  run_ninja(run, o.jobs, members, p);
+  // Temporaries of the runner's own files that a killed run left (each stage removes its own), under the lock.
+  remove_stale_temporaries(run);
+  std::vector<std::string> interrupted;
+  if (!interrupt_signal()) run_ninja(run, o.jobs, members, p, &interrupted);
+  if (const int sig = interrupt_signal()) {
+    remove_stale_temporaries(run);
+    std::cerr << "floesim: interrupted by " << signal_name(sig)
+              << (interrupted.empty() ? std::string(" between stages") : " during stage " + join(interrupted, ", "))
+              << "; nothing half-written left; nothing gathered; rerun to continue: floesim sweep "
+              << o.sweep_dir.string() << " --out " << o.run_dir.string()
+              << " (add --resume to continue the simulations from their checkpoints)\n";
+    return 128 + sig;
+  }
   const int g = gather(bin, run);
   const int failed = report_failures(members, p);
   if (g != 0) std::cerr << "floesim: gathering the results failed (exit " << g << ")\n";

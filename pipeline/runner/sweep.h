@@ -34,6 +34,7 @@ struct SweepOptions {
   bool yes = false;                 // allow more than kMaxMembersUnasked members
   bool slurm = false;               // submit to SLURM (sbatch job arrays) instead of running here
   bool wait = false;                // with slurm: block until the gather job has finished
+  bool resume = false;              // members' simulations continue from their checkpoints (FLOESIM_RESUME)
 };
 
 // Sweeps larger than this need --yes (a typo in an axis can ask for thousands of runs).

@@ -322,3 +322,32 @@ TEST_F(TinyCase, RoundTripStagesIdentifyTheSimulatedLoad) {
   EXPECT_NE(bad.code, 0);
   EXPECT_NE(bad.text.find("identify.config"), std::string::npos) << bad.text;
 }
+
+// Two runs into one folder at once: the second waits for the first (the run folder's lock), saying so, and then
+// finds everything up to date; neither leaves a temporary file.
+TEST_F(TinyCase, ASecondRunIntoTheSameFolderWaitsForTheFirst) {
+  const fs::path run = root_ / "twice";
+  const std::string cmd = "'" + (kBin / "floesim").string() + "' run '" + case_.string() + "' --out '" + run.string() +
+                          "' > '" + (root_ / "first-of-two.log").string() + "' 2>&1";
+  const pid_t pid = fork();
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), nullptr);
+    _exit(127);
+  }
+  // The second starts once the first holds the lock (its lock file exists and a stage has started).
+  for (int i = 0; i < 3000 && !fs::exists(run / "config" / "simulate.json"); ++i) usleep(1000);
+  const RunOutput second = run_case(case_, run);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  std::ifstream in(root_ / "first-of-two.log");
+  std::stringstream first;
+  first << in.rdbuf();
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << first.str();
+  ASSERT_EQ(second.code, 0) << second.text;
+  EXPECT_NE(second.text.find("waiting for " + run.string() + ": another floesim run is writing there"),
+            std::string::npos)
+      << second.text;
+  EXPECT_NE(second.text.find("up to date"), std::string::npos) << second.text;
+  for (const auto& e : fs::recursive_directory_iterator(run))
+    EXPECT_NE(e.path().filename().string().rfind(".tmp-", 0), 0u) << e.path();
+}

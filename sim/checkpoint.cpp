@@ -1,0 +1,279 @@
+#include "sim/checkpoint.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "pipeline/atomic_file.h"
+#include "pipeline/binary.h"
+#include "pipeline/error.h"
+#include "pipeline/interrupt.h"
+#include "pipeline/options.h"
+#include "pipeline/provenance.h"
+
+namespace floesim::sim {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kCheckpointMagic = "floesim-checkpoint/1\n";
+constexpr const char* kRecordsMagic = "floesim-checkpoint-records/1\n";
+constexpr size_t kHashChars = 64;  // SHA-256, hex
+
+// The arrays the recorder appends to at every step or frame, in a fixed order: every series of the layout, then the
+// frames and their body states. A checkpoint stores their tails since the previous one.
+template <class R, class F>
+void for_each_recorded(R& r, F&& f) {
+  for (const FieldSpec& s : series_fields()) f(s.name, r.series.at(s.name));
+  f("frame_time_s", r.frame_time_s);
+  f("frame_offset", r.frame_offset);
+  f("state_body_id", r.state_body_id);
+  f("state_position_m", r.state_position_m);
+  f("state_quaternion", r.state_quaternion);
+  f("state_in_contact", r.state_in_contact);
+}
+
+std::vector<size_t> recorded_sizes(const Results& r) {
+  std::vector<size_t> n;
+  for_each_recorded(r, [&](const char*, const auto& v) { n.push_back(v.size()); });
+  return n;
+}
+
+// A file = magic line + payload + the payload's SHA-256 (hex), written atomically and forced to disk.
+std::string write_blob(const fs::path& file, const char* magic, const std::string& payload) {
+  const std::string hash = sha256_bytes(payload);
+  write_text_atomic(file, magic + payload + hash);
+  return hash;
+}
+
+// The payload of a blob file, checked against its magic and its SHA-256; `expected_hash` (if not empty) must match.
+std::string read_blob(const fs::path& file, const char* magic, const std::string& expected_hash = "") {
+  std::ifstream in(file, std::ios::binary);
+  FLOESIM_REQUIRE(in, file.string(), ": cannot read the checkpoint file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str(), m = magic;
+  FLOESIM_REQUIRE(text.size() >= m.size() + kHashChars && text.compare(0, m.size(), m) == 0, file.string(),
+                  ": not a floesim checkpoint file of this format (", m.substr(0, m.size() - 1),
+                  "); delete the checkpoint folder, or run without --resume");
+  std::string payload = text.substr(m.size(), text.size() - m.size() - kHashChars);
+  const std::string hash = text.substr(text.size() - kHashChars);
+  FLOESIM_REQUIRE(sha256_bytes(payload) == hash, file.string(),
+                  ": damaged (its content does not match its SHA-256); delete the checkpoint folder, or run "
+                  "without --resume");
+  FLOESIM_REQUIRE(expected_hash.empty() || hash == expected_hash, file.string(),
+                  ": is not the chunk the checkpoint names (a leftover of another run?); delete the checkpoint "
+                  "folder, or run without --resume");
+  return payload;
+}
+
+fs::path records_file(const fs::path& dir, size_t index) {
+  char name[32];
+  std::snprintf(name, sizeof name, "records-%06zu.bin", index);
+  return dir / name;
+}
+
+// Flattened leaves of a JSON document: "config.vessel.speed_mps" -> "2.0".
+void flatten(const nlohmann::json& j, const std::string& at, std::map<std::string, std::string>& out) {
+  if (j.is_object()) {
+    for (auto it = j.begin(); it != j.end(); ++it) flatten(*it, at.empty() ? it.key() : at + "." + it.key(), out);
+  } else if (j.is_array() && !j.empty() && j.front().is_object()) {
+    for (size_t i = 0; i < j.size(); ++i) flatten(j[i], at + "[" + std::to_string(i) + "]", out);
+  } else {
+    out[at] = j.dump();
+  }
+}
+
+// What differs between two provenances, as "key: then -> now" lines (at most a handful).
+std::string differences(const nlohmann::json& then, const nlohmann::json& now) {
+  std::map<std::string, std::string> a, b;
+  flatten(then, "", a);
+  flatten(now, "", b);
+  std::vector<std::string> lines;
+  for (const auto& [k, v] : a) {
+    auto it = b.find(k);
+    if (it == b.end()) lines.push_back(k + ": " + v + " -> (absent)");
+    else if (it->second != v) lines.push_back(k + ": " + v + " -> " + it->second);
+  }
+  for (const auto& [k, v] : b)
+    if (!a.count(k)) lines.push_back(k + ": (absent) -> " + v);
+  std::string out;
+  for (size_t i = 0; i < lines.size() && i < 8; ++i) out += "\n  " + lines[i];
+  if (lines.size() > 8) out += "\n  ... and " + std::to_string(lines.size() - 8) + " more";
+  return out;
+}
+
+// The provenance without what changes no result: the settings threads and checkpoint_interval_s, and the settings
+// file itself (its name and hash: what it sets is in "config", resolved).
+nlohmann::json keyed(nlohmann::json p) {
+  if (p.contains("config") && p["config"].is_object()) {
+    p["config"].erase("threads");
+    p["config"].erase("checkpoint_interval_s");
+  }
+  if (p.contains("inputs") && p["inputs"].is_array()) {
+    nlohmann::json kept = nlohmann::json::array();
+    for (const auto& in : p["inputs"])
+      if (!(in.is_object() && in.value("role", "") == "config")) kept.push_back(in);
+    p["inputs"] = kept;
+  }
+  return p;
+}
+
+}  // namespace
+
+std::string checkpoint_key(const nlohmann::json& provenance) { return sha256_bytes(keyed(provenance).dump()); }
+
+void remove_checkpoint(const fs::path& dir) {
+  // checkpoint.bin first: a kill during the removal then leaves no checkpoint rather than one naming chunks that
+  // are gone (the order of a folder's entries is the file system's).
+  std::error_code ec;
+  fs::remove(dir / "checkpoint.bin", ec);
+  fs::remove(dir / "checkpoint.json", ec);
+  fs::remove_all(dir, ec);
+}
+
+Checkpointer::Checkpointer(fs::path dir, nlohmann::json provenance)
+    : dir_(std::move(dir)), provenance_(std::move(provenance)), key_(checkpoint_key(provenance_)) {
+  // Temporaries of a checkpoint write that was killed (one simulate runs in a folder at a time).
+  remove_stale_temporaries(dir_);
+}
+
+void Checkpointer::start_fresh(const Results& r, std::ostream* log) {
+  marks_ = recorded_sizes(r);
+  const fs::path info = dir_ / "checkpoint.json";
+  if (log && fs::exists(info)) {
+    std::string at;
+    try {
+      at = " at t = " + load_json_file(info).at("time_s").dump() + " s";
+    } catch (const std::exception&) {
+    }
+    *log << "  note: " << dir_.string() << " holds a checkpoint" << at
+         << "; starting from t = 0 (without --resume); it is replaced by this run's first checkpoint\n";
+  }
+}
+
+std::unique_ptr<World> Checkpointer::resume(const Model& model, Results& r, RecorderSums& sums, std::ostream* log) {
+  const fs::path file = dir_ / "checkpoint.bin";
+  if (!fs::exists(file)) {
+    if (log) *log << "  --resume: no checkpoint in " << dir_.string() << "; starting from t = 0\n";
+    start_fresh(r, log);
+    return nullptr;
+  }
+  const std::string payload = read_blob(file, kCheckpointMagic);
+  ByteReader in(payload, file.string());
+  const std::string key = in.str(), provenance_text = in.str();
+  if (key != key_) {
+    const nlohmann::json then = nlohmann::json::parse(provenance_text, nullptr, false);
+    throw Error(file.string() + ": this checkpoint was written from other inputs or settings than this run's, so "
+                "resuming it would not give this run's results. What differs (checkpoint -> now):" +
+                (then.is_discarded() ? std::string("\n  (unreadable)") : differences(keyed(then), keyed(provenance_))) +
+                "\nRun without --resume to start from t = 0 (the checkpoint is then replaced), or resume with the "
+                "inputs and settings it was made from.");
+  }
+  const long step = static_cast<long>(in.pod<int64_t>());
+  const size_t chunks = in.size(kHashChars);
+  std::vector<std::string> hashes;
+  for (size_t i = 0; i < chunks; ++i) hashes.push_back(in.str());
+  const std::vector<uint64_t> marks = in.vec<uint64_t>();
+  for (double* x : {&sums.awake, &sums.contacts, &sums.iterations, &sums.pairs, &sums.touching, &sums.edges,
+                    &sums.crushing, &sums.record_s, &sums.wall_s})
+    *x = in.pod<double>();
+
+  // The results so far: the chunks in order, each checked against the hash the checkpoint names.
+  for (size_t i = 0; i < chunks; ++i) {
+    const fs::path rf = records_file(dir_, i + 1);
+    FLOESIM_REQUIRE(fs::exists(rf), rf.string(), ": missing; the checkpoint needs it (delete the checkpoint folder, "
+                    "or run without --resume)");
+    const std::string rp = read_blob(rf, kRecordsMagic, hashes[i]);
+    ByteReader rr(rp, rf.string());
+    FLOESIM_REQUIRE(rr.str() == key_ && rr.size() == i + 1, rf.string(), ": belongs to another run");
+    rr.pod<int64_t>();  // first and last step, for people reading the file
+    rr.pod<int64_t>();
+    for_each_recorded(r, [&](const char* name, auto& v) {
+      FLOESIM_REQUIRE(rr.str() == name, rf.string(), ": damaged (expected the array ", name, ")");
+      rr.vec_append(v);
+    });
+    FLOESIM_REQUIRE(rr.done(), rf.string(), ": damaged (bytes after the last array)");
+  }
+  const std::vector<size_t> sizes = recorded_sizes(r);
+  FLOESIM_REQUIRE(sizes.size() == marks.size() && std::equal(sizes.begin(), sizes.end(), marks.begin()),
+                  file.string(), ": damaged (its chunks do not add up to the results it recorded)");
+
+  std::unique_ptr<World> world = World::restore(model, in);
+  FLOESIM_REQUIRE(in.done(), file.string(), ": damaged (bytes after the world)");
+  FLOESIM_REQUIRE(world->state().step == step, file.string(), ": damaged (its world is at another step)");
+  // Chunks after the last one named: a checkpoint that was being written when the run stopped.
+  for (size_t i = chunks + 1; fs::exists(records_file(dir_, i)); ++i) fs::remove(records_file(dir_, i));
+  marks_ = sizes;
+  chunks_ = hashes;
+  last_step_ = step;
+  replaced_old_ = true;
+  if (log)
+    *log << "  --resume: continuing from the checkpoint at t = " << world->state().time_s << " s (step " << step
+         << ") in " << dir_.string() << "\n";
+  return world;
+}
+
+void Checkpointer::save(const World& world, const Results& r, const RecorderSums& sums) {
+  try {
+    ensure_directory(dir_);
+    if (!replaced_old_) {
+      // A fresh run's first checkpoint replaces whatever checkpoint the folder held.
+      remove_checkpoint(dir_);
+      ensure_directory(dir_);
+      replaced_old_ = true;
+    }
+    const long step = world.state().step;
+    // 1. The records since the last checkpoint, as a new chunk.
+    ByteWriter rec;
+    rec.str(key_);
+    rec.size(chunks_.size() + 1);
+    rec.pod<int64_t>(last_step_ + 1);
+    rec.pod<int64_t>(step);
+    size_t i = 0;
+    std::vector<size_t> sizes;
+    for_each_recorded(r, [&](const char* name, const auto& v) {
+      rec.str(name);
+      rec.vec(v, marks_[i++]);
+      sizes.push_back(v.size());
+    });
+    const std::string hash = write_blob(records_file(dir_, chunks_.size() + 1), kRecordsMagic, rec.bytes());
+    // 2. The world and the list of chunks: this rename is the moment the new checkpoint exists.
+    std::vector<std::string> chunks = chunks_;
+    chunks.push_back(hash);
+    ByteWriter w;
+    w.str(key_);
+    w.str(provenance_.dump());
+    w.pod<int64_t>(step);
+    w.size(chunks.size());
+    for (const std::string& h : chunks) w.str(h);
+    std::vector<uint64_t> marks(sizes.begin(), sizes.end());
+    w.vec(marks);
+    for (double x : {sums.awake, sums.contacts, sums.iterations, sums.pairs, sums.touching, sums.edges,
+                     sums.crushing, sums.record_s, sums.wall_s})
+      w.pod(x);
+    world.save(w);
+    write_blob(dir_ / "checkpoint.bin", kCheckpointMagic, w.bytes());
+    chunks_ = std::move(chunks);
+    marks_ = std::move(sizes);
+    last_step_ = step;
+    // 3. For people and the runner's messages.
+    const nlohmann::json info = {{"format", "floesim-checkpoint/1"},
+                                 {"time_s", world.state().time_s},
+                                 {"step", step},
+                                 {"chunks", chunks_.size()},
+                                 {"key", key_},
+                                 {"resume", "floesim-simulate ... --resume, or floesim run CASE --resume"}};
+    write_text_atomic(dir_ / "checkpoint.json", info.dump(2) + "\n");
+  } catch (const Interrupted&) {
+    throw;
+  } catch (const Error& e) {
+    throw Error(std::string("writing the checkpoint: ") + e.what() +
+                " (or set simulate.checkpoint_interval_s = 0 to run without checkpoints)");
+  }
+}
+
+}  // namespace floesim::sim
