@@ -407,10 +407,10 @@ void World::stage_sleep() {
     state_.still_time_s[b] = slow ? state_.still_time_s[b] + dt : 0.0;
   }
   if (!sleep_allowed_) return;
-  // Islands (Box2D's rule): the awake bodies joined by this step's contacts (a wall or level ice joins nothing). An island
-  // falls asleep as a whole once every floe in it has been slow for sleep.time_s, and never while the vessel is in
-  // it; so floes resting against each other sleep too, and a sleeper touched by an awake body wakes (collide). A
-  // partition does not depend on the order of the unions: deterministic.
+  // Islands (Box2D's rule): the awake bodies joined by this step's contacts (a wall or level ice joins nothing). An
+  // island falls asleep as a whole once every floe in it has been slow for sleep.time_s, and never while the vessel
+  // is in it; so floes resting against each other sleep too, and a sleeper touched by an awake body wakes (collide).
+  // A partition does not depend on the order of the unions: deterministic.
   auto find = [&](int b) {
     while (island_[b] != b) b = island_[b] = island_[island_[b]];
     return b;

@@ -148,8 +148,9 @@ class World {
 };
 
 // What makes a piece of a broken floe: its outline in its own body frame (centred on its centroid), thickness, id,
-// lineage, pose at birth, and whether it stays held by a level-ice sheet. make_piece_body turns it into the body the world appends; the fracture stage and the
-// restore from a checkpoint both use it, so they make the same body to the bit.
+// lineage, pose at birth, and whether it stays held by a level-ice sheet. make_piece_body turns it into the body the
+// world appends; the fracture stage and the restore from a checkpoint both use it, so they make the same body to
+// the bit.
 struct PieceSpec {
   Polygon outline;
   double thickness_m = 0;

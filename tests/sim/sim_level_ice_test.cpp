@@ -214,7 +214,8 @@ TEST(LevelIce, ChannelWidthIsTheSheetAreaLostBehindMidshipOverItsLength) {
   r.floe_id = {1, 99};
   r.floe_level_ice = {1, 1};
   r.floe_vertex_offset = {0, 4};
-  for (const Vec2& p : m.bodies[tiles_of(m)[0]].outline) r.floe_vertices_m.insert(r.floe_vertices_m.end(), {p.x(), p.y()});
+  for (const Vec2& p : m.bodies[tiles_of(m)[0]].outline)
+    r.floe_vertices_m.insert(r.floe_vertices_m.end(), {p.x(), p.y()});
   for (const Vec2& p : left) r.floe_vertices_m.insert(r.floe_vertices_m.end(), {p.x() - c.x(), p.y() - c.y()});
   r.floe_vertex_offset.push_back(static_cast<int64_t>(r.floe_vertices_m.size() / 2));
   const Json j = level_ice_summary(m, r);
