@@ -170,6 +170,37 @@ IceHull read_ice_hull(const std::filesystem::path& file) {
   return h;
 }
 
+namespace {
+// The summary's keys, one list for the writer and the reader.
+template <class L, class F>
+void for_each_level_ice_field(L& ice, F&& f) {
+  f("thickness_m", ice.thickness_m);
+  f("flexural_strength_pa", ice.flexural_strength_pa);
+  f("youngs_modulus_pa", ice.youngs_modulus_pa);
+  f("poisson_ratio", ice.poisson_ratio);
+  f("ice_density_kg_m3", ice.ice_density_kg_m3);
+  f("water_density_kg_m3", ice.water_density_kg_m3);
+  f("gravity_mps2", ice.gravity_mps2);
+  f("mu_ice_structure", ice.friction);
+}
+}  // namespace
+
+nlohmann::json level_ice_json(const LevelIce& ice) {
+  nlohmann::json j = nlohmann::json::object();
+  for_each_level_ice_field(ice, [&](const char* key, double v) { j[key] = v; });
+  return j;
+}
+
+LevelIce level_ice_from_json(const nlohmann::json& j, const std::string& where) {
+  FLOESIM_REQUIRE(j.is_object(), where, " must be an object");
+  LevelIce ice;
+  for_each_level_ice_field(ice, [&](const char* key, double& v) {
+    FLOESIM_REQUIRE(j.contains(key) && j[key].is_number(), where, ".", key, " is missing or not a number");
+    v = j[key].get<double>();
+  });
+  return ice;
+}
+
 std::vector<IceResistanceRow> ice_resistance_table(const IceHull& hull, const LevelIce& ice,
                                                    const std::vector<double>& thicknesses_m,
                                                    const std::vector<double>& speeds_mps) {

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 namespace floesim {
 
 // The hull particulars both formulas take. floesim-hull measures them from the mesh and writes them to hull.json
@@ -67,6 +69,12 @@ RiskaResistance riska(const IceHull& hull, double thickness_m, double speed_mps)
 // The "particulars" block of a hull.json written by floesim-hull. Errors name the file and the key, and say to
 // rerun floesim-hull if the block is missing (a sidecar from an older build).
 IceHull read_ice_hull(const std::filesystem::path& hull_json);
+
+// The ice as a run's summary records it (summary.json level_ice.ice: thickness_m, flexural_strength_pa,
+// youngs_modulus_pa, poisson_ratio, ice_density_kg_m3, water_density_kg_m3, gravity_mps2, mu_ice_structure), written
+// by simulate and read by a sweep's gather. Reading: errors name `where` and the key.
+nlohmann::json level_ice_json(const LevelIce& ice);
+LevelIce level_ice_from_json(const nlohmann::json& j, const std::string& where);
 
 // One row of a resistance table: both formulas for one thickness and one speed.
 struct IceResistanceRow {

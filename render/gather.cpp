@@ -371,21 +371,7 @@ void level_ice_reference(const Json& s, const PlanMember& pm, MemberResult& m) {
         for (const fs::path& o : st.outputs)
           if (o.extension() == ".obj") hull_json = fs::path(o).replace_extension(".json");
     FLOESIM_REQUIRE(!hull_json.empty(), "the plan gives member ", pm.id, " no hull stage with an OBJ");
-    const Json& ice = li["ice"];
-    auto num = [&](const char* key) {
-      FLOESIM_REQUIRE(ice.contains(key) && ice[key].is_number(), pm.summary.string(), ": level_ice.ice.", key,
-                      " is missing or not a number");
-      return ice[key].get<double>();
-    };
-    LevelIce l;
-    l.thickness_m = num("thickness_m");
-    l.flexural_strength_pa = num("flexural_strength_pa");
-    l.youngs_modulus_pa = num("youngs_modulus_pa");
-    l.poisson_ratio = num("poisson_ratio");
-    l.ice_density_kg_m3 = num("ice_density_kg_m3");
-    l.water_density_kg_m3 = num("water_density_kg_m3");
-    l.gravity_mps2 = num("gravity_mps2");
-    l.friction = num("mu_ice_structure");
+    const LevelIce l = level_ice_from_json(li["ice"], pm.summary.string() + ": level_ice.ice");
     const IceHull hull = read_ice_hull(hull_json);
     m.lindqvist_kN = lindqvist(hull, l, m.mean_speed_mps).total_n / 1000.0;
     m.riska_kN = riska(hull, l.thickness_m, m.mean_speed_mps).total_n / 1000.0;

@@ -11,6 +11,7 @@
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
 #include "pipeline/floes_io.h"
+#include "pipeline/ice_resistance.h"
 #include "pipeline/interrupt.h"
 #include "pipeline/provenance.h"
 #include "pipeline/units.h"
@@ -186,14 +187,16 @@ nlohmann::json level_ice_summary(const Model& model, const Results& r) {
   double h_area = 0;
   for (int b : tiles) h_area += model.bodies[b].thickness_m * model.bodies[b].section_area;
   const SimulateOptions& o = model.options;
-  j["ice"] = {{"thickness_m", h_area / sheet_area},
-              {"flexural_strength_pa", o.fracture.flexural_strength_pa},
-              {"youngs_modulus_pa", o.fracture.youngs_modulus_pa},
-              {"poisson_ratio", o.fracture.poisson_ratio},
-              {"ice_density_kg_m3", o.ice.density_kg_m3},
-              {"water_density_kg_m3", o.water.density_kg_m3},
-              {"gravity_mps2", o.water.gravity_mps2},
-              {"mu_ice_structure", o.ice.mu_ice_structure}};
+  LevelIce ice;
+  ice.thickness_m = h_area / sheet_area;
+  ice.flexural_strength_pa = o.fracture.flexural_strength_pa;
+  ice.youngs_modulus_pa = o.fracture.youngs_modulus_pa;
+  ice.poisson_ratio = o.fracture.poisson_ratio;
+  ice.ice_density_kg_m3 = o.ice.density_kg_m3;
+  ice.water_density_kg_m3 = o.water.density_kg_m3;
+  ice.gravity_mps2 = o.water.gravity_mps2;
+  ice.friction = o.ice.mu_ice_structure;
+  j["ice"] = level_ice_json(ice);
   // The vessel at the end (last frame) and the tiles alive then.
   const size_t last = r.frames() - 1;
   double u_end = -std::numeric_limits<double>::infinity();

@@ -104,6 +104,22 @@ inline double table_rb(double alpha) {
   return r[k] + (alpha - a[k]) / (a[k + 1] - a[k]) * (r[k + 1] - r[k]);
 }
 
+// The ramp driven into ice: theta fixed at 60 deg, held at 0.1 m/s (the crushing force grows by ~6 kN per step once
+// the face bites, sigma_c w 1 mm: 4 % of the load), 30 s. The ramp's centre of mass is 22.1 m behind its stem
+// (waterline); the stem starts 0.9 m behind x = 0, so ice whose edge is at x = -0.4 meets the face within a few
+// seconds.
+inline SimulateOptions ramp_options() {
+  SimulateOptions o = floe_options();
+  o.fracture.wedge_angle_deg = {60, 60};
+  o.vessel.vcg_m = -4;
+  o.vessel.propulsion.mode = "speed";
+  o.vessel.propulsion.speed_mps = 0.1;
+  o.vessel.initial_speed_mps = 0.1;
+  o.duration_s = 30;
+  o.vessel.x_m = -23;
+  return o;
+}
+
 // Runs f, expects floesim::Error whose message contains every piece.
 template <class F>
 void expect_error(F f, std::initializer_list<const char*> pieces) {

@@ -168,17 +168,7 @@ TEST(Fracture, VerticalFaceNeverBendsASlopedFaceBendsBeforeSplitting) {
 
 TEST(Fracture, RampDrivenIntoAFloeBreaksItAtTheTableLoad) {
   const double h = 1.0, lc = lc_by_hand(h), w = 0.2 * lc;
-  SimulateOptions o = testing::floe_options();
-  o.fracture.wedge_angle_deg = {60, 60};
-  o.vessel.vcg_m = -4;
-  o.vessel.propulsion.mode = "speed";
-  // 0.1 m/s: the crushing force grows by ~6 kN per step once the face bites (sigma_c w 1 mm), 4 % of the load.
-  o.vessel.propulsion.speed_mps = 0.1;
-  o.vessel.initial_speed_mps = 0.1;
-  o.duration_s = 30;
-  // The ramp's centre of mass is 22.1 m behind its stem (waterline); the stem starts 0.9 m behind x = 0, the
-  // floe's edge is at x = -0.4: the face meets the floe's top corner (x = 0.21 - 0.9 m) within a few seconds.
-  o.vessel.x_m = -23;
+  const SimulateOptions o = testing::ramp_options();
   FloeField f;
   f.floes = {rect_floe(1, -0.4, -100, 200, 200, h)};
   const HullModel hull = ramp_hull(30, w);

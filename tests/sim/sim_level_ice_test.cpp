@@ -110,13 +110,7 @@ TEST(LevelIce, RampBreaksTheSheetAtTheTableLoadAndTheSheetStaysPut) {
   // The fracture tests' ramp (a 30 deg face 0.2 l_c wide) driven at 0.1 m/s into the edge of a sheet: one tile of
   // 200 m x 200 m (tile_m larger than the sheet).
   const double h = 1.0, lc = lc_by_hand(h), w = 0.2 * lc;
-  SimulateOptions o = testing::floe_options();
-  o.fracture.wedge_angle_deg = {60, 60};
-  o.vessel.vcg_m = -4;
-  o.vessel.propulsion.mode = "speed";
-  o.vessel.propulsion.speed_mps = 0.1;
-  o.vessel.initial_speed_mps = 0.1;
-  o.vessel.x_m = -23;
+  SimulateOptions o = testing::ramp_options();
   o.level_ice.extent_m = {-0.4, -100, 199.6, 100};
   o.level_ice.tile_m = 250;
   o.level_ice.thickness_m = h;
