@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+#include <sys/resource.h>
 
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
@@ -800,7 +801,13 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
         << fr["events"]["radial"] << ", splitting " << fr["events"]["splitting"] << "), " << fr["pieces_created"]
         << " pieces, " << std::setprecision(4) << fr["brash_removed_kg"].get<double>() / 1e3
         << " t of brash removed\n";
-  rep << "wrote " << (out_dir / "results.h5").string() << " and " << (out_dir / "summary.json").string() << "\n";
+  rep << "wrote " << (out_dir / "results.h5").string() << " (" << std::setprecision(1)
+      << std::filesystem::file_size(out_dir / "results.h5") / 1e6 << " MB, " << results.state_body_id.size()
+      << " stored body states in " << results.frames() << " frames) and " << (out_dir / "summary.json").string()
+      << "\n";
+  // Peak resident memory of this process (getrusage: kB on Linux), for sizing long runs and cluster jobs.
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) == 0) rep << "peak memory " << usage.ru_maxrss / 1024.0 << " MB\n";
   return rep.str();
 }
 
