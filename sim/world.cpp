@@ -624,7 +624,10 @@ std::unique_ptr<World> World::restore(const Model& base, ByteReader& r) {
     for (int* i : {&c.body_a, &c.part_a, &c.body_b, &c.part_b, &c.row}) *i = r.pod<int32_t>();
     r.mat(c.local_a);
     r.mat(c.impulse);
-    c.type = static_cast<ContactType>(r.pod<uint8_t>());
+    const uint8_t type = r.pod<uint8_t>();
+    FLOESIM_REQUIRE(type <= static_cast<uint8_t>(ContactType::crushing), r.what(),
+                    ": damaged (a cached contact of unknown type ", int(type), ")");
+    c.type = static_cast<ContactType>(type);
     r.mat(c.crush_normal_a);
     r.mat(c.crush_point_a);
     r.mat(c.crush_point_b);
