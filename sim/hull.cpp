@@ -1246,7 +1246,9 @@ std::string write_imported_hull(const HullImportOptions& o, const fs::path& out_
       << "  volume below z = 0   mesh " << fmt_num(v_mesh) << " m^3, convex parts " << fmt_num(h.volume_m3)
       << " m^3 (" << percent(displacement_error) << ")\n"
       << "  displacement         " << mass_text(rho * h.volume_m3) << " (rho_w " << rho << " kg/m^3)\n"
-      << "  waterline            file z = " << fmt_num(o.placement.waterline_z_m) << "; L x B "
+      << "  waterline            "
+      << (o.placement.up_direction == "+z" ? std::string("file z") : "height along file " + o.placement.up_direction)
+      << " = " << fmt_num(o.placement.waterline_z_m) << "; L x B "
       << fmt_num(h.length_wl_m) << " x " << fmt_num(h.beam_wl_m) << " m, x " << fmt_num(x_wl_lo) << " .. "
       << fmt_num(x_wl_hi) << " m\n"
       << "  draught              " << fmt_num(draught_mid) << " m at mid waterline length, " << fmt_num(h.draught_m)
