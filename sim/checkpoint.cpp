@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "pipeline/atomic_file.h"
@@ -231,6 +232,16 @@ std::unique_ptr<World> Checkpointer::resume(const Model& model, Results& r, Reco
   std::unique_ptr<World> world = World::restore(model, in);
   FLOESIM_REQUIRE(in.done(), file.string(), ": damaged (bytes after the world)");
   FLOESIM_REQUIRE(world->state().step == step, file.string(), ": damaged (its world is at another step)");
+  // The frames store bodies of this world (the vessel as 0, floes and pieces by id): simulate rebuilds each body's
+  // last stored state from them (layout /7 stores only what changed).
+  {
+    std::set<int32_t> ids;
+    for (const Body& b : world->model().bodies)
+      if (b.kind != BodyKind::wall) ids.insert(b.kind == BodyKind::vessel ? 0 : b.id);
+    for (const int32_t id : r.state_body_id)
+      FLOESIM_REQUIRE(ids.count(id), file.string(), ": damaged (a frame stores body ", id,
+                      ", which its world does not have); delete the checkpoint folder, or run without --resume");
+  }
   // Chunks after the last one named: a checkpoint that was being written when the run stopped.
   for (size_t i = chunks + 1; fs::exists(records_file(dir_, i)); ++i) fs::remove(records_file(dir_, i));
   marks_ = sizes;

@@ -590,10 +590,20 @@ std::unique_ptr<World> World::restore(const Model& base, ByteReader& r) {
     r.mat(p.position);
     p.orientation = r.quat();
     p.fixed = r.pod<uint8_t>() != 0;
-    FLOESIM_REQUIRE(p.outline.size() >= 3 && signed_area(p.outline) > 0 && p.thickness_m > 0, r.what(),
-                    ": damaged (piece ", p.id, " has no valid outline)");
+    // Every number finite, the outline's area too (a NaN or infinite box crashes the broad phase's tree), the
+    // orientation a unit quaternion, as a run writes them.
+    bool finite = std::isfinite(p.thickness_m) && std::isfinite(p.created_s) && p.position.allFinite() &&
+                  p.orientation.coeffs().allFinite() && std::abs(p.orientation.norm() - 1) < 1e-9;
+    for (const Vec2& v : p.outline) finite = finite && v.allFinite();
+    FLOESIM_REQUIRE(finite && p.outline.size() >= 3 && std::isfinite(signed_area(p.outline)) &&
+                        signed_area(p.outline) > 0 && p.thickness_m > 0,
+                    r.what(), ": damaged (piece ", p.id, " has no valid outline, thickness or pose)");
     const int index = static_cast<int>(m.bodies.size());
     m.bodies.push_back(make_piece_body(p, index, m.options, m.parts));
+    const Body& b = m.bodies.back();
+    FLOESIM_REQUIRE(std::isfinite(b.mass_kg) && b.mass_kg > 0 && b.inertia.allFinite() && b.inv_inertia.allFinite() &&
+                        std::isfinite(b.section_radius),
+                    r.what(), ": damaged (piece ", p.id, " has no finite mass properties)");
   }
   FLOESIM_REQUIRE(m.parts.size() == parts, r.what(), ": the remade body table has ", m.parts.size(),
                   " convex parts, the saved one had ", parts, " (other inputs, or another build of floesim?)");
@@ -613,6 +623,12 @@ std::unique_ptr<World> World::restore(const Model& base, ByteReader& r) {
   require_bodies(r, s.velocity.size(), n, "velocities");
   get_vec3s(r, s.angular_velocity);
   require_bodies(r, s.angular_velocity.size(), n, "angular velocities");
+  // A run's state is finite (the health check stops one that is not) and its orientations are unit quaternions; the
+  // broad phase is built from these poses below.
+  for (size_t b = 0; b < n; ++b)
+    FLOESIM_REQUIRE(s.position[b].allFinite() && s.velocity[b].allFinite() && s.angular_velocity[b].allFinite() &&
+                        s.orientation[b].coeffs().allFinite() && std::abs(s.orientation[b].norm() - 1) < 1e-9,
+                    r.what(), ": damaged (body ", b, " has a non-finite state or an orientation that is not a rotation)");
   s.awake = r.vec<uint8_t>();
   require_bodies(r, s.awake.size(), n, "awake flags");
   s.alive = r.vec<uint8_t>();
@@ -643,6 +659,9 @@ std::unique_ptr<World> World::restore(const Model& base, ByteReader& r) {
   require_bodies(r, w->solver_bodies_.inv_mass.size(), n, "inverse masses");
   get_mat3s(r, w->solver_bodies_.inv_inertia_world);
   require_bodies(r, w->solver_bodies_.inv_inertia_world.size(), n, "inverse inertias");
+  for (size_t b = 0; b < n; ++b)
+    FLOESIM_REQUIRE(w->solver_bodies_.inv_mass[b].allFinite() && w->solver_bodies_.inv_inertia_world[b].allFinite(),
+                    r.what(), ": damaged (body ", b, " has a non-finite inverse mass or inertia)");
   w->jets_.resize(r.size(1));
   for (PropellerJet& j : w->jets_) {
     r.mat(j.origin);

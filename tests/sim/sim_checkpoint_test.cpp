@@ -1,12 +1,14 @@
 // The checkpoint reader (sim/checkpoint.h) against files whose SHA-256 is right but whose content is not what a run
 // writes (what fuzz_checkpoint feeds it, re-sealed): refused with a message naming the file, never accepted into a
-// world and results that disagree. The run: a small generated hull at 4 m/s into 0.3 m floes that break at once,
-// 0.4 s with a checkpoint every 0.1 s (the last at step 30).
+// world and results that disagree. The run: a small generated hull at 4 m/s into 0.3 m floes (the model removes
+// the two it starts on; it meets the others at once and breaks them), 0.4 s with a checkpoint every 0.1 s (the last
+// at step 30).
 #include <gtest/gtest.h>
 
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "pipeline/provenance.h"
@@ -68,58 +70,121 @@ Results fresh_results() {
   return r;
 }
 
-TEST(Checkpoint, ResealedChunkWhoseFrameOffsetsDoNotIndexTheirStatesIsRefused) {
-  const fs::path dir = testing::temp_dir("checkpoint_reseal") / "checkpoint";
-  const Model model = small_breaking_run();
-  const nlohmann::json provenance = {{"program", "sim_checkpoint_test"}};
-  CheckpointPlan plan{dir, provenance, false};
-  RunStats stats;
-  const Results full = simulate(model, stats, nullptr, &plan);
-  ASSERT_EQ(stats.checkpoints, 3);  // at 0.1, 0.2 and 0.3 s; none after the last step
-  ASSERT_GT(full.fracture_time_s.size(), 0u) << "the run must break ice before its last checkpoint";
+const char kRecordsMagic[] = "floesim-checkpoint-records/1\n";
+const char kCheckpointMagic[] = "floesim-checkpoint/1\n";
 
-  // As written, it resumes: step 30, 30 rows per series, 6 frames (every 5 steps).
-  {
-    Checkpointer cp(dir, provenance);
-    Results r = fresh_results();
-    RecorderSums sums;
-    const auto w = cp.resume(model, r, sums, nullptr);
-    ASSERT_TRUE(w);
-    EXPECT_EQ(w->state().step, 30);
-    EXPECT_EQ(r.series.at("time_s").size(), 30u);
-    EXPECT_EQ(r.frame_time_s.size(), 6u);
-    EXPECT_GT(w->model().bodies.size(), model.bodies.size());  // the pieces are remade
-  }
-
-  // The second chunk's frame offsets made to decrease, the chunk re-sealed and the checkpoint re-sealed naming its
-  // new hash: the hashes all agree, the array sizes add up, and the frames no longer index their states.
-  const std::string rmagic = "floesim-checkpoint-records/1\n", cmagic = "floesim-checkpoint/1\n";
-  const fs::path chunk = dir / "records-000002.bin";
+// Element `index` of the array `name` in a records chunk set to `value` (of the array's element type T), the chunk
+// re-sealed and checkpoint.bin re-sealed naming its new hash: the hashes all agree and the array sizes still add up.
+template <class T>
+void reseal_with(const fs::path& dir, const char* chunk_name, const std::string& name, size_t index, T value) {
+  const fs::path chunk = dir / chunk_name;
   const std::string old_text = read_text(chunk);
-  std::string p = payload_of(old_text, rmagic);
-  const std::string name = "frame_offset";
+  std::string p = payload_of(old_text, kRecordsMagic);
   const size_t at = p.find(name);
-  ASSERT_NE(at, std::string::npos);
+  ASSERT_NE(at, std::string::npos) << name;
   uint64_t n;
   std::memcpy(&n, p.data() + at + name.size(), 8);
-  ASSERT_GE(n, 2u);
-  const int64_t bad = 1;  // the chunk's first frame offset, far below the states already recorded
-  std::memcpy(&p[at + name.size() + 8], &bad, 8);
-  seal(chunk, rmagic, p);
-  std::string c = payload_of(read_text(dir / "checkpoint.bin"), cmagic);
-  const std::string old_hash = old_text.substr(old_text.size() - 64), new_hash = sha256_bytes(p);
-  const size_t h = c.find(old_hash);
+  ASSERT_LT(index, n) << name;
+  std::memcpy(&p[at + name.size() + 8 + index * sizeof(T)], &value, sizeof(T));
+  seal(chunk, kRecordsMagic, p);
+  std::string c = payload_of(read_text(dir / "checkpoint.bin"), kCheckpointMagic);
+  const size_t h = c.find(old_text.substr(old_text.size() - 64));
   ASSERT_NE(h, std::string::npos);
-  c.replace(h, 64, new_hash);
-  seal(dir / "checkpoint.bin", cmagic, c);
+  c.replace(h, 64, sha256_bytes(p));
+  seal(dir / "checkpoint.bin", kCheckpointMagic, c);
+}
 
-  Checkpointer cp(dir, provenance);
+class Checkpoint : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = testing::temp_dir("checkpoint_reseal") / "checkpoint";
+    CheckpointPlan plan{dir_, provenance_, false};
+    RunStats stats;
+    const Results full = simulate(model_, stats, nullptr, &plan);
+    ASSERT_EQ(stats.checkpoints, 3);  // at 0.1, 0.2 and 0.3 s; none after the last step
+    ASSERT_GT(full.fracture_time_s.size(), 0u) << "the run must break ice before its last checkpoint";
+  }
+  void TearDown() override { fs::remove_all(dir_.parent_path()); }
+  std::unique_ptr<World> resume(Results& r) {
+    Checkpointer cp(dir_, provenance_);
+    RecorderSums sums;
+    return cp.resume(model_, r, sums, nullptr);
+  }
+  void expect_refused(std::initializer_list<const char*> pieces) {
+    Results r = fresh_results();
+    testing::expect_error([&] { resume(r); }, pieces);
+  }
+
+  const Model model_ = small_breaking_run();
+  const nlohmann::json provenance_ = {{"program", "sim_checkpoint_test"}};
+  fs::path dir_;
+};
+
+TEST_F(Checkpoint, AsWrittenItResumesAtItsLastStep) {
+  // Step 30 (0.3 s at 0.01 s), 30 rows per series, 6 frames (every 5 steps), the pieces remade.
   Results r = fresh_results();
-  RecorderSums sums;
-  testing::expect_error([&] { cp.resume(model, r, sums, nullptr); },
-                        {"checkpoint.bin", "damaged (the frames' offsets do not index their body states)",
-                         "delete the checkpoint folder, or run without --resume"});
-  fs::remove_all(dir.parent_path());
+  const auto w = resume(r);
+  ASSERT_TRUE(w);
+  EXPECT_EQ(w->state().step, 30);
+  EXPECT_EQ(r.series.at("time_s").size(), 30u);
+  EXPECT_EQ(r.frame_time_s.size(), 6u);
+  EXPECT_GT(w->model().bodies.size(), model_.bodies.size());
+}
+
+TEST_F(Checkpoint, ResealedChunkWhoseFrameOffsetsDoNotIndexTheirStatesIsRefused) {
+  // The second chunk's first frame offset set to 1, far below the states already recorded (accepted before the
+  // reader checked the results against its step).
+  reseal_with<int64_t>(dir_, "records-000002.bin", "frame_offset", 0, 1);
+  expect_refused({"checkpoint.bin", "damaged (the frames' offsets do not index their body states)",
+                  "delete the checkpoint folder, or run without --resume"});
+}
+
+TEST_F(Checkpoint, ResealedChunkStoringABodyTheWorldDoesNotHaveIsRefused) {
+  // A stored row of body 999 (there are 4 floes and their pieces): simulate would fail on it as an internal error.
+  reseal_with<int32_t>(dir_, "records-000001.bin", "state_body_id", 1, 999);
+  expect_refused({"checkpoint.bin", "damaged (a frame stores body 999, which its world does not have)"});
+}
+
+// checkpoint.bin's payload after the list of chunks and the marks and sums: where World::save begins (the body
+// table's counts, then the pieces).
+size_t world_offset(const std::string& c) {
+  size_t at = 0;
+  auto u64 = [&](size_t where) {
+    uint64_t v;
+    std::memcpy(&v, c.data() + where, 8);
+    return static_cast<size_t>(v);
+  };
+  at += 8 + u64(at);  // key
+  at += 8 + u64(at);  // provenance
+  at += 8;            // step
+  const size_t chunks = u64(at);
+  at += 8;
+  for (size_t k = 0; k < chunks; ++k) at += 8 + u64(at);
+  at += 8 + 8 * u64(at);  // marks
+  return at + 9 * 8;      // the recorder's sums
+}
+
+TEST_F(Checkpoint, ResealedPieceWithAnInfiniteOrientationIsRefused) {
+  // What fuzz_checkpoint found (crashes/fuzz_checkpoint/crash-piece-quaternion-inf): a piece whose orientation has an
+  // infinite component was remade with a non-finite pose, and building the broad phase's tree from its box crashed
+  // (SEGV in fcl's HierarchyTree::bottomup).
+  std::string c = payload_of(read_text(dir_ / "checkpoint.bin"), kCheckpointMagic);
+  size_t at = world_offset(c);
+  uint64_t pieces;
+  std::memcpy(&pieces, c.data() + at + 16, 8);
+  ASSERT_GT(pieces, 0u);
+  at += 24;
+  uint64_t vertices;
+  std::memcpy(&vertices, c.data() + at, 8);
+  // The first piece: outline, thickness, 4 ints, created_s, position, then the quaternion (x, y, z, w).
+  at += 8 + 16 * vertices + 8 + 16 + 8 + 24;
+  double x;
+  std::memcpy(&x, c.data() + at + 8 * 3, 8);
+  ASSERT_NEAR(std::abs(x), 1.0, 0.5) << "not the orientation of a piece turned about z by less than 90 deg";
+  const double inf = std::numeric_limits<double>::infinity();
+  std::memcpy(&c[at], &inf, 8);
+  seal(dir_ / "checkpoint.bin", kCheckpointMagic, c);
+  expect_refused({"checkpoint.bin", "damaged (piece", "has no valid outline, thickness or pose)"});
 }
 
 }  // namespace
