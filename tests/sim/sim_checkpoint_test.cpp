@@ -164,26 +164,37 @@ size_t world_offset(const std::string& c) {
   return at + 9 * 8;      // the recorder's sums
 }
 
-TEST_F(Checkpoint, ResealedPieceWithAnInfiniteOrientationIsRefused) {
-  // What fuzz_checkpoint found (crashes/fuzz_checkpoint/crash-piece-quaternion-inf): a piece whose orientation has an
-  // infinite component was remade with a non-finite pose, and building the broad phase's tree from its box crashed
-  // (SEGV in fcl's HierarchyTree::bottomup).
-  std::string c = payload_of(read_text(dir_ / "checkpoint.bin"), kCheckpointMagic);
+// checkpoint.bin re-sealed with one number of its first piece replaced: `field` 0 is the position's z, 1 the
+// orientation's x.
+void reseal_first_piece(const fs::path& dir, int field, double value) {
+  std::string c = payload_of(read_text(dir / "checkpoint.bin"), kCheckpointMagic);
   size_t at = world_offset(c);
-  uint64_t pieces;
+  uint64_t pieces, vertices;
   std::memcpy(&pieces, c.data() + at + 16, 8);
   ASSERT_GT(pieces, 0u);
   at += 24;
-  uint64_t vertices;
   std::memcpy(&vertices, c.data() + at, 8);
-  // The first piece: outline, thickness, 4 ints, created_s, position, then the quaternion (x, y, z, w).
-  at += 8 + 16 * vertices + 8 + 16 + 8 + 24;
-  double x;
-  std::memcpy(&x, c.data() + at + 8 * 3, 8);
-  ASSERT_NEAR(std::abs(x), 1.0, 0.5) << "not the orientation of a piece turned about z by less than 90 deg";
-  const double inf = std::numeric_limits<double>::infinity();
-  std::memcpy(&c[at], &inf, 8);
-  seal(dir_ / "checkpoint.bin", kCheckpointMagic, c);
+  // The first piece: outline, thickness, 4 ints, created_s, then the position (x, y, z) and the quaternion (x, y, z, w).
+  const size_t position = at + 8 + 16 * vertices + 8 + 16 + 8, quaternion = position + 24;
+  double z, w;
+  std::memcpy(&z, c.data() + position + 16, 8);
+  std::memcpy(&w, c.data() + quaternion + 24, 8);
+  ASSERT_LT(std::abs(z), 1.0) << "not the height of a floating piece";
+  ASSERT_GT(std::abs(w), 0.5) << "not the orientation of a piece turned about z by less than 120 deg";
+  std::memcpy(&c[field == 0 ? position + 16 : quaternion], &value, 8);
+  seal(dir / "checkpoint.bin", kCheckpointMagic, c);
+}
+
+// What fuzz_checkpoint found twice (crashes/fuzz_checkpoint/): a piece remade with a non-finite pose (an infinite
+// quaternion component) or one near the largest double (z = 3.8e199) gave a box that crashed the build of the broad
+// phase's tree (SEGV in fcl's HierarchyTree::bottomup).
+TEST_F(Checkpoint, ResealedPieceWithAnInfiniteOrientationIsRefused) {
+  reseal_first_piece(dir_, 1, std::numeric_limits<double>::infinity());
+  expect_refused({"checkpoint.bin", "damaged (piece", "has no valid outline, thickness or pose)"});
+}
+
+TEST_F(Checkpoint, ResealedPieceBeyondAnyFieldIsRefused) {
+  reseal_first_piece(dir_, 0, 3.763892008866656e+199);
   expect_refused({"checkpoint.bin", "damaged (piece", "has no valid outline, thickness or pose)"});
 }
 
