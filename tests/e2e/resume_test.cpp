@@ -189,17 +189,16 @@ Outcome Resume::reference_;
 TEST_F(Resume, TheCaseBreaksFloes) {
   ASSERT_EQ(reference_.code, 0) << reference_.text;
   const Results r = read_results(root_ / "reference" / "results.h5");
-  // One before the first SIGINT stop below (step 1200) and one between it and the second (step 3400): a restored
-  // world carries pieces. The gcc build breaks two more, at 39.09 and 39.95 s, in the last second of the run; the
-  // clang build (bench/sanitize) does not: fracture is a threshold on chaotic contact loads, and the two compilers'
-  // round-off differs, so the test asks only for what it relies on.
-  ASSERT_GE(r.fracture_time_s.size(), 2u);
-  EXPECT_LT(r.fracture_time_s[0], 12.0);
-  EXPECT_GT(r.fracture_time_s[1], 12.0);
-  EXPECT_LT(r.fracture_time_s[1], 34.0);
+  // At least one before the second SIGINT stop below (step 3400): the world restored there carries pieces. Which
+  // floes break when depends on the compiler: fracture is a threshold on chaotic contact loads, and round-off
+  // differs between builds (gcc, Release: 9.45, 17.69, 39.09 and 39.95 s; clang with the sanitizers,
+  // bench/sanitize: 26.92 and 38.70 s). Each build is compared with its own uninterrupted run.
+  ASSERT_GE(r.fracture_time_s.size(), 1u);
+  EXPECT_LT(r.fracture_time_s[0], 34.0);
 }
 
-// Stopped twice by SIGINT (after the first and after the second fracture), resumed twice: byte-identical.
+// Stopped twice by SIGINT (at steps 1200 and 3400; a gcc build has broken one floe by the first, two by the second),
+// resumed twice: byte-identical.
 TEST_F(Resume, SigintTwiceThenResumeEqualsTheUninterruptedRunByteForByte) {
   const fs::path out = root_ / "sigint";
   const Outcome first = stop_after(root_ / "sim.json", out, false, 1200, SIGINT);
@@ -214,7 +213,7 @@ TEST_F(Resume, SigintTwiceThenResumeEqualsTheUninterruptedRunByteForByte) {
             std::string::npos)
       << second.text;
   const long s2 = checkpoint_step(out);
-  EXPECT_GE(s2, 3400);  // after the second fracture: the world restored below holds two events' pieces
+  EXPECT_GE(s2, 3400);  // the world restored below holds fracture pieces (TheCaseBreaksFloes)
   const Outcome last = simulate_to_end(root_ / "sim.json", out, true);
   ASSERT_EQ(last.code, 0) << last.text;
   EXPECT_NE(last.text.find("continuing from the checkpoint at t = " + time_text(s2) + " s"),
