@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "pipeline/atomic_file.h"
@@ -122,6 +123,30 @@ nlohmann::json keyed(nlohmann::json p) {
   return p;
 }
 
+// The results read back must be those of a run at `step`: simulate() goes on appending to them, and the results
+// writer and every reader after it index the frames' states through frame_offset. Equal totals (the marks) do not
+// say that the arrays agree with each other.
+void require_results_at_step(const Results& r, long step, long every, const std::string& file) {
+  const auto damaged = [&](const std::string& what) {
+    return Error(file + ": damaged (" + what + "); delete the checkpoint folder, or run without --resume");
+  };
+  if (step < 0) throw damaged("negative step " + std::to_string(step));
+  for (const FieldSpec& f : series_fields())
+    if (r.series.at(f.name).size() != static_cast<size_t>(step) * f.cols)
+      throw damaged(std::string("the series ") + f.name + " holds " + std::to_string(r.series.at(f.name).size()) +
+                    " values, a run at step " + std::to_string(step) + " has " +
+                    std::to_string(static_cast<size_t>(step) * f.cols));
+  const size_t frames = every > 0 ? static_cast<size_t>(step / every) : 0, R = r.state_body_id.size();
+  if (r.frame_time_s.size() != frames || r.frame_offset.size() != frames + 1)
+    throw damaged("it holds " + std::to_string(r.frame_time_s.size()) + " frames, a run at step " +
+                  std::to_string(step) + " has " + std::to_string(frames));
+  if (r.frame_offset.front() != 0 || r.frame_offset.back() != static_cast<int64_t>(R) ||
+      !std::is_sorted(r.frame_offset.begin(), r.frame_offset.end()))
+    throw damaged("the frames' offsets do not index their body states");
+  if (r.state_position_m.size() != 3 * R || r.state_quaternion.size() != 4 * R || r.state_in_contact.size() != R)
+    throw damaged("the frames' body states are of unequal lengths");
+}
+
 }  // namespace
 
 std::string checkpoint_key(const nlohmann::json& provenance) { return sha256_bytes(keyed(provenance).dump()); }
@@ -202,9 +227,21 @@ std::unique_ptr<World> Checkpointer::resume(const Model& model, Results& r, Reco
   FLOESIM_REQUIRE(sizes.size() == marks.size() && std::equal(sizes.begin(), sizes.end(), marks.begin()),
                   file.string(), ": damaged (its chunks do not add up to the results it recorded)");
 
+  require_results_at_step(r, step, model.options.output_every(), file.string());
+
   std::unique_ptr<World> world = World::restore(model, in);
   FLOESIM_REQUIRE(in.done(), file.string(), ": damaged (bytes after the world)");
   FLOESIM_REQUIRE(world->state().step == step, file.string(), ": damaged (its world is at another step)");
+  // The frames store bodies of this world (the vessel as 0, floes and pieces by id): simulate rebuilds each body's
+  // last stored state from them (layout /7 stores only what changed).
+  {
+    std::set<int32_t> ids;
+    for (const Body& b : world->model().bodies)
+      if (b.kind != BodyKind::wall) ids.insert(b.kind == BodyKind::vessel ? 0 : b.id);
+    for (const int32_t id : r.state_body_id)
+      FLOESIM_REQUIRE(ids.count(id), file.string(), ": damaged (a frame stores body ", id,
+                      ", which its world does not have); delete the checkpoint folder, or run without --resume");
+  }
   // Chunks after the last one named: a checkpoint that was being written when the run stopped.
   for (size_t i = chunks + 1; fs::exists(records_file(dir_, i)); ++i) fs::remove(records_file(dir_, i));
   marks_ = sizes;

@@ -780,7 +780,11 @@ HullModel load_hull(const fs::path& file, const HullLoadOptions& o, const HullPl
   FLOESIM_REQUIRE(placement.scale > 0 && std::isfinite(placement.scale), where, ": scale must be > 0, got ",
                   placement.scale);
   FLOESIM_REQUIRE(placement.origin_m.size() == 2, where, ": origin_m must be [x, y]");
-  place_point(placement, Vec3::Zero());  // checks bow_direction
+  try {
+    place_point(placement, Vec3::Zero());  // checks up_direction and bow_direction
+  } catch (const Error& e) {
+    throw Error(where + ": " + e.what());
+  }
 
   Assimp::Importer importer;
   // Our world is z-up like most CAD exports. assimp would turn a Collada file declaring Z_UP into its own y-up
@@ -993,33 +997,86 @@ HullModel load_hull(const fs::path& file, const HullLoadOptions& o, const HullPl
 
 // ---- placement of a mesh from CAD --------------------------------------------------------------------------------
 
-Vec3 place_point(const HullPlacement& p, const Vec3& q) {
-  const double ox = p.origin_m.size() == 2 ? p.origin_m[0] : 0.0, oy = p.origin_m.size() == 2 ? p.origin_m[1] : 0.0;
-  const double x = q.x() - ox, y = q.y() - oy, z = q.z() - p.waterline_z_m;
-  // The turn about z taking the bow to +x (a proper rotation: port stays to port, normals stay outward).
-  Vec3 r;
-  if (p.bow_direction == "+x") r = {x, y, z};
-  else if (p.bow_direction == "-x") r = {-x, -y, z};
-  else if (p.bow_direction == "+y") r = {y, -x, z};
-  else if (p.bow_direction == "-y") r = {-y, x, z};
-  else throw Error("bow_direction must be one of +x, -x, +y, -y, got \"" + p.bow_direction + "\"");
-  return p.scale * r;
+namespace {
+
+// A file axis named "+x" .. "-z": its index (0..2) and sign; Error naming `key` otherwise.
+struct Axis {
+  int index;
+  double sign;
+};
+Axis file_axis(const std::string& d, const char* key, const char* allowed) {
+  if (d.size() == 2 && (d[0] == '+' || d[0] == '-') && d[1] >= 'x' && d[1] <= 'z')
+    return {d[1] - 'x', d[0] == '+' ? 1.0 : -1.0};
+  throw Error(std::string(key) + " must be one of " + allowed + ", got \"" + d + "\"");
 }
 
-namespace {
+// The rotation of the placement as a signed permutation (hull axis k is file axis index[k] times sign[k]) and the
+// file point that becomes the hull origin.
+struct Frame {
+  int index[3];
+  double sign[3];
+  Vec3 origin;
+};
+Frame placement_frame(const HullPlacement& p) {
+  const Axis up = file_axis(p.up_direction, "up_direction", "+z, -z, +y, -y, +x, -x");
+  const Axis bow = file_axis(p.bow_direction, "bow_direction", "+x, -x, +y, -y, +z, -z");
+  FLOESIM_REQUIRE(up.index != bow.index, "bow_direction must be horizontal, across up_direction = \"",
+                  p.up_direction, "\", got \"", p.bow_direction,
+                  "\": set up_direction to the file's vertical axis (\"+y\" for a y-up export) and bow_direction to "
+                  "the axis the bow points along");
+  // Port = up x bow (z x x = y): the hull frame is right-handed whatever the two axes, so the map is a rotation.
+  Vec3 u = Vec3::Zero(), b = Vec3::Zero();
+  u[up.index] = up.sign;
+  b[bow.index] = bow.sign;
+  const Vec3 port = u.cross(b);
+  Frame f;
+  f.index[0] = bow.index, f.sign[0] = bow.sign;
+  f.index[2] = up.index, f.sign[2] = up.sign;
+  f.index[1] = 3 - up.index - bow.index, f.sign[1] = port[f.index[1]];
+  // origin_m on the horizontal axes in axis order, the waterline's height along up.
+  int h = 0;
+  for (int k = 0; k < 3; ++k) {
+    if (k == up.index) f.origin[k] = up.sign * p.waterline_z_m;
+    else f.origin[k] = p.origin_m.size() == 2 ? p.origin_m[h++] : 0.0;
+  }
+  return f;
+}
+
+std::string axis_name(int index, double sign) { return std::string(sign > 0 ? "+" : "-") + char('x' + index); }
+
+// The turn about z of a z-up placement (the hull's x from the bow), degrees.
 double bow_turn_deg(const std::string& bow) {
   return bow == "-x" ? 180.0 : bow == "+y" ? -90.0 : bow == "-y" ? 90.0 : 0.0;
 }
+
 }  // namespace
 
+Vec3 place_point(const HullPlacement& p, const Vec3& q) {
+  // A permutation with signs (no products with zero): exact in floating point, and a proper rotation (port stays
+  // port, normals outward).
+  const Frame f = placement_frame(p);
+  const Vec3 d = q - f.origin;
+  return p.scale * Vec3(f.sign[0] * d[f.index[0]], f.sign[1] * d[f.index[1]], f.sign[2] * d[f.index[2]]);
+}
+
 std::string describe_placement(const HullPlacement& p) {
+  const Frame f = placement_frame(p);
   std::ostringstream s;
-  s << "scale " << fmt_num(p.scale) << "; bow towards " << p.bow_direction;
-  if (p.bow_direction == "+x") s << " (no turn)";
-  else s << ", turned " << fmt_num(bow_turn_deg(p.bow_direction)) << " deg about z to +x";
-  const double ox = p.origin_m.size() == 2 ? p.origin_m[0] : 0.0, oy = p.origin_m.size() == 2 ? p.origin_m[1] : 0.0;
-  s << "; calm waterline at file z = " << fmt_num(p.waterline_z_m) << " -> z = 0";
-  s << "; file (x, y) = (" << fmt_num(ox) << ", " << fmt_num(oy) << ") -> origin";
+  s << "scale " << fmt_num(p.scale) << "; ";
+  if (p.up_direction == "+z") {
+    s << "bow towards " << p.bow_direction;
+    if (p.bow_direction == "+x") s << " (no turn)";
+    else s << ", turned " << fmt_num(bow_turn_deg(p.bow_direction)) << " deg about z to +x";
+    s << "; calm waterline at file z = " << fmt_num(p.waterline_z_m) << " -> z = 0";
+    s << "; file (x, y) = (" << fmt_num(f.origin.x()) << ", " << fmt_num(f.origin.y()) << ") -> origin";
+  } else {
+    // Which file axis each hull axis is, and the file point that becomes the origin.
+    s << "up towards " << p.up_direction << ", bow towards " << p.bow_direction << ": hull x = file "
+      << axis_name(f.index[0], f.sign[0]) << ", y = file " << axis_name(f.index[1], f.sign[1]) << ", z = file "
+      << axis_name(f.index[2], f.sign[2]) << "; calm waterline at file " << p.up_direction.substr(1) << " = "
+      << fmt_num(f.origin[p.up_direction[1] - 'x']) << " -> z = 0; file (x, y, z) = (" << fmt_num(f.origin.x())
+      << ", " << fmt_num(f.origin.y()) << ", " << fmt_num(f.origin.z()) << ") -> origin";
+  }
   return s.str();
 }
 
@@ -1029,9 +1086,12 @@ void require_floating(const HullModel& hull, const std::string& where) {
   const HullPlacement& p = hull.placement;
   // The hull's z range in the file's own frame and units, for the message.
   const double f_lo = b.lo.z() / p.scale + p.waterline_z_m, f_hi = b.hi.z() / p.scale + p.waterline_z_m;
+  const std::string height = p.up_direction == "+z" ? std::string("file z") : "height along " + p.up_direction;
   const std::string fix = "; set waterline_z_m to the height of the calm waterline in the mesh's own frame, "
-                          "between its keel and deck (file z from " + fmt_num(f_lo) + " to " + fmt_num(f_hi) +
-                          "; e.g. keel + draught for a mesh with its keel at z = 0)";
+                          "between its keel and deck (" + height + " from " + fmt_num(f_lo) + " to " + fmt_num(f_hi) +
+                          "; e.g. keel + draught for a mesh with its keel at height 0), and up_direction to the "
+                          "file's vertical axis if the mesh lies on its side or upside down (\"+y\" for a y-up "
+                          "export)";
   FLOESIM_REQUIRE(b.lo.z() < 0, where, ": waterline_z_m = ", fmt_num(p.waterline_z_m),
                   " puts the whole hull above the water (its lowest point is ", fmt_num(b.lo.z()),
                   " m above the waterline): it would displace nothing", fix);
@@ -1127,12 +1187,20 @@ std::string write_imported_hull(const HullImportOptions& o, const fs::path& out_
   side["hull_file"] = out_obj.filename().string();
   side["source_file"] = mesh_file.string();
   side["frame"] = "x forward, y to port, z up; calm waterline z = 0; origin at the placement's origin_m; metres";
-  side["placement"] = {{"scale", o.placement.scale},
-                       {"bow_direction", o.placement.bow_direction},
-                       {"turn_about_z_deg", bow_turn_deg(o.placement.bow_direction)},
-                       {"waterline_z_m", o.placement.waterline_z_m},
-                       {"origin_m", o.placement.origin_m},
-                       {"description", describe_placement(o.placement)}};
+  {
+    const Frame f = placement_frame(o.placement);
+    side["placement"] = {{"scale", o.placement.scale},
+                         {"up_direction", o.placement.up_direction},
+                         {"bow_direction", o.placement.bow_direction},
+                         {"hull_axes_in_file", {axis_name(f.index[0], f.sign[0]), axis_name(f.index[1], f.sign[1]),
+                                                axis_name(f.index[2], f.sign[2])}},
+                         {"waterline_z_m", o.placement.waterline_z_m},
+                         {"origin_m", o.placement.origin_m},
+                         {"origin_in_file_m", {f.origin.x(), f.origin.y(), f.origin.z()}},
+                         {"description", describe_placement(o.placement)}};
+    // The turn about z alone describes a z-up file's placement.
+    if (o.placement.up_direction == "+z") side["placement"]["turn_about_z_deg"] = bow_turn_deg(o.placement.bow_direction);
+  }
   side["parts"] = m.parts.size();
   side["vertices"] = nv;
   side["triangles"] = nt;
@@ -1178,7 +1246,9 @@ std::string write_imported_hull(const HullImportOptions& o, const fs::path& out_
       << "  volume below z = 0   mesh " << fmt_num(v_mesh) << " m^3, convex parts " << fmt_num(h.volume_m3)
       << " m^3 (" << percent(displacement_error) << ")\n"
       << "  displacement         " << mass_text(rho * h.volume_m3) << " (rho_w " << rho << " kg/m^3)\n"
-      << "  waterline            file z = " << fmt_num(o.placement.waterline_z_m) << "; L x B "
+      << "  waterline            "
+      << (o.placement.up_direction == "+z" ? std::string("file z") : "height along file " + o.placement.up_direction)
+      << " = " << fmt_num(o.placement.waterline_z_m) << "; L x B "
       << fmt_num(h.length_wl_m) << " x " << fmt_num(h.beam_wl_m) << " m, x " << fmt_num(x_wl_lo) << " .. "
       << fmt_num(x_wl_hi) << " m\n"
       << "  draught              " << fmt_num(draught_mid) << " m at mid waterline length, " << fmt_num(h.draught_m)

@@ -83,25 +83,44 @@ struct HullLoadOptions {
 
 // Where a mesh from CAD lies in its own frame, and so how it is brought into the hull frame the simulator uses (x
 // forward, y to port, z up, calm waterline at z = 0): a point p of the file goes to
-//   scale * R_bow * (p - [origin_m[0], origin_m[1], waterline_z_m]),
-// with R_bow the turn about z that takes bow_direction to +x. Lengths are in the file's own units and frame.
+//   scale * R * (p - o),
+// with R the proper rotation that takes up_direction to +z and bow_direction to +x (so port, up x bow, to +y), and
+// o the file point on the calm waterline (height waterline_z_m along up_direction) at the horizontal position
+// origin_m. For the default z-up file, R is the turn about z that takes the bow to +x and o = [origin_m, waterline_z_m].
+// Meshes exported y-up (Blender's and many tools' OBJ default) need only up_direction "+y". Lengths are in the
+// file's own units and frame.
 struct HullPlacement {
   double scale = 1.0;                        // file units -> metres (0.001 for a file in mm; 1/31.6 full -> model)
-  std::string bow_direction = "+x";          // where the bow points in the file: +x | -x | +y | -y
-  double waterline_z_m = 0.0;                // z of the calm waterline in the file's frame (file units, before scale)
-  std::vector<double> origin_m = {0.0, 0.0};  // [x, y] in the file's frame that becomes the hull frame's origin
+  std::string up_direction = "+z";           // which file axis points up (deck above keel): +z | -z | +y | ... | -x
+  std::string bow_direction = "+x";          // where the bow points in the file: +x | -x | +y | -y (| +z | -z)
+  double waterline_z_m = 0.0;                // height of the calm waterline along up_direction (file units, unscaled)
+  std::vector<double> origin_m = {0.0, 0.0};  // the file's horizontal coordinates that become the hull frame's origin
   template <class V>
   void visit(V& v) {
     v.field("scale", scale, "-", "multiplies the file's coordinates (file units -> metres)", positive());
-    v.field("bow_direction", bow_direction, "-", "where the bow points in the file: +x, -x, +y or -y",
-            one_of({"+x", "-x", "+y", "-y"}));
+    v.field("up_direction", up_direction, "-",
+            "which axis of the file points up (keel to deck): +z (default), or +y for a y-up export (Blender's OBJ "
+            "default), or -z, -y, +x, -x; applied before the bow turn",
+            one_of({"+z", "-z", "+y", "-y", "+x", "-x"}));
+    v.field("bow_direction", bow_direction, "-",
+            "where the bow points in the file: +x, -x, +y or -y (or +z, -z in a file whose up_direction is x or y)",
+            one_of({"+x", "-x", "+y", "-y", "+z", "-z"}));
+    // The two directions must span the horizontal: a bow along the up axis leaves port undefined.
+    if (up_direction.size() == 2 && bow_direction.size() == 2 && up_direction[1] == bow_direction[1])
+      v.problem("bow_direction",
+                "must be horizontal, across up_direction = \"" + up_direction + "\", got \"" + bow_direction +
+                    "\": set up_direction to the file's vertical axis (\"+y\" for a y-up export) and bow_direction "
+                    "to the axis the bow points along");
     v.field("waterline_z_m", waterline_z_m, "m",
-            "height of the calm waterline in the file's own frame and units (e.g. the draught if the keel is at z = 0)",
+            "height of the calm waterline along up_direction, in the file's own frame and units (e.g. the draught if "
+            "the keel is at height 0; for a +y-up file, the file y of the waterline)",
             Check<double>([](const double& z) -> std::string { return std::isfinite(z) ? "" : "must be finite"; }));
     v.field("origin_m", origin_m, "m",
-            "[x, y] of the file's frame that becomes the hull frame's origin (e.g. midship on the centreline)",
+            "the file's coordinates on its two horizontal axes, in axis order ([x, y] in a z-up file, [x, z] in a "
+            "y-up one, [y, z] in an x-up one), of the point that becomes the hull frame's origin (e.g. midship on the "
+            "centreline)",
             Check<std::vector<double>>([](const std::vector<double>& p) -> std::string {
-              if (p.size() != 2) return "must be [x, y] (2 numbers)";
+              if (p.size() != 2) return "must be 2 numbers (the file's two horizontal coordinates)";
               for (double x : p)
                 if (!std::isfinite(x)) return "must be finite numbers";
               return "";
@@ -145,7 +164,8 @@ void require_floating(const HullModel& hull, const std::string& where);
 // decomposition options).
 struct HullImportOptions {
   std::string file;                    // the mesh (OBJ or anything assimp reads); relative to the config file
-  HullPlacement placement;             // read from the same level: scale, bow_direction, waterline_z_m, origin_m
+  HullPlacement placement;             // read from the same level: scale, up_direction, bow_direction, waterline_z_m,
+                                       // origin_m
   HullLoadOptions load;                // read from the same level: non_convex, slices, max_volume_error
   double water_density_kg_m3 = 1025.0;  // for the displacement reported (the simulation uses its own water density)
   template <class V>

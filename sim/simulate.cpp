@@ -729,7 +729,7 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   } catch (const Error& e) {
     throw Error(std::string(e.what()) + ". floesim-simulate takes the hull frame as the file has it (bow +x, "
                 "waterline z = 0): place a CAD mesh with the hull options (case \"hull\": {\"file\", \"waterline_z_m\", "
-                "\"bow_direction\", \"scale\"}, or floesim-hull) first");
+                "\"up_direction\", \"bow_direction\", \"scale\"}, or floesim-hull) first");
   }
   const Model model = build_model(field, &hull, o);
 

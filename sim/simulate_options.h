@@ -119,7 +119,8 @@ struct PropulsionOptions {
 
 // One propeller of the vessel: its share of the propulsion thrust makes a jet (PHYSICS.md §3.5) that the floes' drag
 // sees. Positions in the hull frame (x forward, y to port, z up, waterline z = 0, the hull's own origin): the hull
-// file's frame after the case's hull placement (bow_direction, waterline_z_m, origin_m, scale).
+// file's frame after the case's hull placement (up_direction, bow_direction, waterline_z_m, origin_m,
+// scale).
 struct PropellerOptions {
   std::vector<double> position_m;         // [x, y, z] of the propeller disc's centre, hull frame
   std::vector<double> axis = {1, 0, 0};   // direction of the thrust it gives (body axes); the jet flows opposite

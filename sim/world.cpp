@@ -484,6 +484,15 @@ void get_mat3s(ByteReader& r, std::vector<Mat3>& v) {
   for (Mat3& x : v) r.mat(x);
 }
 
+// No run has a coordinate or length beyond a million kilometres (a field in projected coordinates, UTM northings
+// of 8e6 m, is far inside), and the broad phase's tree, which multiplies box extents, overflows to inf and crashes
+// on boxes near the largest double (fuzz_checkpoint: a piece at z = 3.8e199).
+constexpr double kMaxLength_m = 1e9;
+template <class V>
+bool within(const V& v, double bound) {
+  return v.allFinite() && v.cwiseAbs().maxCoeff() <= bound;
+}
+
 // The per-body arrays of a state must match the body table; a checkpoint that says otherwise is damaged.
 void require_bodies(const ByteReader& r, size_t got, size_t bodies, const char* what) {
   FLOESIM_REQUIRE(got == bodies, r.what(), ": damaged (", what, " for ", got, " bodies, the world has ", bodies, ")");
@@ -590,10 +599,22 @@ std::unique_ptr<World> World::restore(const Model& base, ByteReader& r) {
     r.mat(p.position);
     p.orientation = r.quat();
     p.fixed = r.pod<uint8_t>() != 0;
-    FLOESIM_REQUIRE(p.outline.size() >= 3 && signed_area(p.outline) > 0 && p.thickness_m > 0, r.what(),
-                    ": damaged (piece ", p.id, " has no valid outline)");
+    // Every number finite and every length within kMaxLength_m, the outline's area finite and positive (a NaN,
+    // infinite or near-infinite box crashes the broad phase's tree), the orientation a unit quaternion, as a run
+    // writes them.
+    bool finite = std::isfinite(p.thickness_m) && p.thickness_m <= kMaxLength_m && std::isfinite(p.created_s) &&
+                  within(p.position, kMaxLength_m) && p.orientation.coeffs().allFinite() &&
+                  std::abs(p.orientation.norm() - 1) < 1e-9;
+    for (const Vec2& v : p.outline) finite = finite && within(v, kMaxLength_m);
+    FLOESIM_REQUIRE(finite && p.outline.size() >= 3 && std::isfinite(signed_area(p.outline)) &&
+                        signed_area(p.outline) > 0 && p.thickness_m > 0,
+                    r.what(), ": damaged (piece ", p.id, " has no valid outline, thickness or pose)");
     const int index = static_cast<int>(m.bodies.size());
     m.bodies.push_back(make_piece_body(p, index, m.options, m.parts));
+    const Body& b = m.bodies.back();
+    FLOESIM_REQUIRE(std::isfinite(b.mass_kg) && b.mass_kg > 0 && b.inertia.allFinite() && b.inv_inertia.allFinite() &&
+                        std::isfinite(b.section_radius),
+                    r.what(), ": damaged (piece ", p.id, " has no finite mass properties)");
   }
   FLOESIM_REQUIRE(m.parts.size() == parts, r.what(), ": the remade body table has ", m.parts.size(),
                   " convex parts, the saved one had ", parts, " (other inputs, or another build of floesim?)");
@@ -613,6 +634,17 @@ std::unique_ptr<World> World::restore(const Model& base, ByteReader& r) {
   require_bodies(r, s.velocity.size(), n, "velocities");
   get_vec3s(r, s.angular_velocity);
   require_bodies(r, s.angular_velocity.size(), n, "angular velocities");
+  // A run's state is what its health check lets through (finite, speeds within health.max_speed_mps and
+  // max_angular_radps), its positions within kMaxLength_m and its orientations unit quaternions; the broad phase is
+  // built from these poses below.
+  const HealthOptions& health = m.options.health;
+  for (size_t b = 0; b < n; ++b)
+    FLOESIM_REQUIRE(within(s.position[b], kMaxLength_m) && s.velocity[b].allFinite() &&
+                        s.velocity[b].norm() <= health.max_speed_mps && s.angular_velocity[b].allFinite() &&
+                        s.angular_velocity[b].norm() <= health.max_angular_radps &&
+                        s.orientation[b].coeffs().allFinite() && std::abs(s.orientation[b].norm() - 1) < 1e-9,
+                    r.what(), ": damaged (body ", b, " has a state no run reaches: non-finite, beyond ", kMaxLength_m,
+                    " m or the health limits, or an orientation that is not a rotation)");
   s.awake = r.vec<uint8_t>();
   require_bodies(r, s.awake.size(), n, "awake flags");
   s.alive = r.vec<uint8_t>();
@@ -624,7 +656,10 @@ std::unique_ptr<World> World::restore(const Model& base, ByteReader& r) {
     for (int* i : {&c.body_a, &c.part_a, &c.body_b, &c.part_b, &c.row}) *i = r.pod<int32_t>();
     r.mat(c.local_a);
     r.mat(c.impulse);
-    c.type = static_cast<ContactType>(r.pod<uint8_t>());
+    const uint8_t type = r.pod<uint8_t>();
+    FLOESIM_REQUIRE(type <= static_cast<uint8_t>(ContactType::crushing), r.what(),
+                    ": damaged (a cached contact of unknown type ", int(type), ")");
+    c.type = static_cast<ContactType>(type);
     r.mat(c.crush_normal_a);
     r.mat(c.crush_point_a);
     r.mat(c.crush_point_b);
@@ -640,6 +675,9 @@ std::unique_ptr<World> World::restore(const Model& base, ByteReader& r) {
   require_bodies(r, w->solver_bodies_.inv_mass.size(), n, "inverse masses");
   get_mat3s(r, w->solver_bodies_.inv_inertia_world);
   require_bodies(r, w->solver_bodies_.inv_inertia_world.size(), n, "inverse inertias");
+  for (size_t b = 0; b < n; ++b)
+    FLOESIM_REQUIRE(w->solver_bodies_.inv_mass[b].allFinite() && w->solver_bodies_.inv_inertia_world[b].allFinite(),
+                    r.what(), ": damaged (body ", b, " has a non-finite inverse mass or inertia)");
   w->jets_.resize(r.size(1));
   for (PropellerJet& j : w->jets_) {
     r.mat(j.origin);

@@ -232,7 +232,7 @@ CasePlan plan_case(const Json& c, const std::string& where, const fs::path& case
       st->args = {"--config", st->config.string(), "--out", hull_obj.string()};
       plan.artefacts.push_back({"hull", "hull/hull.obj", "hull as convex parts, m (OBJ)"});
     } else {
-      // The user's mesh: floesim-hull places it (scale, bow_direction, waterline_z_m, origin_m), cuts it into
+      // The user's mesh: floesim-hull places it (scale, up_direction, bow_direction, waterline_z_m, origin_m), cuts it into
       // convex parts, reports what it did in hull.json and refuses a hull that does not float. Its settings are the
       // case's hull section as it stands (the file's path made absolute), checked by the stage itself.
       Json settings = h;

@@ -41,6 +41,7 @@ void read_all(const floesim::Json& j, const std::string& file, const std::string
   read_one<sim::SimulateOptions>(j, file, path);
   read_one<sim::HullGeneratorOptions>(j, file, path);
   read_one<sim::HullLoadOptions>(j, file, path);
+  read_one<sim::HullImportOptions>(j, file, path);  // a case's hull section: file, placement, decomposition
   read_one<sim::IdentifyOptions>(j, file, path);
   read_one<sim::ShipDataOptions>(j, file, path);
   read_one<sim::IceResistanceOptions>(j, file, path);

@@ -290,7 +290,10 @@ TEST(VideoViews, BadViewOptionsNameTheKey) {
       {{{"side_waterline", 1.5}}, "side_waterline"},
       {{{"contact_colour", "green"}}, "contact_colour"},
   };
-  for (const auto& [j, key] : bad) {
+  for (const auto& item : bad) {
+    // Plain references, not a structured binding: C++17 lets no lambda capture a binding (clang refuses it).
+    const nlohmann::json& j = item.first;
+    const std::string& key = item.second;
     const std::string e = error_of([&] { read_render_options(cfg(j)); });
     EXPECT_NE(e.find(key), std::string::npos) << j.dump() << ": " << e;
     EXPECT_NE(e.find("render.json"), std::string::npos) << e;

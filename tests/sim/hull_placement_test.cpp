@@ -124,6 +124,73 @@ fs::path cube(const fs::path& dir) {
   return f;
 }
 
+TEST(HullPlacement, UpDirectionTurnsTheFilesVerticalToPlusZBeforeTheBowTurn) {
+  // Per case, worked out by hand: the file's up, bow and port directions and the file point on the calm waterline
+  // (height 0.5 along up) at origin_m = [10, -3] on the file's two horizontal axes in axis order. Placed, up must
+  // be +z, the bow +x and port +y (right-handed: the map is a rotation, so normals stay outward).
+  struct Case {
+    const char *up, *bow;
+    Vec3 up_dir, bow_dir, port_dir, origin;
+  };
+  for (const Case& c : {
+           // y-up (Blender's OBJ export: file (x, y, z) = Blender (x, z, -y)); facing -x with +y up, port is +z.
+           Case{"+y", "-x", {0, 1, 0}, {-1, 0, 0}, {0, 0, 1}, {10, 0.5, -3}},
+           Case{"+y", "+z", {0, 1, 0}, {0, 0, 1}, {1, 0, 0}, {10, 0.5, -3}},
+           Case{"-y", "+x", {0, -1, 0}, {1, 0, 0}, {0, 0, 1}, {10, -0.5, -3}},
+           Case{"+x", "+y", {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.5, 10, -3}},
+           // x down: facing -z with -x up, port is -y.
+           Case{"-x", "-z", {-1, 0, 0}, {0, 0, -1}, {0, -1, 0}, {-0.5, 10, -3}},
+           // Upside down: z down, bow +x, port -y.
+           Case{"-z", "+x", {0, 0, -1}, {1, 0, 0}, {0, -1, 0}, {10, -3, -0.5}},
+           // The default: z up, the turn about z alone (the cases of the test above).
+           Case{"+z", "-y", {0, 0, 1}, {0, -1, 0}, {1, 0, 0}, {10, -3, 0.5}}}) {
+    HullPlacement p;
+    p.up_direction = c.up;
+    p.bow_direction = c.bow;
+    p.scale = 2.0;
+    p.waterline_z_m = 0.5;
+    p.origin_m = {10.0, -3.0};
+    const std::string label = std::string("up ") + c.up + ", bow " + c.bow;
+    EXPECT_EQ(place_point(p, c.origin), Vec3::Zero()) << label;
+    EXPECT_EQ(place_point(p, c.origin + c.bow_dir), Vec3(2, 0, 0)) << label;
+    EXPECT_EQ(place_point(p, c.origin + c.port_dir), Vec3(0, 2, 0)) << label;
+    EXPECT_EQ(place_point(p, c.origin + c.up_dir), Vec3(0, 0, 2)) << label;
+    // The loader's report says what it did: the turn about z alone for a z-up file, the axes otherwise.
+    const std::string said = describe_placement(p);
+    EXPECT_NE(said.find(std::string(c.up) == "+z" ? std::string("turned 90 deg about z") : std::string("up towards ") + c.up),
+              std::string::npos) << said;
+  }
+}
+
+TEST(HullPlacement, BowAlongTheUpAxisIsRefusedNamingBothKeysAndTheFix) {
+  auto problem = [](const char* text) {
+    try {
+      read_options<HullImportOptions>(Json::parse(text), "case.json", "hull");
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  for (const char* text : {R"({"file": "h.obj", "up_direction": "+y", "bow_direction": "-y"})",
+                           R"({"file": "h.obj", "bow_direction": "+z"})",
+                           R"({"file": "h.obj", "up_direction": "-x", "bow_direction": "+x"})"}) {
+    const std::string msg = problem(text);
+    EXPECT_NE(msg.find("case.json"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("hull.bow_direction must be horizontal"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("up_direction"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("\"+y\" for a y-up export"), std::string::npos) << msg;  // the fix
+  }
+  EXPECT_NE(problem(R"({"file": "h.obj", "up_direction": "y"})").find("hull.up_direction"), std::string::npos);
+  // Placed in code, not read from JSON: the loader refuses the same, naming the file.
+  const fs::path dir = temp_dir("bow_up");
+  HullPlacement p;
+  p.up_direction = "+y";
+  p.bow_direction = "+y";
+  testing::expect_error([&] { load_hull(cube(dir), {}, p); },
+                        {"cube.obj", "bow_direction must be horizontal", "up_direction"});
+  fs::remove_all(dir);
+}
+
 void expect_refused(const fs::path& dir, const HullImportOptions& o, const std::string& what) {
   const fs::path cfg = dir / "hull_options.json";
   std::ofstream(cfg) << "{}\n";
@@ -295,6 +362,94 @@ void check_real_hull(const RealHull& r, bool full_scale_copy) {
     EXPECT_NEAR(c.side["hydrostatics"]["volume_m3"].get<double>(),
                 a.side["hydrostatics"]["volume_m3"].get<double>(), 1e-4 * r.volume_m3);
   }
+  fs::remove_all(dir);
+}
+
+// A copy of an OBJ whose vertices are permuted and negated per axis (vertex k of the copy = sign[k] * v[axis[k]]),
+// done on the text so that every coordinate keeps its digits: the same hull exported with other axes.
+fs::path axes_copy(const fs::path& src, const fs::path& dst, const int axis[3], const int sign[3]) {
+  std::ifstream in(src);
+  std::ofstream out(dst);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("v ", 0) == 0) {
+      std::istringstream s(line.substr(2));
+      std::string c[3];
+      s >> c[0] >> c[1] >> c[2];
+      out << "v";
+      for (int k = 0; k < 3; ++k) {
+        std::string t = c[axis[k]];
+        if (sign[k] < 0) t = t[0] == '-' ? t.substr(1) : t[0] == '+' ? "-" + t.substr(1) : "-" + t;
+        out << " " << t;
+      }
+      out << "\n";
+    } else {
+      out << line << "\n";
+    }
+  }
+  return dst;
+}
+
+// The same placed hull from two files: the meshes as read and placed, vertex for vertex (the files list them in
+// the same order), and the hydrostatics of the convex parts the stage wrote.
+void expect_same_placement(const HullModel& a, const Placed& pa, const HullModel& b, const Placed& pb, double size,
+                           const std::string& label) {
+  ASSERT_EQ(a.mesh.vertices.size(), b.mesh.vertices.size()) << label;
+  EXPECT_EQ(a.mesh.triangles, b.mesh.triangles) << label;
+  double worst = 0;
+  for (size_t i = 0; i < a.mesh.vertices.size(); ++i)
+    worst = std::max(worst, (a.mesh.vertices[i] - b.mesh.vertices[i]).norm());
+  EXPECT_LE(worst, 1e-6 * size) << label;
+  std::printf("[measured] %s: largest vertex difference %.3g m\n", label.c_str(), worst);
+  const nlohmann::json &s = pa.side, &t = pb.side;
+  EXPECT_EQ(t["parts"], s["parts"]) << label;
+  for (const char* key : {"displacement_kg", "mesh_displaced_volume_m3", "mesh_volume_m3", "parts_volume_m3"})
+    EXPECT_NEAR(t[key].get<double>(), s[key].get<double>(), 1e-6 * s[key].get<double>()) << label << ": " << key;
+  for (const char* key : {"length_wl_m", "beam_wl_m", "draught_mid_wl_m", "draught_max_m"})
+    EXPECT_NEAR(t["waterline"][key].get<double>(), s["waterline"][key].get<double>(), 1e-6 * size)
+        << label << ": waterline." << key;
+  for (int k = 0; k < 2; ++k)
+    EXPECT_NEAR(t["waterline"]["x_wl_m"][k].get<double>(), s["waterline"]["x_wl_m"][k].get<double>(), 1e-6 * size)
+        << label;
+}
+
+// The DTMB 5415 model as a y-up export would hold it, and as an x-up file with its bow along z: placed with
+// up_direction (and the waterline and origin measured in those files), it is the hull placed from the z-up original.
+TEST(HullPlacementRealHulls, Dtmb5415FromYUpAndXUpCopiesIsPlacedAsTheZUpOriginal) {
+  const fs::path dir = temp_dir("dtmb_up");
+  const fs::path f = hull_file(kDtmb.file);
+  ASSERT_TRUE(fs::exists(f));
+  HullPlacement as_is;
+  as_is.bow_direction = "-x";
+  const HullModel a = load_hull(f, {}, as_is);
+  const Placed pa = place(f, as_is, dir / "as_is");
+  auto check = [&](const fs::path& copy, const HullPlacement& p, const std::string& label) {
+    const Placed pb = place(copy, p, dir / copy.stem());
+    expect_same_placement(a, pa, load_hull(copy, {}, p), pb, kDtmb.lpp_m, label);
+    return pb;
+  };
+
+  // 1. Blender's y-up OBJ export: file (x, y, z) = (x, z, -y) of the z-up hull. The bow stays at -x; up is +y.
+  const int blender_axis[3] = {0, 2, 1}, blender_sign[3] = {1, 1, -1};
+  const fs::path yup = axes_copy(f, dir / "y_up.obj", blender_axis, blender_sign);
+  HullPlacement y = as_is;
+  y.up_direction = "+y";
+  const Placed b = check(yup, y, "y-up copy");
+  EXPECT_EQ(b.side["placement"]["hull_axes_in_file"], nlohmann::json({"-x", "+z", "+y"}));
+
+  // 2. The same y-up copy with its keel at height 0 and midship at file (x, z) = (2.5, -0.75): the waterline and
+  // the origin are then given in the y-up file's own terms (waterline_z_m = T along +y, origin_m = [x, z]).
+  HullPlacement ys = y;
+  ys.waterline_z_m = kDtmb.draught_m;
+  ys.origin_m = {2.5, -0.75};
+  check(transformed_copy(yup, dir / "y_up_keel0.obj", 1.0, Vec3(2.5, kDtmb.draught_m, -0.75)), ys,
+        "y-up copy, keel at y = 0, midship at (x, z) = (2.5, -0.75)");
+
+  // 3. An x-up file with the bow towards +z: file (x, y, z) = (z, y, -x) of the z-up hull (a turn about y).
+  const int xup_axis[3] = {2, 1, 0}, xup_sign[3] = {1, 1, -1};
+  HullPlacement x;
+  x.up_direction = "+x";
+  x.bow_direction = "+z";
+  check(axes_copy(f, dir / "x_up.obj", xup_axis, xup_sign), x, "x-up copy, bow +z");
   fs::remove_all(dir);
 }
 

@@ -1,0 +1,268 @@
+// The simulate stage's checkpoint reader (sim/checkpoint.h Checkpointer::resume, and World::restore behind it):
+// checkpoint.bin and its records-NNNNNN.bin chunks, each file a magic line, a payload and the payload's SHA-256.
+//
+// A mutated file almost never matches its SHA-256, so feeding raw bytes only fuzzes the hash check. The input is
+// therefore a small container of files whose first byte picks how they are written:
+//   mode 0      raw: each part is a whole file (magic, payload, hash) as it lies in the folder;
+//   mode 1      sealed: each part is a payload, written with the magic and its correct SHA-256;
+//   mode 2, 3   sealed and fixed up: as 1, and where the payload's layout allows, the run's key and the chunk hashes
+//               that checkpoint.bin names are set to the right ones, so the parser behind them is what is fuzzed.
+// Parts are separated by kSeparator: part 0 is checkpoint.bin, part k is records-00000k.bin.
+//
+// The model the checkpoints belong to is built here (a coarse generated hull ramming small floes that break), and
+// FLOESIM_FUZZ_WRITE_SEED=DIR writes seeds from a real checkpoint of it: a short simulate() with checkpoints on,
+// stored both raw (mode 0) and as sealed payloads (mode 2). Then it exits.
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "fuzz_util.h"
+#include "pipeline/provenance.h"
+#include "pipeline/results_io.h"
+#include "sim/checkpoint.h"
+#include "sim/hull.h"
+#include "sim/model.h"
+#include "sim/simulate.h"
+
+namespace fs = std::filesystem;
+using namespace floesim;
+using namespace floesim::sim;
+
+namespace {
+
+constexpr char kSeparator[] = "\n=floesim-fuzz-file=\n";
+constexpr size_t kMaxParts = 8;  // checkpoint.bin and up to 7 chunks
+constexpr char kCheckpointMagic[] = "floesim-checkpoint/1\n";
+constexpr char kRecordsMagic[] = "floesim-checkpoint-records/1\n";
+constexpr size_t kHashChars = 64;
+
+// The run the checkpoints belong to: a small generated hull at 4 m/s over the first two of four 0.3 m floes (the
+// model removes floes the vessel starts on) and against the other two, which break at 0.08, 0.21 and 0.27 s, so the
+// last checkpoint (0.3 s) holds pieces in its body table, fracture events and cached contacts.
+SimulateOptions run_options() {
+  SimulateOptions o;
+  o.duration_s = 0.4;
+  o.output_interval_s = 0.05;
+  o.checkpoint_interval_s = 0.1;
+  o.steady_start_s = 0;
+  o.sleep.enabled = false;
+  o.vessel.propulsion.mode = "speed";
+  o.vessel.propulsion.speed_mps = 4;
+  o.vessel.initial_speed_mps = 4;
+  o.vessel.x_m = 5.0;
+  return o;
+}
+
+const Model& the_model() {
+  static const Model model = [] {
+    HullGeneratorOptions g;
+    g.length_m = 40;
+    g.beam_m = 9;
+    g.reamer_beam_m = 11;
+    g.draught_m = 3;
+    g.depth_m = 6;
+    g.sections = 6;
+    HullModel h;
+    h.parts = generate_hull(g);
+    for (const TriMesh& p : h.parts) {
+      const int off = static_cast<int>(h.surface.vertices.size());
+      h.surface.vertices.insert(h.surface.vertices.end(), p.vertices.begin(), p.vertices.end());
+      for (auto t : p.triangles) h.surface.triangles.push_back({t[0] + off, t[1] + off, t[2] + off});
+    }
+    FloeField f;
+    int id = 1;
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j) {
+        Floe fl;
+        fl.id = id++;
+        const double x0 = 21 * i, y0 = -20 + 21 * j;
+        fl.outline = {Vec2(x0, y0), Vec2(x0 + 20, y0), Vec2(x0 + 20, y0 + 19), Vec2(x0, y0 + 19)};
+        fl.area_m2 = 20 * 19;
+        fl.thickness_m = 0.3;
+        f.floes.push_back(fl);
+      }
+    return build_model(f, &h, run_options());
+  }();
+  return model;
+}
+
+const nlohmann::json& the_provenance() {
+  static const nlohmann::json p = {{"program", "fuzz_checkpoint"}, {"config", {{"duration_s", 0.4}}}};
+  return p;
+}
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Splits the container (after the mode byte) into its parts.
+std::vector<std::string> split_parts(const std::string& s) {
+  std::vector<std::string> parts;
+  const std::string sep = kSeparator;
+  size_t at = 0;
+  while (parts.size() + 1 < kMaxParts) {
+    const size_t k = s.find(sep, at);
+    if (k == std::string::npos) break;
+    parts.push_back(s.substr(at, k - at));
+    at = k + sep.size();
+  }
+  parts.push_back(s.substr(at));
+  return parts;
+}
+
+// The payload's leading string (u64 length + bytes: the run's key in both kinds of file) set to `key`; returns the
+// offset after it, or npos if the payload is too short to hold one.
+size_t set_leading_string(std::string& payload, size_t at, const std::string& key) {
+  uint64_t n;
+  if (payload.size() < at + sizeof n) return std::string::npos;
+  std::memcpy(&n, payload.data() + at, sizeof n);
+  if (n > payload.size() - at - sizeof n) return std::string::npos;
+  const uint64_t k = key.size();
+  payload.replace(at, sizeof n + n, std::string(reinterpret_cast<const char*>(&k), sizeof k) + key);
+  return at + sizeof k + key.size();
+}
+
+// Skips one u64-length-prefixed string; npos if it runs past the end.
+size_t skip_string(const std::string& payload, size_t at) {
+  uint64_t n;
+  if (at == std::string::npos || payload.size() < at + sizeof n) return std::string::npos;
+  std::memcpy(&n, payload.data() + at, sizeof n);
+  if (n > payload.size() - at - sizeof n) return std::string::npos;
+  return at + sizeof n + n;
+}
+
+// checkpoint.bin's payload with the key and the chunk hashes it names set to those of `chunks` (as far as its
+// layout reads: key, provenance, step, chunk count, one hash string per chunk).
+void fix_up_checkpoint(std::string& payload, const std::string& key, const std::vector<std::string>& chunk_hashes) {
+  size_t at = set_leading_string(payload, 0, key);
+  at = skip_string(payload, at);  // provenance
+  if (at == std::string::npos || payload.size() < at + 16) return;
+  at += 8;  // step
+  uint64_t n;
+  std::memcpy(&n, payload.data() + at, sizeof n);
+  at += sizeof n;
+  for (uint64_t i = 0; i < n && i < chunk_hashes.size(); ++i) {
+    at = set_leading_string(payload, at, chunk_hashes[i]);
+    if (at == std::string::npos) return;
+  }
+}
+
+void write_sealed(const fs::path& file, const char* magic, const std::string& payload) {
+  const std::string text = magic + payload + sha256_bytes(payload);
+  floesim::fuzz::write_input(file, reinterpret_cast<const uint8_t*>(text.data()), text.size());
+}
+
+fs::path records_file(const fs::path& dir, size_t k) {
+  char name[32];
+  std::snprintf(name, sizeof name, "records-%06zu.bin", k);
+  return dir / name;
+}
+
+// A fresh run's results before the first step, as simulate() holds them when it resumes.
+Results fresh_results() {
+  Results r;
+  for (const FieldSpec& f : series_fields()) r.series[f.name];
+  r.frame_offset.push_back(0);
+  return r;
+}
+
+// FLOESIM_FUZZ_WRITE_SEED=DIR: a real checkpoint of the_model(), as seeds.
+void write_seeds(const fs::path& dir) {
+  const fs::path run = floesim::fuzz::temp_file(".seedrun");
+  fs::remove_all(run);
+  CheckpointPlan plan;
+  plan.dir = run / "checkpoint";
+  plan.provenance = the_provenance();
+  RunStats stats;
+  const Results r = simulate(the_model(), stats, nullptr, &plan);
+  std::vector<std::string> files = {read_file(plan.dir / "checkpoint.bin")};
+  for (size_t k = 1; fs::exists(records_file(plan.dir, k)); ++k) files.push_back(read_file(records_file(plan.dir, k)));
+  std::string raw(1, '\0'), sealed(1, '\2');
+  for (size_t i = 0; i < files.size(); ++i) {
+    const size_t magic = std::strlen(i == 0 ? kCheckpointMagic : kRecordsMagic);
+    raw += (i ? kSeparator : "") + files[i];
+    sealed += (i ? kSeparator : "") + files[i].substr(magic, files[i].size() - magic - kHashChars);
+  }
+  std::ofstream(dir / "checkpoint_raw.bin", std::ios::binary) << raw;
+  std::ofstream(dir / "checkpoint_sealed.bin", std::ios::binary) << sealed;
+  std::fprintf(stderr, "fuzz_checkpoint seeds: %zu files (checkpoints %d, fracture events %zu, last step %ld), "
+               "%zu bytes raw\n", files.size(), stats.checkpoints, r.fracture_time_s.size(),
+               static_cast<long>(r.steps()), raw.size());
+  fs::remove_all(run);
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  if (const char* dir = std::getenv("FLOESIM_FUZZ_WRITE_SEED")) {
+    write_seeds(dir);
+    std::exit(0);
+  }
+  return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  static const fs::path dir = floesim::fuzz::temp_file(".checkpoint");
+  static const std::string key = checkpoint_key(the_provenance());
+  const Model& model = the_model();
+  if (size == 0) return 0;
+  const int mode = data[0] & 3;
+  std::vector<std::string> parts = split_parts(std::string(reinterpret_cast<const char*>(data) + 1, size - 1));
+
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  if (mode == 0) {
+    for (size_t i = 0; i < parts.size(); ++i)
+      floesim::fuzz::write_input(i == 0 ? dir / "checkpoint.bin" : records_file(dir, i),
+                                 reinterpret_cast<const uint8_t*>(parts[i].data()), parts[i].size());
+  } else {
+    std::vector<std::string> hashes;
+    for (size_t i = 1; i < parts.size(); ++i) {
+      if (mode >= 2) set_leading_string(parts[i], 0, key);
+      hashes.push_back(sha256_bytes(parts[i]));
+      write_sealed(records_file(dir, i), kRecordsMagic, parts[i]);
+    }
+    if (mode >= 2) fix_up_checkpoint(parts[0], key, hashes);
+    write_sealed(dir / "checkpoint.bin", kCheckpointMagic, parts[0]);
+  }
+
+  floesim::fuzz::expect_ok_or_error([&] {
+    Checkpointer cp(dir, the_provenance());
+    Results r = fresh_results();
+    RecorderSums sums;
+    const std::unique_ptr<World> w = cp.resume(model, r, sums, nullptr);
+    if (!w) std::abort();  // checkpoint.bin was written: resume must read it or refuse it
+    // What an accepted checkpoint promises simulate(), which goes on appending to these arrays and then writes them:
+    // the world and the results at the same step, every series step x columns, frames indexing their states.
+    const long step = w->state().step;
+    if (step < 0 || cp.last_step() != step) std::abort();
+    for (const FieldSpec& f : series_fields())
+      if (r.series.at(f.name).size() != static_cast<size_t>(step) * f.cols) std::abort();
+    const size_t R = r.state_body_id.size();
+    if (r.frame_offset.size() != r.frame_time_s.size() + 1 || r.frame_offset.front() != 0 ||
+        r.frame_offset.back() != static_cast<int64_t>(R) || r.state_position_m.size() != 3 * R ||
+        r.state_quaternion.size() != 4 * R || r.state_in_contact.size() != R)
+      std::abort();
+    for (size_t k = 0; k + 1 < r.frame_offset.size(); ++k)
+      if (r.frame_offset[k] > r.frame_offset[k + 1]) std::abort();
+    const size_t n = w->model().bodies.size();
+    if (w->state().position.size() != n || w->state().alive.size() != n) std::abort();
+    // Every stored row is of a body of the world (simulate rebuilds each body's last stored state from them).
+    std::set<int32_t> ids;
+    for (const Body& b : w->model().bodies)
+      if (b.kind != BodyKind::wall) ids.insert(b.kind == BodyKind::vessel ? 0 : b.id);
+    for (const int32_t id : r.state_body_id)
+      if (!ids.count(id)) std::abort();
+  });
+  return 0;
+}

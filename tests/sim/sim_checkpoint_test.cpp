@@ -1,0 +1,202 @@
+// The checkpoint reader (sim/checkpoint.h) against files whose SHA-256 is right but whose content is not what a run
+// writes (what fuzz_checkpoint feeds it, re-sealed): refused with a message naming the file, never accepted into a
+// world and results that disagree. The run: a small generated hull at 4 m/s into 0.3 m floes (the model removes
+// the two it starts on; it meets the others at once and breaks them), 0.4 s with a checkpoint every 0.1 s (the last
+// at step 30).
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "pipeline/provenance.h"
+#include "sim/checkpoint.h"
+#include "sim/simulate.h"
+#include "tests/sim/sim_fixtures.h"
+
+namespace floesim::sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+Model small_breaking_run() {
+  SimulateOptions o;
+  o.duration_s = 0.4;
+  o.output_interval_s = 0.05;
+  o.checkpoint_interval_s = 0.1;
+  o.steady_start_s = 0;
+  o.sleep.enabled = false;
+  o.vessel.propulsion.mode = "speed";
+  o.vessel.propulsion.speed_mps = 4;
+  o.vessel.initial_speed_mps = 4;
+  o.vessel.x_m = 5;
+  HullGeneratorOptions g;
+  g.length_m = 40, g.beam_m = 9, g.reamer_beam_m = 11, g.draught_m = 3, g.depth_m = 6, g.sections = 6;
+  HullModel h;
+  h.parts = generate_hull(g);
+  h.surface = h.parts[0];
+  for (size_t k = 1; k < h.parts.size(); ++k) {
+    const int off = static_cast<int>(h.surface.vertices.size());
+    h.surface.vertices.insert(h.surface.vertices.end(), h.parts[k].vertices.begin(), h.parts[k].vertices.end());
+    for (auto t : h.parts[k].triangles) h.surface.triangles.push_back({t[0] + off, t[1] + off, t[2] + off});
+  }
+  FloeField f;
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j) f.floes.push_back(testing::rect_floe(1 + 2 * i + j, 21 * i, -20 + 21 * j, 20, 19, 0.3));
+  return build_model(f, &h, o);
+}
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// A checkpoint file's payload (between its magic line and its SHA-256), and the file written back sealed.
+std::string payload_of(const std::string& file_text, const std::string& magic) {
+  return file_text.substr(magic.size(), file_text.size() - magic.size() - 64);
+}
+void seal(const fs::path& p, const std::string& magic, const std::string& payload) {
+  std::ofstream(p, std::ios::binary) << magic << payload << sha256_bytes(payload);
+}
+
+Results fresh_results() {
+  Results r;
+  for (const FieldSpec& f : series_fields()) r.series[f.name];
+  r.frame_offset.push_back(0);
+  return r;
+}
+
+const char kRecordsMagic[] = "floesim-checkpoint-records/1\n";
+const char kCheckpointMagic[] = "floesim-checkpoint/1\n";
+
+// Element `index` of the array `name` in a records chunk set to `value` (of the array's element type T), the chunk
+// re-sealed and checkpoint.bin re-sealed naming its new hash: the hashes all agree and the array sizes still add up.
+template <class T>
+void reseal_with(const fs::path& dir, const char* chunk_name, const std::string& name, size_t index, T value) {
+  const fs::path chunk = dir / chunk_name;
+  const std::string old_text = read_text(chunk);
+  std::string p = payload_of(old_text, kRecordsMagic);
+  const size_t at = p.find(name);
+  ASSERT_NE(at, std::string::npos) << name;
+  uint64_t n;
+  std::memcpy(&n, p.data() + at + name.size(), 8);
+  ASSERT_LT(index, n) << name;
+  std::memcpy(&p[at + name.size() + 8 + index * sizeof(T)], &value, sizeof(T));
+  seal(chunk, kRecordsMagic, p);
+  std::string c = payload_of(read_text(dir / "checkpoint.bin"), kCheckpointMagic);
+  const size_t h = c.find(old_text.substr(old_text.size() - 64));
+  ASSERT_NE(h, std::string::npos);
+  c.replace(h, 64, sha256_bytes(p));
+  seal(dir / "checkpoint.bin", kCheckpointMagic, c);
+}
+
+class Checkpoint : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = testing::temp_dir("checkpoint_reseal") / "checkpoint";
+    CheckpointPlan plan{dir_, provenance_, false};
+    RunStats stats;
+    const Results full = simulate(model_, stats, nullptr, &plan);
+    ASSERT_EQ(stats.checkpoints, 3);  // at 0.1, 0.2 and 0.3 s; none after the last step
+    ASSERT_GT(full.fracture_time_s.size(), 0u) << "the run must break ice before its last checkpoint";
+  }
+  void TearDown() override { fs::remove_all(dir_.parent_path()); }
+  std::unique_ptr<World> resume(Results& r) {
+    Checkpointer cp(dir_, provenance_);
+    RecorderSums sums;
+    return cp.resume(model_, r, sums, nullptr);
+  }
+  void expect_refused(std::initializer_list<const char*> pieces) {
+    Results r = fresh_results();
+    testing::expect_error([&] { resume(r); }, pieces);
+  }
+
+  const Model model_ = small_breaking_run();
+  const nlohmann::json provenance_ = {{"program", "sim_checkpoint_test"}};
+  fs::path dir_;
+};
+
+TEST_F(Checkpoint, AsWrittenItResumesAtItsLastStep) {
+  // Step 30 (0.3 s at 0.01 s), 30 rows per series, 6 frames (every 5 steps), the pieces remade.
+  Results r = fresh_results();
+  const auto w = resume(r);
+  ASSERT_TRUE(w);
+  EXPECT_EQ(w->state().step, 30);
+  EXPECT_EQ(r.series.at("time_s").size(), 30u);
+  EXPECT_EQ(r.frame_time_s.size(), 6u);
+  EXPECT_GT(w->model().bodies.size(), model_.bodies.size());
+}
+
+TEST_F(Checkpoint, ResealedChunkWhoseFrameOffsetsDoNotIndexTheirStatesIsRefused) {
+  // The second chunk's first frame offset set to 1, far below the states already recorded (accepted before the
+  // reader checked the results against its step).
+  reseal_with<int64_t>(dir_, "records-000002.bin", "frame_offset", 0, 1);
+  expect_refused({"checkpoint.bin", "damaged (the frames' offsets do not index their body states)",
+                  "delete the checkpoint folder, or run without --resume"});
+}
+
+TEST_F(Checkpoint, ResealedChunkStoringABodyTheWorldDoesNotHaveIsRefused) {
+  // A stored row of body 999 (there are 4 floes and their pieces): simulate would fail on it as an internal error.
+  reseal_with<int32_t>(dir_, "records-000001.bin", "state_body_id", 1, 999);
+  expect_refused({"checkpoint.bin", "damaged (a frame stores body 999, which its world does not have)"});
+}
+
+// checkpoint.bin's payload after the list of chunks and the marks and sums: where World::save begins (the body
+// table's counts, then the pieces).
+size_t world_offset(const std::string& c) {
+  size_t at = 0;
+  auto u64 = [&](size_t where) {
+    uint64_t v;
+    std::memcpy(&v, c.data() + where, 8);
+    return static_cast<size_t>(v);
+  };
+  at += 8 + u64(at);  // key
+  at += 8 + u64(at);  // provenance
+  at += 8;            // step
+  const size_t chunks = u64(at);
+  at += 8;
+  for (size_t k = 0; k < chunks; ++k) at += 8 + u64(at);
+  at += 8 + 8 * u64(at);  // marks
+  return at + 9 * 8;      // the recorder's sums
+}
+
+// checkpoint.bin re-sealed with one number of its first piece replaced: `field` 0 is the position's z, 1 the
+// orientation's x.
+void reseal_first_piece(const fs::path& dir, int field, double value) {
+  std::string c = payload_of(read_text(dir / "checkpoint.bin"), kCheckpointMagic);
+  size_t at = world_offset(c);
+  uint64_t pieces, vertices;
+  std::memcpy(&pieces, c.data() + at + 16, 8);
+  ASSERT_GT(pieces, 0u);
+  at += 24;
+  std::memcpy(&vertices, c.data() + at, 8);
+  // The first piece: outline, thickness, 4 ints, created_s, then the position (x, y, z) and the quaternion (x, y, z, w).
+  const size_t position = at + 8 + 16 * vertices + 8 + 16 + 8, quaternion = position + 24;
+  double z, w;
+  std::memcpy(&z, c.data() + position + 16, 8);
+  std::memcpy(&w, c.data() + quaternion + 24, 8);
+  ASSERT_LT(std::abs(z), 1.0) << "not the height of a floating piece";
+  ASSERT_GT(std::abs(w), 0.5) << "not the orientation of a piece turned about z by less than 120 deg";
+  std::memcpy(&c[field == 0 ? position + 16 : quaternion], &value, 8);
+  seal(dir / "checkpoint.bin", kCheckpointMagic, c);
+}
+
+// What fuzz_checkpoint found twice (crashes/fuzz_checkpoint/): a piece remade with a non-finite pose (an infinite
+// quaternion component) or one near the largest double (z = 3.8e199) gave a box that crashed the build of the broad
+// phase's tree (SEGV in fcl's HierarchyTree::bottomup).
+TEST_F(Checkpoint, ResealedPieceWithAnInfiniteOrientationIsRefused) {
+  reseal_first_piece(dir_, 1, std::numeric_limits<double>::infinity());
+  expect_refused({"checkpoint.bin", "damaged (piece", "has no valid outline, thickness or pose)"});
+}
+
+TEST_F(Checkpoint, ResealedPieceBeyondAnyFieldIsRefused) {
+  reseal_first_piece(dir_, 0, 3.763892008866656e+199);
+  expect_refused({"checkpoint.bin", "damaged (piece", "has no valid outline, thickness or pose)"});
+}
+
+}  // namespace
+}  // namespace floesim::sim
