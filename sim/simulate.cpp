@@ -15,8 +15,9 @@
 #include "pipeline/interrupt.h"
 #include "pipeline/provenance.h"
 #include "pipeline/units.h"
-#include "sim/fracture_laws.h"
 #include "sim/checkpoint.h"
+#include "sim/fracture.h"
+#include "sim/fracture_laws.h"
 #include "sim/world.h"
 
 namespace floesim::sim {
@@ -120,8 +121,8 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
   f["min_piece_area_m2"] = o.fracture.min_piece_area_m2;
   f["piece_area_m2"] = distribution(piece_area);
   f["piece_equivalent_diameter_m"] = distribution(piece_diameter);
-  // Wedges: R_b from the table for each event's theta and width (static: without the speed correction), against
-  // the smallest child of the event (the wedge: the floe it broke from is longer than the wedge by the
+  // Wedges: R_b of fracture.piece_size for each event's theta and width (static: without the speed correction),
+  // against the smallest child of the event (the wedge: the floe it broke from is longer than the wedge by the
   // finite-floe rule, so the remainder is the larger piece).
   std::vector<double> rb, wedge_size, wedge_ratio;
   const double rho_w_g = o.water.density_kg_m3 * o.water.gravity_mps2;
@@ -130,7 +131,8 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
     const double h = thickness[r.fracture_parent_id[e]];
     const double lc = characteristic_length_m(o.fracture.youngs_modulus_pa, o.fracture.poisson_ratio, h, rho_w_g);
     const double theta = r.fracture_theta_rad[e], w = r.fracture_width_m[e];
-    const double rb_e = wedge_failure(theta, o.fracture.flexural_strength_pa, h, w / (theta * lc)).rb_over_lc * lc;
+    const double rb_e = static_piece_rb_m(
+        o.fracture, wedge_failure(theta, o.fracture.flexural_strength_pa, h, w / (theta * lc)).rb_over_lc, lc);
     double smallest = 0;
     for (int64_t i = r.fracture_child_offset[e]; i < r.fracture_child_offset[e + 1]; ++i) {
       const double a = area[r.fracture_child_id[i]];
@@ -143,7 +145,8 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
     const double a0 = w / theta;
     wedge_ratio.push_back(smallest / (0.5 * theta * ((a0 + rb_e) * (a0 + rb_e) - a0 * a0)));
   }
-  f["wedges"] = {{"rb_m", distribution(rb)},
+  f["wedges"] = {{"piece_size", o.fracture.piece_size},
+                 {"rb_m", distribution(rb)},
                  {"sqrt_piece_area_m", distribution(wedge_size)},
                  {"piece_area_over_sector_area", distribution(wedge_ratio)}};
   return f;
