@@ -133,14 +133,21 @@ namespace {
 // as is_convex uses, so a piece merged under `turn >= -tol` passes is_convex(piece, tol) bit for bit.
 double turn(const Vec2& a, const Vec2& b, const Vec2& c) { return cross(b - a, c - b); }
 
+// The path a -> b -> c is straight to round-off: its turn is below 1e-12 of |ab| |bc| (the sine of the angle). A
+// digitised outline has runs of collinear pixel-grid vertices whose computed turn is a few ulps off zero, either
+// side; an ear over one of them would be a zero-area sliver, which no convex solid can be made of.
+bool straight(const Vec2& a, const Vec2& b, const Vec2& c) {
+  return std::abs(turn(a, b, c)) <= 1e-12 * (b - a).norm() * (c - b).norm();
+}
+
 // q inside the CCW triangle (a, b, c); with `closed` a point on its boundary counts as inside.
 bool in_triangle(const Vec2& q, const Vec2& a, const Vec2& b, const Vec2& c, bool closed) {
   const double d1 = cross(b - a, q - a), d2 = cross(c - b, q - b), d3 = cross(a - c, q - c);
   return closed ? (d1 >= 0 && d2 >= 0 && d3 >= 0) : (d1 > 0 && d2 > 0 && d3 > 0);
 }
 
-// Ear clipping of a simple CCW ring; returns CCW index triangles of non-zero area that tile it. Straight (collinear)
-// vertices are never ear tips, and a vertex lying on a candidate ear's boundary blocks it, so collinear vertices end
+// Ear clipping of a simple CCW ring; returns CCW index triangles of non-zero area that tile it. Straight (collinear,
+// to round-off) vertices are never ear tips, and a vertex lying on a candidate ear's boundary blocks it, so collinear vertices end
 // up as corners of proper triangles instead of zero-area slivers. If numerical trouble leaves no ear (a nearly
 // degenerate or touching ring) the rules are relaxed step by step instead of failing.
 std::vector<std::array<int, 3>> ear_clip(const Polygon& p) {
@@ -154,7 +161,7 @@ std::vector<std::array<int, 3>> ear_clip(const Polygon& p) {
   tris.reserve(n);
   auto is_ear = [&](int i, bool closed) {
     const int a = prev[i], c = next[i];
-    if (turn(p[a], p[i], p[c]) <= 0) return false;
+    if (turn(p[a], p[i], p[c]) <= 0 || straight(p[a], p[i], p[c])) return false;
     for (int j = next[c]; j != a; j = next[j]) {
       const Vec2& q = p[j];
       if (q == p[a] || q == p[i] || q == p[c]) continue;  // a touching ring may repeat a position
@@ -187,7 +194,7 @@ std::vector<std::array<int, 3>> ear_clip(const Polygon& p) {
       double best_turn = -std::numeric_limits<double>::infinity();
       for (int k = 0; k < remaining; ++k, i = next[i]) {
         const double t = turn(p[prev[i]], p[i], p[next[i]]);
-        if (t == 0) {
+        if (straight(p[prev[i]], p[i], p[next[i]])) {
           best = i;
           emit = false;
           break;
@@ -201,7 +208,7 @@ std::vector<std::array<int, 3>> ear_clip(const Polygon& p) {
     --remaining;
   }
   const int a = prev[cursor], c = next[cursor];
-  if (turn(p[a], p[cursor], p[c]) > 0) tris.push_back({a, cursor, c});
+  if (turn(p[a], p[cursor], p[c]) > 0 && !straight(p[a], p[cursor], p[c])) tris.push_back({a, cursor, c});
   return tris;
 }
 

@@ -50,6 +50,10 @@ const std::vector<FieldSpec>& series_fields() {
        "part of ice_load from contacts with level ice tiles (breaking the sheet's edge; the rest is the floes and "
        "broken pieces being cleared, turned and submerged), body axes",
        6},
+      {"ice_kinetic_energy", 1, "J",
+       "kinetic energy of the floes and pieces (translation and rotation) at the end of the step: a long run's ice "
+       "must not gain energy",
+       7},
   };
   return k;
 }
@@ -178,8 +182,9 @@ std::vector<T> read_ds(hid_t file_id, const std::string& name, size_t cols, cons
 
 // The layout this version writes (floesim-results/N); it still reads every earlier one so that old artefacts still
 // plot and render: /1 had no fracture (no /fracture, no lineage), /2 no solver series beyond sweeps and residual,
-// /3 no /states/in_contact, /4 no /geometry/floe_level_ice, /5 no ice_load_level_ice series.
-constexpr int kLayoutVersion = 6;
+// /3 no /states/in_contact, /4 no /geometry/floe_level_ice, /5 no ice_load_level_ice series, /6 every alive body
+// in every frame (which FrameReplay reads like the changed bodies of /7) and no ice_kinetic_energy series.
+constexpr int kLayoutVersion = 7;
 constexpr const char* kLayoutPrefix = "floesim-results/";
 std::string layout_name(int version) { return kLayoutPrefix + std::to_string(version); }
 
@@ -474,6 +479,63 @@ Results read_results(const std::filesystem::path& path, bool with_states) {
   const std::string fracture = fracture_problem(r);
   FLOESIM_REQUIRE(fracture.empty(), file, ": ", fracture, " (a damaged file, or not written by floesim-simulate?)");
   return r;
+}
+
+FrameReplay::FrameReplay(const Results& r, const std::string& source) : r_(r) {
+  slot_of_.push_back({0, 0});
+  ended_s_.push_back(std::numeric_limits<double>::infinity());
+  for (size_t g = 0; g < r.floe_id.size(); ++g) {
+    slot_of_.push_back({r.floe_id[g], static_cast<int32_t>(g + 1)});
+    ended_s_.push_back(g < r.floe_ended_s.size() ? r.floe_ended_s[g] : std::numeric_limits<double>::infinity());
+  }
+  std::sort(slot_of_.begin(), slot_of_.end());
+  for (size_t i = 1; i < slot_of_.size(); ++i)
+    FLOESIM_REQUIRE(slot_of_[i].first != slot_of_[i - 1].first, source, ": body id ", slot_of_[i].first,
+                    slot_of_[i].first == 0 ? " (the vessel's)" : "", " appears twice in /geometry/floe_id");
+  FLOESIM_REQUIRE(r.frame_offset.size() == r.frames() + 1 && r.frame_offset.front() == 0 &&
+                      static_cast<size_t>(r.frame_offset.back()) == r.state_body_id.size(),
+                  source, ": /frames/offset does not match /states");
+  for (size_t k = 0; k < r.frames(); ++k) {
+    FLOESIM_REQUIRE(r.frame_offset[k] <= r.frame_offset[k + 1], source, ": /frames/offset decreases at frame ", k);
+    bool vessel = false;
+    for (int64_t row = r.frame_offset[k]; row < r.frame_offset[k + 1]; ++row) {
+      const int32_t id = r.state_body_id[static_cast<size_t>(row)];
+      vessel = vessel || id == 0;
+      const auto it = std::lower_bound(slot_of_.begin(), slot_of_.end(), std::make_pair(id, INT32_MIN));
+      FLOESIM_REQUIRE(it != slot_of_.end() && it->first == id, source, ": frame ", k, " has a state for body ", id,
+                      ", which has no floe geometry in /geometry/floe_id");
+    }
+    FLOESIM_REQUIRE(vessel, source, ": frame ", k, " (t = ", r.frame_time_s[k], " s) has no vessel state (body_id 0)");
+  }
+  slot_row_.assign(slot_of_.size(), -1);
+}
+
+void FrameReplay::seek(size_t frame) {
+  FLOESIM_REQUIRE(frame < r_.frames(), "internal: frame ", frame, " of ", r_.frames());
+  if (static_cast<long>(frame) < frame_) {
+    std::fill(slot_row_.begin(), slot_row_.end(), -1);
+    frame_ = -1;
+  }
+  for (size_t k = static_cast<size_t>(frame_ + 1); k <= frame; ++k)
+    for (int64_t row = r_.frame_offset[k]; row < r_.frame_offset[k + 1]; ++row) {
+      const int32_t id = r_.state_body_id[static_cast<size_t>(row)];
+      const auto it = std::lower_bound(slot_of_.begin(), slot_of_.end(), std::make_pair(id, INT32_MIN));
+      slot_row_[static_cast<size_t>(it->second)] = row;
+    }
+  frame_ = static_cast<long>(frame);
+  // A floe that broke up is replaced by its pieces from the step it broke in (ended_s is that step's end).
+  const double t = r_.frame_time_s[frame];
+  rows_.clear();
+  floes_.clear();
+  for (size_t s = 0; s < slot_row_.size(); ++s) {
+    if (slot_row_[s] < 0) continue;
+    if (ended_s_[s] <= t) {
+      slot_row_[s] = -1;
+      continue;
+    }
+    rows_.push_back(slot_row_[s]);
+    floes_.push_back(static_cast<int32_t>(s) - 1);
+  }
 }
 
 }  // namespace floesim

@@ -5,6 +5,11 @@
 //   /frames/time_s         [F]            float64   times of the stored body states (output interval)
 //   /frames/offset         [F+1]          int64     rows of frame k are offset[k] .. offset[k+1]-1 of /states/*
 //   /states/body_id        [R]            int32     0 = vessel, k >= 1 = floe id k (bodies may appear later)
+//                          Frame k stores the vessel and every body that is new or whose pose or in_contact changed
+//                          since its last stored row: a body absent from a frame is unchanged, not gone. A body is
+//                          gone from the frames at and after its /geometry/floe_ended_s. FrameReplay below gives the
+//                          state of every body at a frame (a sleeping field costs nothing per frame, so a long
+//                          transit's file grows with the ice that moves, not with the field).
 //   /states/position_m     [R x 3]        float64   centre of mass, world frame (x right, y up, z up from water)
 //   /states/quaternion_wxyz[R x 4]        float64   body-to-world rotation
 //   /states/in_contact     [R]            int8      1: a floe pressed against the vessel in the step that ends at
@@ -36,7 +41,9 @@
 //   /fracture/brash_mass_kg      [E]      float64   mass of pieces below the minimum size, removed (counted here)
 //   /fracture/child_offset       [E+1]    int64     pieces of event k: child_id[offset[k] .. offset[k+1]-1]
 //   /fracture/child_id           [C]      int32     floe ids of the pieces that became bodies
-//   Layout "floesim-results/6" (this one) added the series ice_load_level_ice (NaN when reading an earlier file);
+//   Layout "floesim-results/7" (this one) stores only the changed bodies in a frame and added the series
+//   ice_kinetic_energy (NaN when reading an earlier file); earlier layouts stored every alive body in every frame,
+//   which FrameReplay reads the same way. "/6" added the series ice_load_level_ice (NaN when reading an earlier file);
 //   "/5" added /geometry/floe_level_ice (all 0 when reading an earlier file); "/4" added /states/in_contact; "/3"
 //   added the solver series (relax sweeps and residual, subspace solves, capped steps, contact-law violations); "/2"
 //   added /fracture and the lineage datasets. "/1" to "/5" files are still read: a series a file lacks is filled as
@@ -125,6 +132,34 @@ struct Results {
 // /geometry), as write_results and read_results do; for code that builds Results in memory. Returns the first
 // problem found, naming the dataset, or "" if there is none.
 std::string fracture_problem(const Results& r);
+
+// The state of every body at one frame, from the frames up to it (see the layout above: a body keeps its last
+// stored row until it ends). Reads every layout: the earlier ones store every alive body in every frame, which
+// replays to the same thing. Frames are visited forwards in O(rows stored since the last one + bodies); seeking
+// backwards replays from the first frame.
+class FrameReplay {
+ public:
+  // Error if a state row names a body that is neither the vessel (0) nor in /geometry/floe_id, or a frame lacks the
+  // vessel. `source` names the file in messages.
+  FrameReplay(const Results& r, const std::string& source);
+  void seek(size_t frame);
+  size_t frame() const { return static_cast<size_t>(frame_); }
+  // The /states rows that hold each body's state at the current frame: the vessel's first, then the floes in
+  // /geometry/floe_id order (the order in which they were made).
+  const std::vector<int64_t>& rows() const { return rows_; }
+  // The /geometry index of each row's floe (-1 for the vessel), in the order of rows().
+  const std::vector<int32_t>& floes() const { return floes_; }
+  int64_t vessel_row() const { return rows_.empty() ? -1 : rows_.front(); }
+
+ private:
+  const Results& r_;
+  std::vector<std::pair<int32_t, int32_t>> slot_of_;  // body id -> slot (0 vessel, 1 + geometry index), sorted
+  std::vector<int64_t> slot_row_;                     // slot -> latest /states row, -1 if none yet or gone
+  std::vector<double> ended_s_;                       // slot -> time it ended (+inf: lasted)
+  long frame_ = -1;
+  std::vector<int64_t> rows_;
+  std::vector<int32_t> floes_;
+};
 
 // Checks consistency (every series has steps x cols values, offsets monotone, ...) and writes atomically.
 void write_results(const std::filesystem::path& file, const Results& r);

@@ -173,7 +173,7 @@ struct SceneRenderer::Impl {
   std::vector<float> pos, nrm;
   std::vector<uint8_t> col;
   std::vector<FloeDraw> floes;          // per geometry index
-  std::vector<int32_t> row_floe;        // per state row: geometry index, -1 for the vessel
+  std::unique_ptr<FrameReplay> replay;  // every body's state at the frame drawn (a frame stores what changed)
   std::vector<int64_t> vessel_row;      // per frame
   GLint hull_first = 0, hull_count = 0;
   double hull_radius = 0;
@@ -212,25 +212,16 @@ struct SceneRenderer::Impl {
   }
   GLint vertex_count() const { return static_cast<GLint>(pos.size() / 3); }
 
-  // Every state row must name the vessel or a floe with geometry, with a finite pose; every frame needs the vessel.
+  // Every state row must name the vessel or a floe with geometry, with a finite pose; every frame needs the vessel
+  // (FrameReplay checks the names and the vessel).
   void check_states() {
     const size_t frames = r.frames();
     FLOESIM_REQUIRE(frames > 0, source, ": the results hold no frames (/frames/time_s is empty): nothing to render");
-    FLOESIM_REQUIRE(r.frame_offset.size() == frames + 1 && r.frame_offset.front() == 0 &&
-                        static_cast<size_t>(r.frame_offset.back()) == r.state_body_id.size(),
-                    source, ": /frames/offset does not match /states (run floesim-simulate again?)");
-    std::vector<std::pair<int32_t, int32_t>> ids;  // floe id -> geometry index, sorted for lookups
-    for (size_t g = 0; g < r.floe_id.size(); ++g) ids.push_back({r.floe_id[g], static_cast<int32_t>(g)});
-    std::sort(ids.begin(), ids.end());
-    for (size_t i = 1; i < ids.size(); ++i)
-      FLOESIM_REQUIRE(ids[i].first != ids[i - 1].first, source, ": floe id ", ids[i].first,
-                      " appears twice in /geometry/floe_id");
     FLOESIM_REQUIRE(r.state_in_contact.size() == r.state_body_id.size(), source, ": /states/in_contact has ",
                     r.state_in_contact.size(), " rows, /states/body_id ", r.state_body_id.size());
-    row_floe.assign(r.state_body_id.size(), -1);
+    replay = std::make_unique<FrameReplay>(r, source);
     vessel_row.assign(frames, -1);
     for (size_t k = 0; k < frames; ++k) {
-      FLOESIM_REQUIRE(r.frame_offset[k] <= r.frame_offset[k + 1], source, ": /frames/offset decreases at frame ", k);
       for (int64_t row = r.frame_offset[k]; row < r.frame_offset[k + 1]; ++row) {
         const int32_t id = r.state_body_id[row];
         const double* q = &r.state_quaternion[4 * row];
@@ -240,17 +231,8 @@ struct SceneRenderer::Impl {
                             qn > 0.5 && qn < 2.0,
                         source, ": body ", id, " in frame ", k, " (t = ", r.frame_time_s[k],
                         " s) has a non-finite position or an invalid quaternion (did the simulation blow up?)");
-        if (id == 0) {
-          vessel_row[k] = row;
-          continue;
-        }
-        auto it = std::lower_bound(ids.begin(), ids.end(), std::make_pair(id, INT32_MIN));
-        FLOESIM_REQUIRE(it != ids.end() && it->first == id, source, ": frame ", k, " has a state for body ", id,
-                        ", which has no floe geometry in /geometry/floe_id");
-        row_floe[row] = it->second;
+        if (id == 0) vessel_row[k] = row;
       }
-      FLOESIM_REQUIRE(vessel_row[k] >= 0, source, ": frame ", k, " (t = ", r.frame_time_s[k],
-                      " s) has no vessel state (body_id 0)");
     }
     // Lineage (the piece colours) and events in time order (the overlay counts them by bisection).
     const std::string problem = fracture_problem(r);
@@ -554,8 +536,10 @@ struct SceneRenderer::Impl {
     // Towards the viewer: the eye for the perspective view, the view's back direction for the orthographic ones.
     const Eigen::Vector3f eye_f = eye.cast<float>(), to_viewer = view.block<1, 3>(2, 0).transpose().cast<float>();
     gl.LoadMatrixd(view.data());
-    for (int64_t row = r.frame_offset[k]; row < r.frame_offset[k + 1]; ++row) {
-      const int32_t g = row_floe[row];
+    replay->seek(k);
+    for (size_t i = 0; i < replay->rows().size(); ++i) {
+      const int64_t row = replay->rows()[i];
+      const int32_t g = replay->floes()[i];
       if (g < 0) continue;
       const Vec3 c = Vec3(&r.state_position_m[3 * row]) - origin;
       // The side view shows a slab of the field about the vessel's centre plane (a floe is in it or not, whole).

@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+#include <sys/resource.h>
 
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
@@ -201,10 +202,11 @@ nlohmann::json level_ice_summary(const Model& model, const Results& r) {
   ice.friction = o.ice.mu_ice_structure;
   j["ice"] = level_ice_json(ice);
   // The vessel at the end (last frame) and the tiles alive then.
-  const size_t last = r.frames() - 1;
+  FrameReplay replay(r, "the results");
+  replay.seek(r.frames() - 1);
   double u_end = -std::numeric_limits<double>::infinity();
   std::map<int32_t, Vec2> end_position;
-  for (int64_t row = r.frame_offset[last]; row < r.frame_offset[last + 1]; ++row) {
+  for (const int64_t row : replay.rows()) {
     const Vec2 x(r.state_position_m[3 * row], r.state_position_m[3 * row + 1]);
     if (r.state_body_id[row] == 0) u_end = to_track(x).x();
     else end_position[r.state_body_id[row]] = x;
@@ -301,6 +303,62 @@ constexpr ScalarSeries kScalarSeries[] = {
     {"solver_surge_load_error", [](const StepReport& r) { return r.surge_load_error_n; }},
 };
 
+// A body's id in the results layout: 0 for the vessel, its floe id otherwise.
+int32_t results_id(const Body& b) { return b.kind == BodyKind::vessel ? 0 : b.id; }
+
+// The last stored state of each body (world body-table index), so that a frame stores only the bodies that changed
+// (layout /7): a sleeping field costs nothing per frame. Rebuilt from the results on resume, which hold every row
+// stored so far, so a resumed run stores exactly what an uninterrupted one does.
+class StoredStates {
+ public:
+  StoredStates(const World& w, const Results& r) {
+    const Model& m = w.model();
+    std::map<int32_t, size_t> index;
+    for (size_t b = 0; b < m.bodies.size(); ++b)
+      if (m.bodies[b].kind != BodyKind::wall) index[results_id(m.bodies[b])] = b;
+    last_.resize(m.bodies.size());
+    for (size_t row = 0; row < r.state_body_id.size(); ++row) {
+      const auto it = index.find(r.state_body_id[row]);
+      FLOESIM_REQUIRE(it != index.end(), "internal: stored state of body ", r.state_body_id[row], " not in the world");
+      const double* x = &r.state_position_m[3 * row];
+      const double* q = &r.state_quaternion[4 * row];
+      last_[it->second] = {Vec3(x[0], x[1], x[2]), Quat(q[0], q[1], q[2], q[3]), r.state_in_contact[row], true};
+    }
+  }
+  // True if body b is new or its pose or contact flag differs from its last stored row; then remembers this one.
+  bool changed(size_t b, const Vec3& x, const Quat& q, int8_t in_contact) {
+    if (b >= last_.size()) last_.resize(b + 1);  // pieces made since the last frame
+    Last& l = last_[b];
+    if (l.stored && l.x == x && l.q.coeffs() == q.coeffs() && l.in_contact == in_contact) return false;
+    l = {x, q, in_contact, true};
+    return true;
+  }
+
+ private:
+  struct Last {
+    Vec3 x = Vec3::Zero();
+    Quat q = Quat::Identity();
+    int8_t in_contact = 0;
+    bool stored = false;
+  };
+  std::vector<Last> last_;
+};
+
+// Kinetic energy of the floes and pieces (translation and rotation, without added mass); sleeping and fixed bodies
+// have none.
+double ice_kinetic_energy(const World& w) {
+  const Model& m = w.model();
+  const State& s = w.state();
+  double e = 0;
+  for (size_t b = 0; b < m.bodies.size(); ++b) {
+    const Body& body = m.bodies[b];
+    if (body.kind != BodyKind::floe || !s.alive[b] || !s.awake[b]) continue;
+    const Vec3 wb = s.orientation[b].conjugate() * s.angular_velocity[b];
+    e += 0.5 * body.mass_kg * s.velocity[b].squaredNorm() + 0.5 * wb.dot(body.inertia * wb);
+  }
+  return e;
+}
+
 }  // namespace
 
 Results simulate(const Model& model, RunStats& stats, std::ostream* progress, const CheckpointPlan* checkpoints) {
@@ -329,14 +387,10 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress, co
   auto& c_prop = *col["propulsion_load"];
   std::vector<std::vector<double>*> c_scalar;  // kScalarSeries' columns, looked up once
   for (const ScalarSeries& f : kScalarSeries) c_scalar.push_back(col.at(f.name));
-  const size_t nb = model.bodies.size();  // at the start; the world's table grows as ice breaks
-  const size_t frames = static_cast<size_t>(steps / every);
+  auto& c_kinetic = *col["ice_kinetic_energy"];
+  // The states grow with the ice that moves (a frame stores only what changed: no reservation by field size).
   r.frame_offset.push_back(0);
-  r.frame_time_s.reserve(frames);
-  r.state_body_id.reserve(frames * nb);
-  r.state_position_m.reserve(frames * nb * 3);
-  r.state_quaternion.reserve(frames * nb * 4);
-  r.state_in_contact.reserve(frames * nb);
+  r.frame_time_s.reserve(static_cast<size_t>(steps / every));
   std::vector<int8_t> pressed;  // per body: pressed against the vessel in this step (frames only)
 
   // The world: fresh, or continued from a checkpoint (sim/checkpoint.h) with the results recorded up to it.
@@ -350,6 +404,7 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress, co
     else cp->start_fresh(r, progress);
   }
   if (!world) world = std::make_unique<World>(model);
+  StoredStates stored(*world, r);
   const long first = world->state().step + 1;
   stats.resumed_at_step = first - 1;
 
@@ -396,6 +451,7 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress, co
       push_body_wrench(c_wind, R, rep.wind_load);
       push_body_wrench(c_prop, R, rep.propulsion_load);
       for (size_t i = 0; i < c_scalar.size(); ++i) c_scalar[i]->push_back(kScalarSeries[i].get(rep));
+      c_kinetic.push_back(ice_kinetic_energy(w));
       sums.awake += rep.awake_floes;
       sums.contacts += rep.contacts;
       sums.iterations += rep.solve.iterations;
@@ -403,8 +459,8 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress, co
       sums.touching += w.collision_stats().narrowphase_hits;
       sums.edges += w.collision_stats().edge_contacts;
       sums.crushing += w.collision_stats().crushing_contacts;
-      // Frames at t = k * output_interval (k >= 1): the bodies alive, vessel first (body id 0), pieces in the order
-      // they were made.
+      // Frames at t = k * output_interval (k >= 1): the vessel and the bodies that are new or changed since they
+      // were last stored (layout /7), vessel first (body id 0), pieces in the order they were made.
       if (k % every == 0) {
         r.frame_time_s.push_back(s.time_s);
         const Model& wm = w.model();
@@ -416,7 +472,9 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress, co
         for (size_t b = 0; b < wm.bodies.size(); ++b) {
           const Body& body = wm.bodies[b];
           if (body.kind == BodyKind::wall || !s.alive[b]) continue;  // walls are fixed: not in the results layout
-          r.state_body_id.push_back(body.kind == BodyKind::vessel ? 0 : body.id);
+          if (!stored.changed(b, s.position[b], s.orientation[b], pressed[b]) && body.kind != BodyKind::vessel)
+            continue;
+          r.state_body_id.push_back(results_id(body));
           const Vec3& x = s.position[b];
           const Quat& qb = s.orientation[b];
           r.state_position_m.insert(r.state_position_m.end(), {x.x(), x.y(), x.z()});
@@ -746,7 +804,13 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
         << fr["events"]["radial"] << ", splitting " << fr["events"]["splitting"] << "), " << fr["pieces_created"]
         << " pieces, " << std::setprecision(4) << fr["brash_removed_kg"].get<double>() / 1e3
         << " t of brash removed\n";
-  rep << "wrote " << (out_dir / "results.h5").string() << " and " << (out_dir / "summary.json").string() << "\n";
+  rep << "wrote " << (out_dir / "results.h5").string() << " (" << std::setprecision(1)
+      << std::filesystem::file_size(out_dir / "results.h5") / 1e6 << " MB, " << results.state_body_id.size()
+      << " stored body states in " << results.frames() << " frames) and " << (out_dir / "summary.json").string()
+      << "\n";
+  // Peak resident memory of this process (getrusage: kB on Linux), for sizing long runs and cluster jobs.
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) == 0) rep << "peak memory " << usage.ru_maxrss / 1024.0 << " MB\n";
   return rep.str();
 }
 

@@ -124,6 +124,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       std::abort();
     for (const auto& f : floesim::series_fields())
       if (r.get(f.name).size() != r.steps() * f.cols) std::abort();
+    // The frames replayed (layout /7 stores the changed bodies; the render and the summaries replay them): either
+    // refused with an Error or every frame's rows inside /states, the vessel first.
+    floesim::FrameReplay walk(r, file);
+    for (size_t k = 0; k < r.frames(); ++k) {
+      walk.seek(k);
+      if (walk.rows().empty() || r.state_body_id[size_t(walk.vessel_row())] != 0) std::abort();
+      for (int64_t row : walk.rows())
+        if (row < 0 || size_t(row) >= R) std::abort();
+    }
+    if (r.frames() > 1) walk.seek(0);  // backwards: replays from the start
   });
   if (H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_ALL) != 0) {
     std::fprintf(stderr, "read_results left HDF5 ids open\n");

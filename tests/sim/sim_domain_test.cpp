@@ -107,10 +107,12 @@ TEST(SimDomain, FloesPackIntoTheDownstreamCornerAndWallsAreNotInTheResults) {
   RunStats stats;
   const Results r = simulate(m, stats);
   // Last frame: every floe is inside the domain corner region, stopped; the spread of the field shrank.
-  const size_t k = r.frames() - 1;
+  FrameReplay replay(r, "results");
+  replay.seek(r.frames() - 1);
   double xmax = -1e9, ymax = -1e9, xmin = 1e9, ymin = 1e9;
   int rows = 0;
-  for (int64_t row = r.frame_offset[k]; row < r.frame_offset[k + 1]; ++row, ++rows) {
+  for (const int64_t row : replay.rows()) {
+    ++rows;
     const int32_t bid = r.state_body_id[row];
     EXPECT_GE(bid, 0) << "a wall in the results";
     if (bid == 0) continue;

@@ -143,7 +143,9 @@ TEST(LevelIce, RampBreaksTheSheetAtTheTableLoadAndTheSheetStaysPut) {
       if (b.id == id) {
         children += b.mass_kg;
         (b.fixed ? sheet_pieces : free_pieces) += 1;
-        if (!b.fixed) EXPECT_LT(b.section_area, 0.01 * model.bodies[tile].section_area);
+        if (!b.fixed) {
+          EXPECT_LT(b.section_area, 0.01 * model.bodies[tile].section_area);
+        }
       }
   EXPECT_EQ(free_pieces, 1);
   EXPECT_GE(sheet_pieces, 1);
