@@ -124,8 +124,11 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
   f["piece_equivalent_diameter_m"] = distribution(piece_diameter);
   // Wedges: R_b of fracture.piece_size for each event's theta and width (static: without the speed correction),
   // against the smallest child of the event (the wedge: the floe it broke from is longer than the wedge by the
-  // finite-floe rule, so the remainder is the larger piece).
+  // finite-floe rule, so the remainder is the larger piece). An event with one child and brash removed lost its
+  // wedge to brash (a sliver cut beside an earlier crack): its only child is the remainder, not a piece, so it is
+  // counted apart instead (in level ice it would otherwise put the tile's size among the pieces).
   std::vector<double> rb, wedge_size, wedge_ratio;
+  int wedge_brash = 0;
   const double rho_w_g = o.water.density_kg_m3 * o.water.gravity_mps2;
   for (size_t e = 0; e < r.fracture_mode.size(); ++e) {
     if (r.fracture_mode[e] == kFractureSplitting || rho_w_g <= 0) continue;
@@ -141,6 +144,10 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
     }
     if (smallest <= 0) continue;
     rb.push_back(rb_e);
+    if (r.fracture_child_offset[e + 1] - r.fracture_child_offset[e] == 1 && r.fracture_brash_mass_kg[e] > 0) {
+      ++wedge_brash;
+      continue;
+    }
     wedge_size.push_back(std::sqrt(smallest));
     // The wedge's area if the floe were wider than it: the sector of angle theta between radii a and a + R_b.
     const double a0 = w / theta;
@@ -148,6 +155,7 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
   }
   f["wedges"] = {{"piece_size", o.fracture.piece_size},
                  {"rb_m", distribution(rb)},
+                 {"events_wedge_to_brash", wedge_brash},
                  {"sqrt_piece_area_m", distribution(wedge_size)},
                  {"piece_area_over_sector_area", distribution(wedge_ratio)}};
   return f;
