@@ -372,7 +372,7 @@ void write_results(const std::filesystem::path& path, const Results& r) {
   out.commit();
 }
 
-Results read_results(const std::filesystem::path& path, bool with_states) {
+Results read_results(const std::filesystem::path& path, bool with_states, const std::set<std::string>& only_series) {
   const std::string file = path.string();
   FLOESIM_REQUIRE(std::filesystem::exists(path), file, ": no such results file (run floesim-simulate first)");
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
@@ -409,8 +409,13 @@ Results read_results(const std::filesystem::path& path, bool with_states) {
   FLOESIM_REQUIRE(version > 0, file, ": layout ", layout, " is not supported by this version (it reads ",
                   layout_name(1), " to ", layout_name(kLayoutVersion), "; a newer floesim wrote it?)");
   const bool before_fracture = version < 2;
+  // time_s always: it defines the steps.
+  auto wanted = [&](const FieldSpec& f) {
+    return only_series.empty() || only_series.count(f.name) || std::string(f.name) == "time_s";
+  };
   for (const auto& f : series_fields())
-    if (f.since <= version) r.series[f.name] = read_ds<double>(fid, std::string("/series/") + f.name, f.cols, file);
+    if (f.since <= version && wanted(f))
+      r.series[f.name] = read_ds<double>(fid, std::string("/series/") + f.name, f.cols, file);
   const size_t n = r.steps();
   for (const auto& f : series_fields())
     if (r.series.count(f.name))
@@ -471,7 +476,7 @@ Results read_results(const std::filesystem::path& path, bool with_states) {
     r.floe_ended_s.assign(floes, std::numeric_limits<double>::infinity());
   }
   for (const auto& f : series_fields())
-    if (f.since > version) r.series[f.name] = missing_series(f, n, floes);
+    if (f.since > version && wanted(f)) r.series[f.name] = missing_series(f, n, floes);
   if (before_fracture) return r;
   for_each_fracture_dataset(r, [&](const char* name, auto& v, size_t cols, Rows) {
     v = read_ds<typename std::decay_t<decltype(v)>::value_type>(fid, name, cols, file);

@@ -55,6 +55,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -163,7 +164,9 @@ class FrameReplay {
 
 // Checks consistency (every series has steps x cols values, offsets monotone, ...) and writes atomically.
 void write_results(const std::filesystem::path& file, const Results& r);
-// Reads and validates; errors name the file and the dataset.
-Results read_results(const std::filesystem::path& file, bool with_states = true);
+// Reads and validates; errors name the file and the dataset. `only_series` (non-empty) reads just those series
+// (and time_s): a reader that needs one series of a long run need not hold them all (72 values, 0.58 kB, per step).
+Results read_results(const std::filesystem::path& file, bool with_states = true,
+                     const std::set<std::string>& only_series = {});
 
 }  // namespace floesim

@@ -101,16 +101,19 @@ RenderStats render_video(const Results& r, const RenderOptions& o, const fs::pat
   return st;
 }
 
+// The series the render draws (the strip chart's surge ice load); the others stay on disk.
+const std::set<std::string> kRenderSeries = {"time_s", "ice_load"};
+
 RenderStats render_video(const fs::path& results, const fs::path& config, const fs::path& out_mp4) {
   const RenderOptions o = read_render_options(config);
-  const Results r = read_results(results);
+  const Results r = read_results(results, true, kRenderSeries);
   const auto prov = make_provenance("floesim-render", {{"results", results}, {"config", config}}, options_to_json(o));
   return render_video(r, o, out_mp4, prov, results.string());
 }
 
 void render_still(const fs::path& results, const fs::path& config, size_t frame, const fs::path& out_image) {
   const RenderOptions o = read_render_options(config);
-  const Results r = read_results(results);
+  const Results r = read_results(results, true, kRenderSeries);
   FLOESIM_REQUIRE(frame < r.frames(), results.string(), ": frame ", frame, " requested, the results hold ",
                   r.frames(), " frames (0 .. ", r.frames() - 1, ")");
   SceneRenderer scene(r, o, results.string());

@@ -168,6 +168,19 @@ TEST(ResultsIo, RoundTripAndBitIdenticalRewrites) {
   fs::remove(b);
 }
 
+TEST(ResultsIo, OnlySeriesReadsThoseAndTimeAsTheWholeReadDoes) {
+  const fs::path a = fs::temp_directory_path() / "floesim_results_only.h5";
+  write_results(a, small_results(7));
+  const Results all = read_results(a);
+  const Results some = read_results(a, true, {"ice_load"});
+  EXPECT_EQ(some.series.size(), 2u);  // ice_load and time_s
+  EXPECT_EQ(some.get("ice_load"), all.get("ice_load"));
+  EXPECT_EQ(some.get("time_s"), all.get("time_s"));
+  EXPECT_THROW(some.get("hydro_load"), Error);
+  EXPECT_EQ(some.state_body_id, all.state_body_id);
+  fs::remove(a);
+}
+
 TEST(ResultsIo, RefusesInconsistentSeriesAndLeavesNoFile) {
   Results r = small_results(3);
   r.series["time_s"].push_back(9.0);

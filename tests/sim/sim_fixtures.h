@@ -108,6 +108,20 @@ inline double table_rb(double alpha) {
 // the face bites, sigma_c w 1 mm: 4 % of the load), 30 s. The ramp's centre of mass is 22.1 m behind its stem
 // (waterline); the stem starts 0.9 m behind x = 0, so ice whose edge is at x = -0.4 meets the face within a few
 // seconds.
+// The coarse hull at 2 m/s (held) from x = -60 m into a 120 m x 120 m level ice sheet of 40 m tiles, 10 s: wedges
+// break off within seconds (a short transit with fracture of a sheet).
+inline SimulateOptions level_ice_transit_options() {
+  SimulateOptions o = floe_options();
+  o.vessel.propulsion.mode = "speed";
+  o.vessel.propulsion.speed_mps = 2;
+  o.vessel.initial_speed_mps = 2;
+  o.vessel.x_m = -60;
+  o.duration_s = 10;
+  o.level_ice.extent_m = {0, -60, 120, 60};
+  o.level_ice.tile_m = 40;
+  return o;
+}
+
 inline SimulateOptions ramp_options() {
   SimulateOptions o = floe_options();
   o.fracture.wedge_angle_deg = {60, 60};

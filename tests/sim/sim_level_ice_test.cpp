@@ -155,14 +155,7 @@ TEST(LevelIce, RampBreaksTheSheetAtTheTableLoadAndTheSheetStaysPut) {
 
 TEST(LevelIce, TransitIsByteIdenticalOnRerunAndAcrossThreads) {
   const auto dir = testing::temp_dir("level_ice_determinism");
-  SimulateOptions o = testing::floe_options();
-  o.vessel.propulsion.mode = "speed";
-  o.vessel.propulsion.speed_mps = 2;
-  o.vessel.initial_speed_mps = 2;
-  o.vessel.x_m = -60;
-  o.duration_s = 10;
-  o.level_ice.extent_m = {0, -60, 120, 60};
-  o.level_ice.tile_m = 40;
+  SimulateOptions o = testing::level_ice_transit_options();
   const HullModel hull = coarse_hull();
   std::vector<std::string> bytes;
   for (int threads : {1, 1, 2}) {

@@ -130,14 +130,7 @@ TEST(SimTransit, StoredFramesReplayToEveryBodysStateAndSleepingFloesCostNoRows) 
 }
 
 TEST(SimTransit, StoredFramesReplayThroughFractureOfLevelIce) {
-  SimulateOptions o = testing::floe_options();
-  o.vessel.propulsion.mode = "speed";
-  o.vessel.propulsion.speed_mps = 2;
-  o.vessel.initial_speed_mps = 2;
-  o.vessel.x_m = -60;
-  o.duration_s = 10;
-  o.level_ice.extent_m = {0, -60, 120, 60};
-  o.level_ice.tile_m = 40;
+  const SimulateOptions o = testing::level_ice_transit_options();
   const HullModel hull = coarse_hull();
   const Model m = build_model(FloeField{}, &hull, o);
   size_t stored = 0, dense = 0;
