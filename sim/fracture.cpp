@@ -97,7 +97,7 @@ Candidate evaluate(const Model& model, const State& state, const PairLoad& pl, l
   Candidate bend = c;
   if (edge && f_v > 0 && rho_w_g > 0) {
     const double pr = radial_crack_load_n(fo.flexural_strength_pa, h, width / lc);
-    double rb = wf.rb_over_lc * lc;
+    double rb = static_piece_rb_m(fo, wf.rb_over_lc, lc);
     if (fo.speed_correction) {
       // Approach speed of the other body into the floe at the contact point.
       const Vec3 r_f = pl.point - x, r_o = pl.point - state.position[pl.other];
@@ -106,6 +106,8 @@ Candidate evaluate(const Model& model, const State& state, const PairLoad& pl, l
       const double vn = std::max(0.0, v_rel.dot(pl.normal.normalized()));
       rb *= std::max(0.1, 1 + fo.speed_coefficient_spm * vn);  // never below a tenth of the static piece
     }
+    // The check below stays Nevel's xi* even for the empirical piece: whether the floe bends as a wedge (and
+    // at what load) is the plate's mechanics; only where the circumferential crack runs is replaced.
     // A floe shorter than the wedge (apex -> crack) along the load does not bend as a wedge (§2.1, finite floes):
     // it tilts, submerges or splits instead. Level ice cannot tilt away: a cusp left between two earlier cracks
     // is held by the sheet and breaks off whole (the wedge's cut takes what of it lies inside).
@@ -173,7 +175,9 @@ std::vector<Polygon> cut(const Body& body, const Candidate& c, const FractureOpt
         if (is_brash(p, body.thickness_m, fo.min_piece_area_m2)) return {};
     } else {
       // The wedge: apex a = alpha l_c behind the contact point (outside the ice), radial cracks at +-theta/2 about
-      // the inward normal, the circumferential crack R_b beyond the load point. The crack is cut as two straight
+      // the inward normal, the circumferential crack R_b beyond the load point, so its radius about the apex is
+      // a + R_b (Nevel's xi* l_c; with the empirical piece C_l l_c (1 + C_v v_n) + a: the apex stays Nevel's,
+      // set by the contact width, and the piece's reach from the load point is the empirical R_b). The crack is cut as two straight
       // cracks meeting on the axis at R_b, the radial cracks as long as makes the piece's area the sector's
       // (equal_area_wedge): the piece reaches as far and weighs as much as Nevel's sector. The arc itself (16
       // chords) notched the floe left behind at 17 reflex corners, so it became a body of ~10 convex parts (68
@@ -246,6 +250,10 @@ bool is_brash(const Polygon& piece, double thickness_m, double min_area_m2) {
   double perimeter = 0;
   for (size_t i = 0; i < piece.size(); ++i) perimeter += (piece[(i + 1) % piece.size()] - piece[i]).norm();
   return 4 * area / perimeter < thickness_m;
+}
+
+double static_piece_rb_m(const FractureOptions& o, double rb_nevel_over_lc, double lc_m) {
+  return (o.piece_size == "empirical" ? o.piece_c_l : rb_nevel_over_lc) * lc_m;
 }
 
 double wedge_angle_rad(const FractureOptions& o, int floe_id, long step) {

@@ -4,7 +4,8 @@
 //
 //   bending / radial  F_V >= max(P_r(w/l_c), P_f(theta, a/l_c))    out-of-plane: a wedge of angle theta breaks
 //                                                                   off (radial cracks at +-theta/2, the
-//                                                                   circumferential crack at xi* l_c from the apex);
+//                                                                   circumferential crack R_b beyond the load:
+//                                                                   Nevel's or C_l l_c, fracture.piece_size);
 //                                                                   "radial" when P_r governs, "bending" when P_f does
 //   splitting         F_H >= C_s K_IC h sqrt(L)                     in-plane: the floe splits along the force line
 //
@@ -62,6 +63,11 @@ std::vector<FractureCut> find_fractures(const Model& model, const State& state, 
 // than the ice is thick (plan width 4 A / perimeter below h: a sliver is a block, not a plate, and its tiny
 // inertia about its long axis would only destabilise the contacts it sits in).
 bool is_brash(const Polygon& piece, double thickness_m, double min_area_m2);
+
+// The broken wedge's static extent R_b beyond the load point (PHYSICS.md §2.1 step 3), m: Nevel's
+// (xi* - alpha) l_c (rb_nevel_over_lc, from wedge_failure) with fracture.piece_size "nevel", C_l l_c with
+// "empirical". The speed correction (1 + C_v v_n) multiplies it where the approach speed is known (the fracture step).
+double static_piece_rb_m(const FractureOptions& o, double rb_nevel_over_lc, double lc_m);
 
 // The wedge angle drawn for a floe at a step: uniform in fracture.wedge_angle_deg (radians), from a hash.
 double wedge_angle_rad(const FractureOptions& o, int floe_id, long step);

@@ -16,8 +16,9 @@
 #include "pipeline/interrupt.h"
 #include "pipeline/provenance.h"
 #include "pipeline/units.h"
-#include "sim/fracture_laws.h"
 #include "sim/checkpoint.h"
+#include "sim/fracture.h"
+#include "sim/fracture_laws.h"
 #include "sim/world.h"
 
 namespace floesim::sim {
@@ -121,17 +122,21 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
   f["min_piece_area_m2"] = o.fracture.min_piece_area_m2;
   f["piece_area_m2"] = distribution(piece_area);
   f["piece_equivalent_diameter_m"] = distribution(piece_diameter);
-  // Wedges: R_b from the table for each event's theta and width (static: without the speed correction), against
-  // the smallest child of the event (the wedge: the floe it broke from is longer than the wedge by the
-  // finite-floe rule, so the remainder is the larger piece).
+  // Wedges: R_b of fracture.piece_size for each event's theta and width (static: without the speed correction),
+  // against the smallest child of the event (the wedge: the floe it broke from is longer than the wedge by the
+  // finite-floe rule, so the remainder is the larger piece). An event with one child and brash removed lost its
+  // wedge to brash (a sliver cut beside an earlier crack): its only child is the remainder, not a piece, so it is
+  // counted apart instead (in level ice it would otherwise put the tile's size among the pieces).
   std::vector<double> rb, wedge_size, wedge_ratio;
+  int wedge_brash = 0;
   const double rho_w_g = o.water.density_kg_m3 * o.water.gravity_mps2;
   for (size_t e = 0; e < r.fracture_mode.size(); ++e) {
     if (r.fracture_mode[e] == kFractureSplitting || rho_w_g <= 0) continue;
     const double h = thickness[r.fracture_parent_id[e]];
     const double lc = characteristic_length_m(o.fracture.youngs_modulus_pa, o.fracture.poisson_ratio, h, rho_w_g);
     const double theta = r.fracture_theta_rad[e], w = r.fracture_width_m[e];
-    const double rb_e = wedge_failure(theta, o.fracture.flexural_strength_pa, h, w / (theta * lc)).rb_over_lc * lc;
+    const double rb_e = static_piece_rb_m(
+        o.fracture, wedge_failure(theta, o.fracture.flexural_strength_pa, h, w / (theta * lc)).rb_over_lc, lc);
     double smallest = 0;
     for (int64_t i = r.fracture_child_offset[e]; i < r.fracture_child_offset[e + 1]; ++i) {
       const double a = area[r.fracture_child_id[i]];
@@ -139,12 +144,18 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
     }
     if (smallest <= 0) continue;
     rb.push_back(rb_e);
+    if (r.fracture_child_offset[e + 1] - r.fracture_child_offset[e] == 1 && r.fracture_brash_mass_kg[e] > 0) {
+      ++wedge_brash;
+      continue;
+    }
     wedge_size.push_back(std::sqrt(smallest));
     // The wedge's area if the floe were wider than it: the sector of angle theta between radii a and a + R_b.
     const double a0 = w / theta;
     wedge_ratio.push_back(smallest / (0.5 * theta * ((a0 + rb_e) * (a0 + rb_e) - a0 * a0)));
   }
-  f["wedges"] = {{"rb_m", distribution(rb)},
+  f["wedges"] = {{"piece_size", o.fracture.piece_size},
+                 {"rb_m", distribution(rb)},
+                 {"events_wedge_to_brash", wedge_brash},
                  {"sqrt_piece_area_m", distribution(wedge_size)},
                  {"piece_area_over_sector_area", distribution(wedge_ratio)}};
   return f;

@@ -413,7 +413,12 @@ struct FractureOptions {
   double splitting_coefficient = 2.0;        // C_s of F_split = C_s K_IC h sqrt(L) (§2.2: 2-3; §2.4's example: 2)
   std::vector<double> wedge_angle_deg = {45.0, 90.0};  // theta drawn uniformly in [min, max] per event (§2.1)
   int seed = 1;                              // of the theta draws (a hash of seed, floe id and step: reproducible)
-  bool speed_correction = false;             // R_b x (1 + C_v v_n) (§2.1, velocity effects)
+  // The broken piece's extent R_b beyond the load point (§2.1 step 3): "nevel", the static wedge's
+  // (xi* - alpha) l_c (0.3-0.8 l_c for ship contacts); or "empirical", C_l l_c (Wang 2001; Su et al. 2010), the
+  // size of observed icebreaker cusps (0.1-0.3 l_c). Either way P_f and the finite-floe check stay Nevel's.
+  std::string piece_size = "nevel";
+  double piece_c_l = 1.0 / 6;                // C_l of the empirical R_b = C_l l_c (§2.1: ~1/6)
+  bool speed_correction = false;             // R_b x (1 + C_v v_n) (§2.1, velocity effects), either piece size
   double speed_coefficient_spm = -0.1;       // C_v, s/m
   double min_piece_area_m2 = 1.0;            // smaller pieces become brash: removed, their mass counted
   template <class V>
@@ -438,8 +443,17 @@ struct FractureOptions {
               return "";
             }));
     v.field("seed", seed, "-", "seed of the wedge-angle draws", int_in_range(0, 2147483647));
+    v.field("piece_size", piece_size, "-",
+            "the broken wedge's extent R_b beyond the load point: \"nevel\" (the static wedge's (xi* - alpha) l_c, "
+            "PHYSICS.md 2.1's table) or \"empirical\" (piece_c_l x l_c, Wang 2001); the failure load is the table's",
+            one_of({"nevel", "empirical"}));
+    v.field("piece_c_l", piece_c_l, "-",
+            "C_l of the empirical piece size R_b = C_l l_c (x (1 + C_v v_n) with speed_correction); "
+            "used with piece_size \"empirical\"",
+            in_range(0.01, 1.5));
     v.field("speed_correction", speed_correction, "-",
-            "shrink the broken piece with the normal speed: R_b x (1 + speed_coefficient_spm x v_n)");
+            "shrink the broken piece with the normal speed: R_b x (1 + speed_coefficient_spm x v_n), R_b from "
+            "piece_size");
     v.field("speed_coefficient_spm", speed_coefficient_spm, "s/m", "C_v of the speed correction (< 0: smaller pieces)",
             in_range(-10, 0));
     v.field("min_piece_area_m2", min_piece_area_m2, "m^2",

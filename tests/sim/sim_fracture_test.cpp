@@ -28,8 +28,9 @@ using testing::table_rb;
 // A model with the coarse hull far away (body 0, the structure) and the given floes; fracture at fixed theta.
 struct Rig {
   Model model;
-  explicit Rig(const std::vector<Floe>& floes, double theta_deg = 60) {
-    SimulateOptions o = testing::floe_options();
+  explicit Rig(const std::vector<Floe>& floes, double theta_deg = 60)
+      : Rig(floes, theta_deg, testing::floe_options()) {}
+  Rig(const std::vector<Floe>& floes, double theta_deg, SimulateOptions o) {
     o.fracture.wedge_angle_deg = {theta_deg, theta_deg};
     o.vessel.x_m = -5000;  // the hull is only a structure body for hand-made contacts
     FloeField f;
@@ -99,6 +100,49 @@ TEST(Fracture, WedgeBreaksAtTheTableLoadAndExtendsRbIntoTheIce) {
   const double a = alpha * lc;
   const double sector = 0.5 * theta * ((a + rb) * (a + rb) - a * a);
   EXPECT_NEAR(signed_area(wedge), sector, 0.06 * sector);  // the thin part behind the edge is cut off
+}
+
+TEST(Fracture, EmpiricalPieceReachesClLcTimesTheSpeedFactorBeyondTheLoad) {
+  // PHYSICS.md §2.1's empirical piece (Wang 2001; Su et al. 2010): R_b = C_l l_c (1 + C_v v_n), with the failure
+  // load still the wedge table's. The load of the Nevel test above (30 deg face, w = 0.2 l_c, theta = 60 deg), at
+  // rest and with the structure moving at 2 m/s along x: the face's normal n = (sin 30, 0, -cos 30) puts
+  // v_n = 2 sin 30 = 1 m/s into the floe. By hand, for h = 1 m (l_c = 14.61 m), C_l = 1/6 and C_v = -0.1 s/m:
+  // l_c/6 = 2.435 m at rest and 0.15 l_c = 2.192 m at 1 m/s, against Nevel's ~0.6 l_c = 8.8 m for this load.
+  const double h = 1.0, lc = lc_by_hand(h), w = 0.2 * lc, theta = kPi / 3;
+  SimulateOptions o = testing::floe_options();
+  o.fracture.piece_size = "empirical";
+  o.fracture.piece_c_l = 1.0 / 6;
+  o.fracture.speed_correction = true;
+  o.fracture.speed_coefficient_spm = -0.1;
+  Rig rig({rect_floe(1, 0, -100, 200, 200, h)}, 60, o);
+  const double dt = rig.model.options.time_step_s;
+  const double alpha = w / (theta * lc), a = alpha * lc;
+  const double fail = std::max(0.226 * 5e5 * h * h, table_pf(alpha) * theta * 5e5 * h * h);
+  const Vec3 p(0.05, 0, 0);
+  for (const double speed : {0.0, 2.0}) {
+    World world(rig.model);
+    world.mutable_state().velocity[0] = Vec3(speed, 0, 0);
+    const double vn = speed * std::sin(kPi / 6);
+    const double rb = lc / 6 * (1 - 0.1 * vn);
+    const auto cuts = find_fractures(
+        world.model(), world.state(), {pushing_contact(p, sloped_normal(30), 1.05 * fail / std::cos(kPi / 6), w, dt)},
+        dt);
+    ASSERT_EQ(cuts.size(), 1u) << speed;
+    const FractureEvent& e = cuts[0].event;
+    EXPECT_NEAR(e.threshold_n, fail, 0.05 * fail) << speed;  // the piece changes, the failure load does not
+    EXPECT_NEAR(e.rb_m, rb, 1e-9 * rb) << speed;
+    ASSERT_EQ(cuts[0].pieces.size(), 2u);
+    const Polygon& wedge = signed_area(cuts[0].pieces[0]) < signed_area(cuts[0].pieces[1]) ? cuts[0].pieces[0]
+                                                                                            : cuts[0].pieces[1];
+    // The wedge's tip lies on the axis, at a + R_b from the apex (a behind the load point): R_b beyond the load.
+    double reach = 0;
+    for (const Vec2& v : wedge) reach = std::max(reach, v.x() - (p.x() - 100));
+    EXPECT_NEAR(reach, rb, 1e-3 * rb) << speed;
+    // Its area is the sector's between radii a and a + R_b about the apex (the sliver behind the ice edge, 0.05 m
+    // behind the load point, is outside the floe).
+    const double sector = 0.5 * theta * ((a + rb) * (a + rb) - a * a);
+    EXPECT_NEAR(signed_area(wedge), sector, 0.06 * sector) << speed;
+  }
 }
 
 TEST(Fracture, SplittingLoadScalesAsKicHSqrtL) {
@@ -335,6 +379,9 @@ TEST(Fracture, BadOptionsNameTheKey) {
       {R"({"fracture": {"wedge_angle_deg": [45, 180]}})", "wedge_angle_deg"},
       {R"({"fracture": {"wedge_angle_deg": [90, 45]}})", "wedge_angle_deg"},
       {R"({"fracture": {"min_piece_area_m2": -1}})", "min_piece_area_m2"},
+      {R"({"fracture": {"piece_size": "wang"}})", "piece_size"},
+      {R"({"fracture": {"piece_c_l": 0}})", "piece_c_l"},
+      {R"({"fracture": {"piece_c_l": 2}})", "piece_c_l"},
       {R"({"fracture": {"theta": 1}})", "theta"},
   };
   for (const auto& [text, key] : bad) {
