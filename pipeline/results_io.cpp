@@ -500,8 +500,10 @@ FrameReplay::FrameReplay(const Results& r, const std::string& source) : r_(r) {
   FLOESIM_REQUIRE(r.frame_offset.size() == r.frames() + 1 && r.frame_offset.front() == 0 &&
                       static_cast<size_t>(r.frame_offset.back()) == r.state_body_id.size(),
                   source, ": /frames/offset does not match /states");
-  for (size_t k = 0; k < r.frames(); ++k) {
+  // Offsets all checked first: a later one that decreases would let an earlier frame's rows run past /states.
+  for (size_t k = 0; k < r.frames(); ++k)
     FLOESIM_REQUIRE(r.frame_offset[k] <= r.frame_offset[k + 1], source, ": /frames/offset decreases at frame ", k);
+  for (size_t k = 0; k < r.frames(); ++k) {
     bool vessel = false;
     for (int64_t row = r.frame_offset[k]; row < r.frame_offset[k + 1]; ++row) {
       const int32_t id = r.state_body_id[static_cast<size_t>(row)];

@@ -181,6 +181,23 @@ TEST(ResultsIo, OnlySeriesReadsThoseAndTimeAsTheWholeReadDoes) {
   fs::remove(a);
 }
 
+TEST(ResultsIo, FrameReplayRefusesOffsetsThatRunPastTheStates) {
+  // Three frames over two state rows, the middle offset past the end: refused before any row is read.
+  Results r = small_results(3);
+  r.frame_time_s = {0.1, 0.2, 0.3};
+  r.frame_offset = {0, 100, 1, 2};
+  r.state_body_id = {0, 0};
+  r.state_position_m.assign(6, 0.0);
+  r.state_quaternion = {1, 0, 0, 0, 1, 0, 0, 0};
+  r.state_in_contact = {0, 0};
+  EXPECT_THROW(FrameReplay(r, "test"), Error);
+  r.frame_offset = {0, 1, 1, 2};  // frame 1 stores nothing, not even the vessel
+  EXPECT_THROW(FrameReplay(r, "test"), Error);
+  r.frame_offset = {0, 1, 2, 2};
+  r.state_body_id = {0, 0};
+  EXPECT_THROW(FrameReplay(r, "test"), Error);  // frame 2 lacks the vessel
+}
+
 TEST(ResultsIo, RefusesInconsistentSeriesAndLeavesNoFile) {
   Results r = small_results(3);
   r.series["time_s"].push_back(9.0);
