@@ -101,7 +101,7 @@ constexpr double kClipTolerance = 1e-9;
 // piece of the overlap's boundary; counting both would double it (e.g. the volume of two floes' common top).
 void clip_faces(const ConvexPart& P, const PartWorld& pw, const Vec3& tp, const ConvexPart& Q, const PartWorld& qw,
                 const Vec3& tq, const Vec3& origin, bool second_side, std::vector<Vec3>& poly, std::vector<Vec3>& tmp,
-                SideSums& out) {
+                std::vector<double>& dist, SideSums& out) {
   const size_t nq = Q.faces.size();
   const Vec3 shift_p = tp - origin, shift_q = tq - origin;
   // Q's box, widened: a face of P entirely outside it is entirely outside Q and clips to nothing, so it is skipped
@@ -125,14 +125,23 @@ void clip_faces(const ConvexPart& P, const PartWorld& pw, const Vec3& tp, const 
     for (size_t g = 0; g < nq && poly.size() >= 3; ++g) {
       const Vec3& qn = qw.n[g];
       const double qd = qw.d[g] + qn.dot(shift_q) + kClipTolerance;
+      // Signed distances first: most planes of Q leave the face whole (nothing to copy) or remove it entirely.
+      const size_t k = poly.size();
+      dist.resize(k);
+      size_t inside = 0;
+      for (size_t i = 0; i < k; ++i) inside += (dist[i] = qn.dot(poly[i]) - qd) <= 0;
+      if (inside == k) continue;
+      if (inside == 0) {
+        poly.clear();
+        break;
+      }
       tmp.swap(poly);
       poly.clear();
-      const size_t k = tmp.size();
-      double sp = qn.dot(tmp[k - 1]) - qd;  // previous vertex (edge tmp[k-1] -> tmp[0] first)
+      double sp = dist[k - 1];  // previous vertex (edge tmp[k-1] -> tmp[0] first)
       for (size_t i = 0; i < k; ++i) {
         const Vec3& p = tmp[i == 0 ? k - 1 : i - 1];
         const Vec3& q = tmp[i];
-        const double sq = qn.dot(q) - qd;
+        const double sq = dist[i];
         if ((sp <= 0) != (sq <= 0)) poly.push_back(p + (sp / (sp - sq)) * (q - p));
         if (sq <= 0) poly.push_back(q);
         sp = sq;
@@ -214,6 +223,7 @@ void row_sums(const SurfacePolygons& s, const Vec3& c, const Vec3& u, const doub
 // Scratch buffers of the patch computation, and the two sides of the last overlap clipped (with `surface`).
 struct PatchScratch {
   std::vector<Vec3> poly, tmp, half;
+  std::vector<double> dist;
   SurfacePolygons surface;
   SideSums sa, sb;
 };
@@ -235,8 +245,8 @@ ContactPatch overlap_patch(const ConvexPart& A, const PartWorld& wa, const Conve
     ps.sa = ps.sb = SideSums{};
     ps.sa.surface = ps.sb.surface = &ps.surface;
     ps.sb.side = 1;
-    clip_faces(A, wa, zero, B, wb, shift_b, origin, false, ps.poly, ps.tmp, ps.sa);
-    clip_faces(B, wb, shift_b, A, wa, zero, origin, true, ps.poly, ps.tmp, ps.sb);
+    clip_faces(A, wa, zero, B, wb, shift_b, origin, false, ps.poly, ps.tmp, ps.dist, ps.sa);
+    clip_faces(B, wb, shift_b, A, wa, zero, origin, true, ps.poly, ps.tmp, ps.dist, ps.sb);
   }
   const SideSums& sa = ps.sa;
   const SideSums& sb = ps.sb;
@@ -301,8 +311,10 @@ ContactPatch overlap_patch(const ConvexPart& A, const PartWorld& wa, const Conve
   ps.surface.clear();
   fa.surface = fb.surface = &ps.surface;
   fb.side = 1;
-  if (side == PatchSide::symmetric || !from_b) clip_faces(A, wa, zero, B, wb, t, origin, false, ps.poly, ps.tmp, fa);
-  if (side == PatchSide::symmetric || from_b) clip_faces(B, wb, t, A, wa, zero, origin, true, ps.poly, ps.tmp, fb);
+  if (side == PatchSide::symmetric || !from_b)
+    clip_faces(A, wa, zero, B, wb, t, origin, false, ps.poly, ps.tmp, ps.dist, fa);
+  if (side == PatchSide::symmetric || from_b)
+    clip_faces(B, wb, t, A, wa, zero, origin, true, ps.poly, ps.tmp, ps.dist, fb);
   double area_eps;
   if (side == PatchSide::symmetric) area_eps = 0.5 * (fa.vec_area - fb.vec_area).dot(r.normal);
   else area_eps = from_b ? -fb.vec_area.dot(r.normal) : fa.vec_area.dot(r.normal);
