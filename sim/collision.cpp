@@ -99,11 +99,30 @@ constexpr double kClipTolerance = 1e-9;
 // per face, a face leaving nothing as soon as one plane has it all outside. second_side: P's faces lying in the
 // plane of a face of Q with the same orientation are skipped, because Q's side (clipped first) already holds that
 // piece of the overlap's boundary; counting both would double it (e.g. the volume of two floes' common top).
+struct ClipScratch {
+  std::vector<Vec3> poly, tmp;
+  std::vector<double> dist;  // signed distances of poly's vertices to the plane being clipped by
+  std::vector<int> planes;   // Q's planes that can cut P
+};
 void clip_faces(const ConvexPart& P, const PartWorld& pw, const Vec3& tp, const ConvexPart& Q, const PartWorld& qw,
-                const Vec3& tq, const Vec3& origin, bool second_side, std::vector<Vec3>& poly, std::vector<Vec3>& tmp,
-                std::vector<double>& dist, SideSums& out) {
+                const Vec3& tq, const Vec3& origin, bool second_side, ClipScratch& cs, SideSums& out) {
+  std::vector<Vec3>& poly = cs.poly;
+  std::vector<Vec3>& tmp = cs.tmp;
+  std::vector<double>& dist = cs.dist;
   const size_t nq = Q.faces.size();
   const Vec3 shift_p = tp - origin, shift_q = tq - origin;
+  // Q's planes that can cut P: a plane with P's whole box inside it (by far more than the round-off of a clipped
+  // vertex) leaves every face of P whole, so it is left out of the clipping (a floe piece against a hull section
+  // of 28 faces is cut by the few facing it). The same polygons result, to the bit.
+  constexpr double kPlaneMargin = 1e-6;
+  const Vec3 pc = 0.5 * (pw.lo + pw.hi) + shift_p, ph = 0.5 * (pw.hi - pw.lo);
+  cs.planes.clear();
+  for (size_t g = 0; g < nq; ++g) {
+    const Vec3& qn = qw.n[g];
+    const double support = qn.dot(pc) + qn.cwiseAbs().dot(ph);
+    if (support - (qw.d[g] + qn.dot(shift_q) + kClipTolerance) > -kPlaneMargin)
+      cs.planes.push_back(static_cast<int>(g));
+  }
   // Q's box, widened: a face of P entirely outside it is entirely outside Q and clips to nothing, so it is skipped
   // before the clipping (most faces of two floes touching at a corner). The margin keeps every face the tolerance
   // of the half-spaces could let in (1e-9 m, more at a sharp corner of Q: up to 1e-9 / sin(half its angle)).
@@ -122,7 +141,8 @@ void clip_faces(const ConvexPart& P, const PartWorld& pw, const Vec3& tp, const 
     }
     poly.clear();
     for (int i : P.faces[f]) poly.push_back(pw.v[i] + shift_p);
-    for (size_t g = 0; g < nq && poly.size() >= 3; ++g) {
+    for (size_t j = 0; j < cs.planes.size() && poly.size() >= 3; ++j) {
+      const int g = cs.planes[j];
       const Vec3& qn = qw.n[g];
       const double qd = qw.d[g] + qn.dot(shift_q) + kClipTolerance;
       // Signed distances first: most planes of Q leave the face whole (nothing to copy) or remove it entirely.
@@ -222,8 +242,8 @@ void row_sums(const SurfacePolygons& s, const Vec3& c, const Vec3& u, const doub
 
 // Scratch buffers of the patch computation, and the two sides of the last overlap clipped (with `surface`).
 struct PatchScratch {
-  std::vector<Vec3> poly, tmp, half;
-  std::vector<double> dist;
+  ClipScratch clip;
+  std::vector<Vec3> half;
   SurfacePolygons surface;
   SideSums sa, sb;
 };
@@ -245,8 +265,8 @@ ContactPatch overlap_patch(const ConvexPart& A, const PartWorld& wa, const Conve
     ps.sa = ps.sb = SideSums{};
     ps.sa.surface = ps.sb.surface = &ps.surface;
     ps.sb.side = 1;
-    clip_faces(A, wa, zero, B, wb, shift_b, origin, false, ps.poly, ps.tmp, ps.dist, ps.sa);
-    clip_faces(B, wb, shift_b, A, wa, zero, origin, true, ps.poly, ps.tmp, ps.dist, ps.sb);
+    clip_faces(A, wa, zero, B, wb, shift_b, origin, false, ps.clip, ps.sa);
+    clip_faces(B, wb, shift_b, A, wa, zero, origin, true, ps.clip, ps.sb);
   }
   const SideSums& sa = ps.sa;
   const SideSums& sb = ps.sb;
@@ -312,9 +332,9 @@ ContactPatch overlap_patch(const ConvexPart& A, const PartWorld& wa, const Conve
   fa.surface = fb.surface = &ps.surface;
   fb.side = 1;
   if (side == PatchSide::symmetric || !from_b)
-    clip_faces(A, wa, zero, B, wb, t, origin, false, ps.poly, ps.tmp, ps.dist, fa);
+    clip_faces(A, wa, zero, B, wb, t, origin, false, ps.clip, fa);
   if (side == PatchSide::symmetric || from_b)
-    clip_faces(B, wb, t, A, wa, zero, origin, true, ps.poly, ps.tmp, ps.dist, fb);
+    clip_faces(B, wb, t, A, wa, zero, origin, true, ps.clip, fb);
   double area_eps;
   if (side == PatchSide::symmetric) area_eps = 0.5 * (fa.vec_area - fb.vec_area).dot(r.normal);
   else area_eps = from_b ? -fb.vec_area.dot(r.normal) : fa.vec_area.dot(r.normal);

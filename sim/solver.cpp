@@ -305,10 +305,13 @@ double sweep_contact(State& state, const SolverBodies& sb, Contact& c, double dt
 
 // How far one exact local update would move each row's velocity (m/s), nothing applied: the violation of the
 // contact law (complementarity, crushing law, Coulomb disk) at the current impulses. Returns the largest over all
-// rows; `sum_sq` gets the sum of squares (the merit the subspace step must lower).
-double law_violation(const State& state, const Island& island, double dt, bool use_bias, double* sum_sq = nullptr) {
+// rows; `sum_sq` gets the sum of squares (the merit the subspace step must lower). The sum only grows, so once it
+// reaches `stop_at` the rest cannot bring it below: the measurement stops there (a failed subspace step is known
+// as soon as its first rows exceed the merit before it), and `sum_sq` is then at least `stop_at`.
+double law_violation(const State& state, const Island& island, double dt, bool use_bias, double* sum_sq = nullptr,
+                     double stop_at = std::numeric_limits<double>::infinity()) {
   double worst = 0, sq = 0;
-  for (int i = 0; i < island.n; ++i) {
+  for (int i = 0; i < island.n && !(sq >= stop_at); ++i) {
     const Contact& c = island[i];
     const double pn = normal_update(c, rel_velocity(state, c, c.normal), dt, use_bias);
     double p1, p2;
@@ -475,7 +478,7 @@ int subspace_step(const SolverBodies& sb, State& state, const Island& island, do
       const double s = pt > lim ? (pt > 0 ? lim / pt : 0.0) : 1.0;
       set_impulses(c, pn, s * p.y(), s * p.z());
     }
-    law_violation(state, island, dt, use_bias, &after);
+    law_violation(state, island, dt, use_bias, &after, before);
     if (after < before) {
       applied_mu = mu;
       break;
