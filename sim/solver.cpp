@@ -67,23 +67,19 @@ std::map<std::pair<int, int>, double> crushing_law(const SimulateOptions& o, std
   return stiffness;
 }
 
-// Applies an impulse p along a row to the two bodies: a gets -p, b gets +p; ma, mb = M^-1 d and ia, ib =
-// I^-1 (r x d) of the row per body (prepare_contacts). A fixed body (a wall) is not written: islands solved in
-// parallel may share it.
-inline void apply(State& s, const Contact& c, const Vec3& ma, const Vec3& mb, const Vec3& ia, const Vec3& ib,
+// Applies an impulse p along the row (d, ia, ib) to the two bodies: a gets -p, b gets +p. A fixed body (a wall)
+// is not written: islands solved in parallel may share it.
+inline void apply(State& s, const SolverBodies& sb, const Contact& c, const Vec3& d, const Vec3& ia, const Vec3& ib,
                   double p) {
   if (!c.fixed_a) {
-    s.velocity[c.body_a] -= p * ma;
+    s.velocity[c.body_a] -= p * (sb.inv_mass[c.body_a] * d);
     s.angular_velocity[c.body_a] -= p * ia;
   }
   if (!c.fixed_b) {
-    s.velocity[c.body_b] += p * mb;
+    s.velocity[c.body_b] += p * (sb.inv_mass[c.body_b] * d);
     s.angular_velocity[c.body_b] += p * ib;
   }
 }
-inline void apply_normal(State& s, const Contact& c, double p) { apply(s, c, c.ma_n, c.mb_n, c.ia_n, c.ib_n, p); }
-inline void apply_t1(State& s, const Contact& c, double p) { apply(s, c, c.ma_t1, c.mb_t1, c.ia_t1, c.ib_t1, p); }
-inline void apply_t2(State& s, const Contact& c, double p) { apply(s, c, c.ma_t2, c.mb_t2, c.ia_t2, c.ib_t2, p); }
 
 // A body the contact impulses cannot move (zero inverse mass and inertia: a domain wall).
 bool is_fixed(const SolverBodies& sb, int b) { return sb.inv_mass[b].isZero(0) && sb.inv_inertia_world[b].isZero(0); }
@@ -176,19 +172,17 @@ ContactIslands prepare_contacts(const Model& model, const SolverBodies& sb, Stat
     const Mat3& Ia = sb.inv_inertia_world[c.body_a];
     const Mat3& Ib = sb.inv_inertia_world[c.body_b];
     const Mat3 im = sb.inv_mass[c.body_a] + sb.inv_mass[c.body_b];  // translational part of W (added mass: a tensor)
-    auto row = [&](const Vec3& d, Vec3& ma, Vec3& mb, Vec3& ia, Vec3& ib) {
+    auto row = [&](const Vec3& d, Vec3& ia, Vec3& ib) {
       const Vec3 rad = c.ra.cross(d), rbd = c.rb.cross(d);
-      ma = sb.inv_mass[c.body_a] * d;
-      mb = sb.inv_mass[c.body_b] * d;
       ia = Ia * rad;
       ib = Ib * rbd;
       const double w = d.dot(im * d) + rad.dot(ia) + rbd.dot(ib);
       return w > 0 ? 1.0 / w : 0.0;
     };
-    c.mass_n = row(c.normal, c.ma_n, c.mb_n, c.ia_n, c.ib_n);
+    c.mass_n = row(c.normal, c.ia_n, c.ib_n);
     c.inv_mass_n = c.mass_n > 0 ? 1.0 / c.mass_n : 0.0;
-    c.mass_t1 = row(c.t1, c.ma_t1, c.mb_t1, c.ia_t1, c.ib_t1);
-    c.mass_t2 = row(c.t2, c.ma_t2, c.mb_t2, c.ia_t2, c.ib_t2);
+    c.mass_t1 = row(c.t1, c.ia_t1, c.ib_t1);
+    c.mass_t2 = row(c.t2, c.ia_t2, c.ib_t2);
     // Bias = smallest allowed normal velocity. Rigid: push out the overlap beyond the slop at ERP per step (capped);
     // a speculative gap allows approaching by gap/dt. Crushing rows never push out (PHYSICS.md §1.8(c)); a pair
     // backed off from its crushed depth approaches over the gap freely.
@@ -232,9 +226,9 @@ ContactIslands prepare_contacts(const Model& model, const SolverBodies& sb, Stat
       c.pt1 *= s;
       c.pt2 *= s;
     }
-    apply_normal(state, c, c.pn);
-    apply_t1(state, c, c.pt1);
-    apply_t2(state, c, c.pt2);
+    apply(state, sb, c, c.normal, c.ia_n, c.ib_n, c.pn);
+    apply(state, sb, c, c.t1, c.ia_t1, c.ib_t1, c.pt1);
+    apply(state, sb, c, c.t2, c.ia_t2, c.ib_t2, c.pt2);
   }
   return contact_islands(contacts, sb.inv_mass.size());
 }
@@ -282,7 +276,7 @@ double sweep_contact(State& state, const SolverBodies& sb, Contact& c, double dt
   const double pn = normal_update(c, rel_velocity(state, c, c.normal), dt, use_bias);
   const double dpn = pn - c.pn;
   if (dpn != 0) {
-    apply_normal(state, c, dpn);
+    apply(state, sb, c, c.normal, c.ia_n, c.ib_n, dpn);
     c.pn = pn;
     change = std::abs(dpn) * c.inv_mass_n;
   }
@@ -291,11 +285,11 @@ double sweep_contact(State& state, const SolverBodies& sb, Contact& c, double dt
   friction_update(c, c.t1.dot(dv), c.t2.dot(dv), p1, p2);
   const double d1 = p1 - c.pt1, d2 = p2 - c.pt2;
   if (d1 != 0) {
-    apply_t1(state, c, d1);
+    apply(state, sb, c, c.t1, c.ia_t1, c.ib_t1, d1);
     change = std::max(change, std::abs(d1) / std::max(c.mass_t1, 1e-300));
   }
   if (d2 != 0) {
-    apply_t2(state, c, d2);
+    apply(state, sb, c, c.t2, c.ia_t2, c.ib_t2, d2);
     change = std::max(change, std::abs(d2) / std::max(c.mass_t2, 1e-300));
   }
   c.pt1 = p1;
@@ -443,9 +437,9 @@ int subspace_step(const SolverBodies& sb, State& state, const Island& island, do
     old[r] = Vec3(c.pn, c.pt1, c.pt2);
   }
   auto set_impulses = [&](Contact& c, double pn, double p1, double p2) {
-    apply_normal(state, c, pn - c.pn);
-    apply_t1(state, c, p1 - c.pt1);
-    apply_t2(state, c, p2 - c.pt2);
+    apply(state, sb, c, c.normal, c.ia_n, c.ib_n, pn - c.pn);
+    apply(state, sb, c, c.t1, c.ia_t1, c.ib_t1, p1 - c.pt1);
+    apply(state, sb, c, c.t2, c.ia_t2, c.ib_t2, p2 - c.pt2);
     c.pn = pn;
     c.pt1 = p1;
     c.pt2 = p2;

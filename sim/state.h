@@ -59,9 +59,6 @@ struct Contact {
   Vec3 ia_n = Vec3::Zero(), ib_n = Vec3::Zero();    // I^-1 (r x n), world
   Vec3 ia_t1 = Vec3::Zero(), ib_t1 = Vec3::Zero();
   Vec3 ia_t2 = Vec3::Zero(), ib_t2 = Vec3::Zero();
-  Vec3 ma_n = Vec3::Zero(), mb_n = Vec3::Zero();    // M^-1 n, world (the translational inverse mass is a tensor)
-  Vec3 ma_t1 = Vec3::Zero(), mb_t1 = Vec3::Zero();
-  Vec3 ma_t2 = Vec3::Zero(), mb_t2 = Vec3::Zero();
   double mass_n = 0, mass_t1 = 0, mass_t2 = 0;       // effective masses 1/W of the rows
   double bias = 0;                                    // smallest allowed normal velocity (m/s); crushing:
                                                       // -crush_gap_m / dt (free approach to the crushed depth)
