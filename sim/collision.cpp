@@ -134,9 +134,13 @@ void clip_faces(const ConvexPart& P, const PartWorld& pw, const Vec3& tp, const 
     if (second_side) {
       const double df = pw.d[f] + pw.n[f].dot(shift_p);
       bool coplanar = false;
-      for (size_t g = 0; g < nq && !coplanar; ++g)
+      // Only Q's planes that can cut P: a face of P lying in a plane of Q touches that plane, so P's box is not
+      // inside it by the planes' margin.
+      for (size_t j = 0; j < cs.planes.size() && !coplanar; ++j) {
+        const int g = cs.planes[j];
         coplanar = pw.n[f].dot(qw.n[g]) > 1 - 1e-12 &&
                    std::abs(df - (qw.d[g] + qw.n[g].dot(shift_q))) <= kClipTolerance;
+      }
       if (coplanar) continue;
     }
     poly.clear();
@@ -574,13 +578,14 @@ struct CollisionWorld::Impl {
   }
 
   // Separation of the deepest vertex of `other` below each face of `ref`; returns the face of largest separation.
+  // A face whose deepest vertex so far is already no better than the best face is left at once.
   static int best_face(const ConvexPart& ref, const PartWorld& rw, const PartWorld& other, double& sep) {
     int best = -1;
     sep = -1e300;
     for (size_t f = 0; f < ref.faces.size(); ++f) {
       if (ref.face_internal[f]) continue;  // not a surface of the body
       double s = 1e300;
-      for (const Vec3& v : other.v) s = std::min(s, rw.n[f].dot(v) - rw.d[f]);
+      for (size_t i = 0; i < other.v.size() && s > sep; ++i) s = std::min(s, rw.n[f].dot(other.v[i]) - rw.d[f]);
       if (s > sep) {
         sep = s;
         best = static_cast<int>(f);
@@ -595,6 +600,21 @@ struct CollisionWorld::Impl {
     int fa, fb;
     double sa, sb;
   };
+  // Whether a face of one part has the whole other part in front of it (the parts are apart): face_axes's
+  // sa > 0 || sb > 0, without finding the best axes (a compliant pair needs only this).
+  static bool face_separates(const ConvexPart& ref, const PartWorld& rw, const PartWorld& other) {
+    for (size_t f = 0; f < ref.faces.size(); ++f) {
+      if (ref.face_internal[f]) continue;
+      bool all_in_front = true;
+      for (size_t i = 0; i < other.v.size() && all_in_front; ++i) all_in_front = rw.n[f].dot(other.v[i]) - rw.d[f] > 0;
+      if (all_in_front) return true;
+    }
+    return false;
+  }
+  bool separated(const PairCandidate& pc) const {
+    return face_separates(model.parts[pc.part_a], world[pc.part_a], world[pc.part_b]) ||
+           face_separates(model.parts[pc.part_b], world[pc.part_b], world[pc.part_a]);
+  }
   FaceAxes face_axes(const PairCandidate& pc) const {
     FaceAxes f;
     f.fa = best_face(model.parts[pc.part_a], world[pc.part_a], world[pc.part_b], f.sa);
@@ -857,12 +877,12 @@ void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out
     for (int i = begin; i < end; ++i) {
       const PairCandidate& pc = m.pairs[i];
       // A separating face axis proves the parts apart: most box-overlapping neighbours end here, before GJK.
-      const Impl::FaceAxes axes = m.face_axes(pc);
-      if (axes.sa > 0 || axes.sb > 0) continue;
       if (m.is_compliant(pc)) {
-        if (m.crushing_contact(pc, sc, sc.contacts)) ++sc.hits, ++sc.crushing;
+        if (!m.separated(pc) && m.crushing_contact(pc, sc, sc.contacts)) ++sc.hits, ++sc.crushing;
         continue;
       }
+      const Impl::FaceAxes axes = m.face_axes(pc);
+      if (axes.sa > 0 || axes.sb > 0) continue;
       fcl::CollisionResultd res;
       fcl::collide(m.objects[pc.part_a].get(), m.objects[pc.part_b].get(), req, res);
       if (!res.isCollision() || res.numContacts() == 0) continue;
