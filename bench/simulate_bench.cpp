@@ -258,6 +258,19 @@ double run_field(int scale, const BenchOptions& bo, const HullModel& hull, bool 
               st.mean_awake_floes, st.mean_contacts, st.mean_pairs, st.mean_iterations);
   std::printf("  steps %ld, wall %.2f s, %.3f ms/step, %.2f simulated s per wall s (%d threads)\n", st.steps,
               st.wall_s, 1e3 * st.wall_s / st.steps, rtf, bo.threads);
+  {
+    // How well the contact solver converged (the results' solver series): a faster step must not be a worse answer.
+    auto mean = [&](const char* name) {
+      const auto& x = r.get(name);
+      double sum = 0;
+      for (double v : x) sum += v;
+      return x.empty() ? 0.0 : sum / static_cast<double>(x.size());
+    };
+    std::printf("  solver (mean per step): capped %.3f (relax %.3f), complementarity %.3g m/s (relax %.3g), "
+                "relax sweeps %.1f, subspace solves %.2f\n",
+                mean("solver_capped"), mean("relax_capped"), mean("solver_complementarity"),
+                mean("relax_complementarity"), mean("relax_iterations"), mean("solver_subspace_solves"));
+  }
   std::printf("  stage ms/step:");
   for (int i = 0; i < kStageCount; ++i) std::printf(" %s %.3f", stage_name(i), 1e3 * st.stage_s[i] / st.steps);
   std::printf("\n  results: record %.2f s (in the wall time, %.1f %%), write %.2f s (%.1f MB, %zu frames)\n",
