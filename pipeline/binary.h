@@ -48,8 +48,8 @@ class ByteWriter {
 class ByteReader {
  public:
   // `what` names the file in errors ("...: damaged or not a floesim checkpoint").
-  ByteReader(const std::string& bytes, std::string what) : p_(bytes.data()), end_(bytes.data() + bytes.size()),
-                                                           what_(std::move(what)) {}
+  ByteReader(const std::string& bytes, std::string what)
+      : begin_(bytes.data()), p_(bytes.data()), end_(bytes.data() + bytes.size()), what_(std::move(what)) {}
   template <class T>
   T pod() {
     static_assert(std::is_arithmetic_v<T>);
@@ -80,6 +80,14 @@ class ByteReader {
     if (n) std::memcpy(v.data() + at, p_, n * sizeof(T));
     p_ += n * sizeof(T);
   }
+  // Passes over one vec() record: its element count, its elements starting at `*at` bytes from the start.
+  template <class T>
+  size_t vec_skip(size_t* at = nullptr) {
+    const size_t n = size(sizeof(T));
+    if (at) *at = offset();
+    p_ += n * sizeof(T);
+    return n;
+  }
   template <class T>
   std::vector<T> vec() {
     std::vector<T> v;
@@ -96,12 +104,14 @@ class ByteReader {
     return q;
   }
   bool done() const { return p_ == end_; }
+  size_t offset() const { return static_cast<size_t>(p_ - begin_); }  // bytes read so far
   const std::string& what() const { return what_; }
 
  private:
   void need(size_t n) const {
     FLOESIM_REQUIRE(static_cast<size_t>(end_ - p_) >= n, what_, ": damaged (it ends too early)");
   }
+  const char* begin_;
   const char* p_;
   const char* end_;
   std::string what_;

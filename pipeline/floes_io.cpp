@@ -124,6 +124,9 @@ FloeField floes_from_geojson(const nlohmann::json& j, const std::string& file) {
                       ": a vertex is not [x, y]: ", pt.dump());
       const double x = pt[0].get<double>(), y = pt[1].get<double>();
       FLOESIM_REQUIRE(std::isfinite(x) && std::isfinite(y), fw, ": a vertex is not finite");
+      FLOESIM_REQUIRE(std::abs(x) <= kMaxWorldCoordinateM && std::abs(y) <= kMaxWorldCoordinateM, fw, ": vertex ",
+                      pt.dump(), " is more than ", kMaxWorldCoordinateM / 1e3,
+                      " km from the origin; give the floes in metres of a local or projected frame");
       f.outline.emplace_back(x, y);
     }
     if (f.outline.size() > 1 && f.outline.front() == f.outline.back()) f.outline.pop_back();

@@ -10,6 +10,10 @@ using Vec2 = Eigen::Vector2d;
 using Polygon = std::vector<Vec2>;  // open ring (last vertex != first)
 
 inline constexpr double kPi = 3.14159265358979323846;  // the one copy (geometry, hydrodynamics, imaging, tests)
+// The farthest from the origin a floe vertex, the vessel or a rectangle of the options may be, m. Projected
+// coordinates such as UTM (northings up to 10,000 km) fit; beyond it a position is a mistake, and a far larger
+// one overflows the bounding volumes of the collision detection (fuzz_checkpoint found such a crash in fcl).
+inline constexpr double kMaxWorldCoordinateM = 1e7;
 
 double point_segment_distance(const Vec2& v, const Vec2& p, const Vec2& q);  // to the segment pq
 double signed_area(const Polygon& p);  // > 0 for counter-clockwise

@@ -88,6 +88,11 @@ void Results::push(const std::string& name, std::initializer_list<double> row) {
   v.insert(v.end(), row.begin(), row.end());
 }
 
+ResultsSeries::ResultsSeries(const Results& r) : r_(r) {
+  FLOESIM_REQUIRE(r.series_first_step == 0, "internal: these results hold the series from step ",
+                  r.series_first_step, " on; read them through the SeriesSource that holds the earlier steps");
+}
+
 const std::vector<double>& Results::get(const std::string& name) const {
   auto it = series.find(name);
   if (it == series.end()) throw Error("results have no series '" + name + "'");
@@ -306,13 +311,14 @@ namespace {
 
 void write_results(const std::filesystem::path& path, const Results& r) {
   const std::string file = path.string();
-  const size_t n = r.steps();
-  for (const auto& f : series_fields()) {
-    auto it = r.series.find(f.name);
-    FLOESIM_REQUIRE(it != r.series.end(), file, ": internal: series ", f.name, " was not recorded");
-    FLOESIM_REQUIRE(it->second.size() == n * f.cols, file, ": internal: series ", f.name, " has ",
-                    it->second.size(), " values, expected ", n, " x ", f.cols);
-  }
+  for (const auto& f : series_fields())  // before ResultsSeries::get would call a missing one an unknown series
+    FLOESIM_REQUIRE(r.series.count(f.name), file, ": internal: series ", f.name, " was not recorded");
+  write_results(path, r, ResultsSeries(r));
+}
+
+void write_results(const std::filesystem::path& path, const Results& r, const SeriesSource& series) {
+  const std::string file = path.string();
+  const size_t n = series.steps();
   FLOESIM_REQUIRE(r.frame_offset.size() == r.frame_time_s.size() + 1, file, ": internal: frame offsets");
   FLOESIM_REQUIRE(r.floe_level_ice.empty() || r.floe_level_ice.size() == r.floe_id.size(), file,
                   ": internal: floe_level_ice has ", r.floe_level_ice.size(), " rows for ", r.floe_id.size(), " floes");
@@ -339,8 +345,12 @@ void write_results(const std::filesystem::path& path, const Results& r) {
     for (const char* g : {"/series", "/frames", "/states", "/geometry", "/fracture"}) {
       H5Id gid(H5Gcreate2(fid, g, H5P_DEFAULT, gcpl, H5P_DEFAULT), H5Gclose);
     }
-    for (const auto& f : series_fields())
-      write_ds(fid, std::string("/series/") + f.name, r.series.at(f.name), f.cols, file);
+    for (const auto& f : series_fields()) {  // one series in memory at a time (see SeriesSource)
+      const std::vector<double> values = series.get(f.name);
+      FLOESIM_REQUIRE(values.size() == n * f.cols, file, ": internal: series ", f.name, " has ", values.size(),
+                      " values, expected ", n, " x ", f.cols);
+      write_ds(fid, std::string("/series/") + f.name, values, f.cols, file);
+    }
     write_ds(fid, "/frames/time_s", r.frame_time_s, 1, file);
     write_ds(fid, "/frames/offset", r.frame_offset, 1, file);
     write_ds(fid, "/states/body_id", r.state_body_id, 1, file);

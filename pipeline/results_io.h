@@ -84,6 +84,8 @@ const FieldSpec& series_field(const std::string& name);  // Error if unknown
 
 struct Results {
   std::map<std::string, std::vector<double>> series;  // name -> row-major [steps x cols]
+  // The step of series' first rows: 0, unless a long run left the earlier rows on disk (see SeriesSource).
+  size_t series_first_step = 0;
 
   std::vector<double> frame_time_s;
   std::vector<int64_t> frame_offset;  // size frames+1
@@ -162,7 +164,33 @@ class FrameReplay {
   std::vector<int32_t> floes_;
 };
 
-// Checks consistency (every series has steps x cols values, offsets monotone, ...) and writes atomically.
+// The per-step series of a run, one at a time. A long simulation keeps only the rows since its last checkpoint in
+// Results::series and leaves the earlier ones on disk in the checkpoint's chunks (sim/checkpoint.h): all the series
+// together are 72 values, 0.58 kB, per step (207 MB per simulated hour at 0.01 s), one of them at most 6 values.
+// The results writer and the summary read them through this, one series at a time, so that a run's memory does not
+// hold them all.
+class SeriesSource {
+ public:
+  virtual ~SeriesSource() = default;
+  virtual size_t steps() const = 0;
+  // The whole series, row-major [steps x cols]; Error if the layout has no such series.
+  virtual std::vector<double> get(const std::string& name) const = 0;
+};
+
+// The series as Results::series holds them (all rows in memory).
+class ResultsSeries final : public SeriesSource {
+ public:
+  explicit ResultsSeries(const Results& r);  // Error if r.series do not start at step 0
+  size_t steps() const override { return r_.steps(); }
+  std::vector<double> get(const std::string& name) const override { return r_.get(name); }
+
+ private:
+  const Results& r_;
+};
+
+// Checks consistency (every series has steps x cols values, offsets monotone, ...) and writes atomically. The
+// series come from `series` (one at a time), or from r.series.
+void write_results(const std::filesystem::path& file, const Results& r, const SeriesSource& series);
 void write_results(const std::filesystem::path& file, const Results& r);
 // Reads and validates; errors name the file and the dataset. `only_series` (non-empty) reads just those series
 // (and time_s): a reader that needs one series of a long run need not hold them all (72 values, 0.58 kB, per step).

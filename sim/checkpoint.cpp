@@ -37,6 +37,9 @@ void for_each_recorded(R& r, F&& f) {
   f("state_in_contact", r.state_in_contact);
 }
 
+// The recorded arrays that are series: the first ones of for_each_recorded.
+bool is_series(size_t array) { return array < series_fields().size(); }
+
 std::vector<size_t> recorded_sizes(const Results& r) {
   std::vector<size_t> n;
   for_each_recorded(r, [&](const char*, const auto& v) { n.push_back(v.size()); });
@@ -125,17 +128,20 @@ nlohmann::json keyed(nlohmann::json p) {
 
 // The results read back must be those of a run at `step`: simulate() goes on appending to them, and the results
 // writer and every reader after it index the frames' states through frame_offset. Equal totals (the marks) do not
-// say that the arrays agree with each other.
-void require_results_at_step(const Results& r, long step, long every, const std::string& file) {
+// say that the arrays agree with each other. `series_values`: each series' values read (in memory or on disk).
+void require_results_at_step(const Results& r, const std::vector<size_t>& series_values, long step, long every,
+                             const std::string& file) {
   const auto damaged = [&](const std::string& what) {
     return Error(file + ": damaged (" + what + "); delete the checkpoint folder, or run without --resume");
   };
   if (step < 0) throw damaged("negative step " + std::to_string(step));
-  for (const FieldSpec& f : series_fields())
-    if (r.series.at(f.name).size() != static_cast<size_t>(step) * f.cols)
-      throw damaged(std::string("the series ") + f.name + " holds " + std::to_string(r.series.at(f.name).size()) +
+  for (size_t k = 0; k < series_fields().size(); ++k) {
+    const FieldSpec& f = series_fields()[k];
+    if (series_values[k] != static_cast<size_t>(step) * f.cols)
+      throw damaged(std::string("the series ") + f.name + " holds " + std::to_string(series_values[k]) +
                     " values, a run at step " + std::to_string(step) + " has " +
                     std::to_string(static_cast<size_t>(step) * f.cols));
+  }
   const size_t frames = every > 0 ? static_cast<size_t>(step / every) : 0, R = r.state_body_id.size();
   if (r.frame_time_s.size() != frames || r.frame_offset.size() != frames + 1)
     throw damaged("it holds " + std::to_string(r.frame_time_s.size()) + " frames, a run at step " +
@@ -160,14 +166,16 @@ void remove_checkpoint(const fs::path& dir) {
   fs::remove_all(dir, ec);
 }
 
-Checkpointer::Checkpointer(fs::path dir, nlohmann::json provenance)
-    : dir_(std::move(dir)), provenance_(std::move(provenance)), key_(checkpoint_key(provenance_)) {
+Checkpointer::Checkpointer(fs::path dir, nlohmann::json provenance, bool spill_series)
+    : dir_(std::move(dir)), provenance_(std::move(provenance)), key_(checkpoint_key(provenance_)),
+      spill_series_(spill_series) {
   // Temporaries of a checkpoint write that was killed (one simulate runs in a folder at a time).
   remove_stale_temporaries(dir_);
 }
 
 void Checkpointer::start_fresh(const Results& r, std::ostream* log) {
   marks_ = recorded_sizes(r);
+  on_disk_.assign(marks_.size(), 0);
   const fs::path info = dir_ / "checkpoint.json";
   if (log && fs::exists(info)) {
     std::string at;
@@ -207,7 +215,9 @@ std::unique_ptr<World> Checkpointer::resume(const Model& model, Results& r, Reco
                     &sums.crushing, &sums.record_s, &sums.wall_s})
     *x = in.pod<double>();
 
-  // The results so far: the chunks in order, each checked against the hash the checkpoint names.
+  // The results so far: the chunks in order, each checked against the hash the checkpoint names (with
+  // spill_series, the series are only counted: CheckpointSeries reads them when the results are written).
+  std::vector<size_t> on_disk(marks.size(), 0);
   for (size_t i = 0; i < chunks; ++i) {
     const fs::path rf = records_file(dir_, i + 1);
     FLOESIM_REQUIRE(fs::exists(rf), rf.string(), ": missing; the checkpoint needs it (delete the checkpoint folder, "
@@ -217,17 +227,25 @@ std::unique_ptr<World> Checkpointer::resume(const Model& model, Results& r, Reco
     FLOESIM_REQUIRE(rr.str() == key_ && rr.size() == i + 1, rf.string(), ": belongs to another run");
     rr.pod<int64_t>();  // first and last step, for people reading the file
     rr.pod<int64_t>();
+    size_t k = 0;
     for_each_recorded(r, [&](const char* name, auto& v) {
       FLOESIM_REQUIRE(rr.str() == name, rf.string(), ": damaged (expected the array ", name, ")");
-      rr.vec_append(v);
+      if (spill_series_ && is_series(k) && k < on_disk.size())
+        on_disk[k] += rr.template vec_skip<typename std::decay_t<decltype(v)>::value_type>();
+      else
+        rr.vec_append(v);
+      ++k;
     });
     FLOESIM_REQUIRE(rr.done(), rf.string(), ": damaged (bytes after the last array)");
   }
-  const std::vector<size_t> sizes = recorded_sizes(r);
-  FLOESIM_REQUIRE(sizes.size() == marks.size() && std::equal(sizes.begin(), sizes.end(), marks.begin()),
-                  file.string(), ": damaged (its chunks do not add up to the results it recorded)");
+  std::vector<size_t> sizes = recorded_sizes(r);
+  FLOESIM_REQUIRE(sizes.size() == marks.size(), file.string(), ": damaged (it records ", marks.size(),
+                  " arrays, this version ", sizes.size(), ")");
+  for (size_t k = 0; k < sizes.size(); ++k) sizes[k] += on_disk[k];
+  FLOESIM_REQUIRE(std::equal(sizes.begin(), sizes.end(), marks.begin()), file.string(),
+                  ": damaged (its chunks do not add up to the results it recorded)");
 
-  require_results_at_step(r, step, model.options.output_every(), file.string());
+  require_results_at_step(r, sizes, step, model.options.output_every(), file.string());
 
   std::unique_ptr<World> world = World::restore(model, in);
   FLOESIM_REQUIRE(in.done(), file.string(), ": damaged (bytes after the world)");
@@ -245,6 +263,7 @@ std::unique_ptr<World> Checkpointer::resume(const Model& model, Results& r, Reco
   // Chunks after the last one named: a checkpoint that was being written when the run stopped.
   for (size_t i = chunks + 1; fs::exists(records_file(dir_, i)); ++i) fs::remove(records_file(dir_, i));
   marks_ = sizes;
+  on_disk_ = on_disk;
   chunks_ = hashes;
   last_step_ = step;
   replaced_old_ = true;
@@ -254,7 +273,7 @@ std::unique_ptr<World> Checkpointer::resume(const Model& model, Results& r, Reco
   return world;
 }
 
-void Checkpointer::save(const World& world, const Results& r, const RecorderSums& sums) {
+void Checkpointer::save(const World& world, Results& r, const RecorderSums& sums) {
   try {
     ensure_directory(dir_);
     if (!replaced_old_) {
@@ -271,11 +290,12 @@ void Checkpointer::save(const World& world, const Results& r, const RecorderSums
     rec.pod<int64_t>(last_step_ + 1);
     rec.pod<int64_t>(step);
     size_t i = 0;
-    std::vector<size_t> sizes;
+    std::vector<size_t> sizes;  // each array's values so far, in memory or on disk
     for_each_recorded(r, [&](const char* name, const auto& v) {
       rec.str(name);
-      rec.vec(v, marks_[i++]);
-      sizes.push_back(v.size());
+      rec.vec(v, marks_[i] - on_disk_[i]);
+      sizes.push_back(on_disk_[i] + v.size());
+      ++i;
     });
     const std::string hash = write_blob(records_file(dir_, chunks_.size() + 1), kRecordsMagic, rec.bytes());
     // 2. The world and the list of chunks: this rename is the moment the new checkpoint exists.
@@ -297,6 +317,13 @@ void Checkpointer::save(const World& world, const Results& r, const RecorderSums
     chunks_ = std::move(chunks);
     marks_ = std::move(sizes);
     last_step_ = step;
+    if (spill_series_) {  // the chunk holds them now: out of memory
+      for (size_t k = 0; k < series_fields().size(); ++k) {
+        r.series.at(series_fields()[k].name).clear();
+        on_disk_[k] = marks_[k];
+      }
+      r.series_first_step = static_cast<size_t>(step);
+    }
     // 3. For people and the runner's messages.
     const nlohmann::json info = {{"format", "floesim-checkpoint/1"},
                                  {"time_s", world.state().time_s},
@@ -311,6 +338,74 @@ void Checkpointer::save(const World& world, const Results& r, const RecorderSums
     throw Error(std::string("writing the checkpoint: ") + e.what() +
                 " (or set simulate.checkpoint_interval_s = 0 to run without checkpoints)");
   }
+}
+
+CheckpointSeries::CheckpointSeries(const fs::path& dir, const nlohmann::json& provenance, long steps_on_disk,
+                                   const Results& tail)
+    : tail_(tail), steps_on_disk_(static_cast<size_t>(std::max(0L, steps_on_disk))) {
+  FLOESIM_REQUIRE(tail.series_first_step == steps_on_disk_, "internal: the series in memory start at step ",
+                  tail.series_first_step, ", not at the ", steps_on_disk_, " steps on disk");
+  if (steps_on_disk_ == 0) return;
+  const fs::path file = dir / "checkpoint.bin";
+  const auto gone = [&](const std::string& what) {
+    return Error(file.string() + ": " + what + "; the run's series before it cannot be read back (the checkpoint "
+                 "folder must stay as the run left it until its results are written): run again");
+  };
+  if (!fs::exists(file)) throw gone("missing");
+  const std::string payload = read_blob(file, kCheckpointMagic);
+  ByteReader in(payload, file.string());
+  if (in.str() != checkpoint_key(provenance)) throw gone("is another run's checkpoint");
+  in.str();  // the provenance
+  if (in.pod<int64_t>() != static_cast<int64_t>(steps_on_disk_)) throw gone("is at another step than this run's last");
+  const size_t chunks = in.size(kHashChars);
+  std::vector<std::string> hashes;
+  for (size_t i = 0; i < chunks; ++i) hashes.push_back(in.str());
+  const size_t header = std::string(kRecordsMagic).size();
+  for (size_t i = 0; i < chunks; ++i) {
+    const fs::path rf = records_file(dir, i + 1);
+    if (!fs::exists(rf)) throw gone(rf.filename().string() + " is missing");
+    const std::string rp = read_blob(rf, kRecordsMagic, hashes[i]);
+    ByteReader rr(rp, rf.string());
+    rr.str();  // the key, the chunk's number, its first and last step
+    rr.size();
+    rr.pod<int64_t>();
+    rr.pod<int64_t>();
+    for (const FieldSpec& f : series_fields()) {  // the series come first in a chunk (for_each_recorded)
+      FLOESIM_REQUIRE(rr.str() == f.name, rf.string(), ": damaged (expected the array ", f.name, ")");
+      size_t at = 0;
+      const size_t n = rr.vec_skip<double>(&at);
+      segments_[f.name].push_back({rf, header + at, n});
+    }
+  }
+  for (const FieldSpec& f : series_fields()) {
+    size_t n = 0;
+    for (const Segment& s : segments_[f.name]) n += s.count;
+    if (n != steps_on_disk_ * f.cols)
+      throw gone(std::string("its chunks hold ") + std::to_string(n) + " values of " + f.name + ", not " +
+                 std::to_string(steps_on_disk_) + " x " + std::to_string(f.cols));
+  }
+}
+
+size_t CheckpointSeries::steps() const { return steps_on_disk_ + tail_.steps(); }
+
+std::vector<double> CheckpointSeries::get(const std::string& name) const {
+  const FieldSpec& f = series_field(name);
+  std::vector<double> v;
+  v.reserve(steps() * f.cols);
+  const auto it = segments_.find(name);
+  if (it != segments_.end())
+    for (const Segment& s : it->second) {
+      std::ifstream in(s.file, std::ios::binary);
+      in.seekg(static_cast<std::streamoff>(s.offset));
+      const size_t at = v.size();
+      v.resize(at + s.count);
+      in.read(reinterpret_cast<char*>(v.data() + at), static_cast<std::streamsize>(s.count * sizeof(double)));
+      FLOESIM_REQUIRE(in, s.file.string(), ": cannot read back the series ", name, " (the file changed or went away "
+                      "while the run was writing its results): run again");
+    }
+  const std::vector<double>& t = tail_.get(name);
+  v.insert(v.end(), t.begin(), t.end());
+  return v;
 }
 
 }  // namespace floesim::sim

@@ -20,9 +20,11 @@
 // other inputs or settings is refused, naming what differs.
 #pragma once
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -49,10 +51,13 @@ void remove_checkpoint(const std::filesystem::path& dir);
 class Checkpointer {
  public:
   // `dir`: OUT/checkpoint; `provenance`: the stage's (make_provenance), whose key identifies the run.
-  Checkpointer(std::filesystem::path dir, nlohmann::json provenance);
+  // `spill_series`: the per-step series written to a chunk leave memory (save empties Results::series, resume reads
+  // none back): a long run's memory then holds one checkpoint interval of them; CheckpointSeries reads them back.
+  Checkpointer(std::filesystem::path dir, nlohmann::json provenance, bool spill_series = false);
 
   // Resume: the world after the last checkpointed step, with the results recorded up to it appended to `r` (which
-  // holds the empty series of a fresh run) and the sums restored; null if there is no checkpoint (said on `log`).
+  // holds the empty series of a fresh run; with spill_series, the series stay on disk and only the frames are
+  // appended) and the sums restored; null if there is no checkpoint (said on `log`).
   // Error if the checkpoint is of other inputs or settings (naming the differences), or damaged.
   std::unique_ptr<World> resume(const Model& model, Results& r, RecorderSums& sums, std::ostream* log);
 
@@ -60,20 +65,47 @@ class Checkpointer {
   // replaces it, so that a run started without --resume by mistake can still be stopped and resumed).
   void start_fresh(const Results& r, std::ostream* log);
 
-  // Writes a checkpoint after the world's last step (the results recorded up to it, the sums).
-  void save(const World& world, const Results& r, const RecorderSums& sums);
+  // Writes a checkpoint after the world's last step (the results recorded up to it, the sums). With spill_series,
+  // the series rows it wrote then leave r.series (which holds only the rows since the last checkpoint).
+  void save(const World& world, Results& r, const RecorderSums& sums);
 
   long last_step() const { return last_step_; }
+  // Steps whose series are on disk in the chunks and no longer in memory (0 without spill_series).
+  long series_steps_on_disk() const { return spill_series_ ? last_step_ : 0; }
   const std::filesystem::path& dir() const { return dir_; }
 
  private:
   std::filesystem::path dir_;
   nlohmann::json provenance_;
   std::string key_;
+  bool spill_series_ = false;
   std::vector<size_t> marks_;          // sizes of the recorded arrays at the last checkpoint
+  std::vector<size_t> on_disk_;        // values of each recorded array not in memory (before Results' first)
   std::vector<std::string> chunks_;    // SHA-256 of each records chunk, in order
   long last_step_ = 0;
   bool replaced_old_ = false;          // the folder's earlier content has been cleared (fresh start)
+};
+
+// The series of a run whose Checkpointer spilled them: the rows of the first `steps_on_disk` steps from the chunks
+// of the checkpoint in `dir` (that of the run `provenance` names, at that step; every chunk is checked against its
+// SHA-256 once, here), then the rows in `tail`.series. Error, naming the file, if the checkpoint is not that or its
+// chunks are damaged or gone.
+class CheckpointSeries final : public SeriesSource {
+ public:
+  CheckpointSeries(const std::filesystem::path& dir, const nlohmann::json& provenance, long steps_on_disk,
+                   const Results& tail);
+  size_t steps() const override;
+  std::vector<double> get(const std::string& name) const override;
+
+ private:
+  struct Segment {
+    std::filesystem::path file;
+    size_t offset;  // bytes from the start of the file to the first value
+    size_t count;   // values
+  };
+  const Results& tail_;
+  size_t steps_on_disk_ = 0;
+  std::map<std::string, std::vector<Segment>> segments_;  // series name -> its values in each chunk, in order
 };
 
 }  // namespace floesim::sim

@@ -106,6 +106,13 @@ std::vector<Floe> level_ice_tiles(const FloeField& field, const LevelIceOptions&
   const double t = li.tile_m;
   for (const Sheet& sh : sheets) {
     const Aabb2 box = bounds(sh.outline);
+    // Each tile is a body: a sheet of more tiles than a large field has floes is a mistake of units or of tile_m
+    // (and a grid of billions of lines would never finish).
+    constexpr double kMaxTiles = 1e6;
+    const double nx = std::ceil((box.hi.x() - box.lo.x()) / t) + 1, ny = std::ceil((box.hi.y() - box.lo.y()) / t) + 1;
+    FLOESIM_REQUIRE(nx * ny <= kMaxTiles, sh.name, ": a sheet of ", box.hi.x() - box.lo.x(), " m x ",
+                    box.hi.y() - box.lo.y(), " m makes ", nx * ny, " tiles of level_ice.tile_m = ", t,
+                    " m, more than ", kMaxTiles, "; enlarge level_ice.tile_m or give a smaller sheet");
     // Grid lines: tile_m apart, centred on the sheet's box (a vessel on the sheet's centre line meets the middle of
     // a tile, not a crack-stopping side), plus the openings' sides inside it.
     auto lines = [&](double lo, double hi, int axis) {

@@ -164,6 +164,10 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
 }  // namespace
 
 nlohmann::json level_ice_summary(const Model& model, const Results& r) {
+  return level_ice_summary(model, r, ResultsSeries(r));
+}
+
+nlohmann::json level_ice_summary(const Model& model, const Results& r, const SeriesSource& series) {
   nlohmann::json j;
   const int v = model.vessel;
   std::vector<int> tiles;
@@ -252,10 +256,9 @@ nlohmann::json level_ice_summary(const Model& model, const Results& r) {
   // The mean surge ice resistance over the steady part, split by what the hull touched: the sheet's tiles (breaking
   // its edge: crushing until the wedges fail in bending) and the floes and broken pieces (clearing, turning and
   // submerging them, with their friction).
-  if (!r.series.count("time_s") || !r.series.count("ice_load") || !r.series.count("ice_load_level_ice")) return j;
-  const auto& t = r.get("time_s");
-  const auto& all = r.get("ice_load");
-  const auto& sheet = r.get("ice_load_level_ice");
+  if (series.steps() == 0) return j;
+  const std::vector<double> t = series.get("time_s"), all = series.get("ice_load"),
+                            sheet = series.get("ice_load_level_ice");
   double sum_all = 0, sum_sheet = 0, n = 0;
   for (size_t i = 0; i < t.size(); ++i) {
     if (t[i] < model.options.steady_start_s - 0.5 * model.options.time_step_s) continue;
@@ -374,11 +377,15 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress, co
   const SimulateOptions& o = model.options;
   const long steps = o.steps(), every = o.output_every();
   Results r;
-  // Direct references to the series columns: no map look-up per step, one reservation up front.
+  // Direct references to the series columns: no map look-up per step, one reservation up front (for the whole
+  // run, or for one checkpoint interval when the checkpoints take the series out of memory).
+  const long checkpoint_every = o.checkpoint_every();
+  const bool spill = checkpoints && checkpoints->spill_series && checkpoint_every > 0;
+  const long rows_held = spill ? std::min(steps, checkpoint_every) : steps;
   std::map<std::string, std::vector<double>*> col;
   for (const FieldSpec& f : series_fields()) {
     auto& v = r.series[f.name];
-    v.reserve(static_cast<size_t>(steps) * f.cols);
+    v.reserve(static_cast<size_t>(rows_held) * f.cols);
     col[f.name] = &v;
   }
   auto& c_time = *col["time_s"];
@@ -405,13 +412,13 @@ Results simulate(const Model& model, RunStats& stats, std::ostream* progress, co
   RecorderSums sums;
   std::unique_ptr<Checkpointer> cp;
   std::unique_ptr<World> world;
-  const long checkpoint_every = o.checkpoint_every();
   if (checkpoints) {
-    cp = std::make_unique<Checkpointer>(checkpoints->dir, checkpoints->provenance);
+    cp = std::make_unique<Checkpointer>(checkpoints->dir, checkpoints->provenance, spill);
     if (checkpoints->resume) world = cp->resume(model, r, sums, progress);
     else cp->start_fresh(r, progress);
   }
   if (!world) world = std::make_unique<World>(model);
+  if (cp) r.series_first_step = static_cast<size_t>(cp->series_steps_on_disk());
   StoredStates stored(*world, r);
   const long first = world->state().step + 1;
   stats.resumed_at_step = first - 1;
@@ -561,13 +568,11 @@ namespace {
 // How well the contact solver did over the whole run (every step, not only the steady part: an unconverged step
 // during the start-up is as wrong as any other), for the solve and for the relax pass whose impulses are the
 // recorded loads.
-nlohmann::json solver_summary(const SolverOptions& o, const Results& r) {
+nlohmann::json solver_summary(const SolverOptions& o, const SeriesSource& series) {
   auto pass = [&](const char* prefix) {
     const std::string p = prefix;
-    const auto& sweeps = r.get(p + "_iterations");
-    const auto& resid = r.get(p + "_residual");
-    const auto& capped = r.get(p + "_capped");
-    const auto& viol = r.get(p + "_complementarity");
+    const std::vector<double> sweeps = series.get(p + "_iterations"), resid = series.get(p + "_residual"),
+                              capped = series.get(p + "_capped"), viol = series.get(p + "_complementarity");
     const size_t n = sweeps.size();
     double sum = 0, most = 0, rmax = 0, ncap = 0, vmax = 0, vsum = 0;
     for (size_t i = 0; i < n; ++i) {
@@ -587,7 +592,7 @@ nlohmann::json solver_summary(const SolverOptions& o, const Results& r) {
                           {"mean_complementarity_mps", vsum / d}};
   };
   nlohmann::json j = pass("solver");
-  const auto& sub = r.get("solver_subspace_solves");
+  const std::vector<double> sub = series.get("solver_subspace_solves");
   double subs = 0;
   for (double x : sub) subs += x;
   j["method"] = o.method;
@@ -600,32 +605,34 @@ nlohmann::json solver_summary(const SolverOptions& o, const Results& r) {
 
 }  // namespace
 
-nlohmann::json summarize(const Model& model, const Results& r) {
+nlohmann::json summarize(const Model& model, const Results& r) { return summarize(model, r, ResultsSeries(r)); }
+
+nlohmann::json summarize(const Model& model, const Results& r, const SeriesSource& series) {
   const SimulateOptions& o = model.options;
-  const auto& t = r.get("time_s");
-  const auto& ice = r.get("ice_load");
-  const auto& ice_rigid = r.get("ice_load_rigid");
-  const auto& ice_compliant = r.get("ice_load_compliant");
-  const auto& vel = r.get("vessel_velocity_mps");
-  const auto& prop = r.get("propulsion_load");
-  const auto& awake = r.get("awake_floes");
-  const auto& contacts = r.get("contact_count");
-  const auto& vcont = r.get("vessel_contact_count");
   // Steady part: rows with t >= steady_start_s (within half a step).
+  const size_t steps = series.steps();
   size_t first = 0;
-  while (first < t.size() && t[first] < o.steady_start_s - 0.5 * o.time_step_s) ++first;
-  std::vector<double> fx;
-  double speed = 0, thrust = 0, aw = 0, co = 0, vc = 0, fx_rigid = 0, fx_compliant = 0;
-  for (size_t i = first; i < t.size(); ++i) {
-    fx.push_back(ice[6 * i]);
-    fx_rigid += ice_rigid[6 * i];
-    fx_compliant += ice_compliant[6 * i];
-    speed += vel[3 * i];
-    thrust += prop[6 * i];
-    aw += awake[i];
-    co += contacts[i];
-    vc += vcont[i];
+  {
+    const std::vector<double> t = series.get("time_s");
+    while (first < steps && t[first] < o.steady_start_s - 0.5 * o.time_step_s) ++first;
   }
+  // One series in memory at a time (a long run's are read back from disk): column 0 of `name` summed over the
+  // steady part.
+  auto steady_sum = [&](const char* name) {
+    const std::vector<double> x = series.get(name);
+    const size_t cols = static_cast<size_t>(series_field(name).cols);
+    double sum = 0;
+    for (size_t i = first; i < steps; ++i) sum += x[cols * i];
+    return sum;
+  };
+  std::vector<double> fx;  // the surge ice load over the steady part
+  {
+    const std::vector<double> ice = series.get("ice_load");
+    for (size_t i = first; i < steps; ++i) fx.push_back(ice[6 * i]);
+  }
+  const double fx_rigid = steady_sum("ice_load_rigid"), fx_compliant = steady_sum("ice_load_compliant");
+  const double speed = steady_sum("vessel_velocity_mps"), thrust = steady_sum("propulsion_load");
+  const double aw = steady_sum("awake_floes"), co = steady_sum("contact_count"), vc = steady_sum("vessel_contact_count");
   const double n = static_cast<double>(fx.size());
   FLOESIM_REQUIRE(n > 0, "internal: no steady samples");
   double mean = 0;
@@ -679,13 +686,14 @@ nlohmann::json summarize(const Model& model, const Results& r) {
   s["mean_awake_floes"] = aw / n;
   s["mean_contacts"] = co / n;
   s["mean_vessel_contacts"] = vc / n;
-  s["solver"] = solver_summary(o.solver, r);
+  s["solver"] = solver_summary(o.solver, series);
   // The solver's error on the mean load (solver.reference_sweeps > 0): recorded minus converged, over the steady
   // part, against the mean surge ice load.
-  const auto& err = r.get("solver_surge_load_error");
-  if (o.solver.reference_sweeps > 0 && err.size() == t.size()) {
+  const std::vector<double> err =
+      o.solver.reference_sweeps > 0 ? series.get("solver_surge_load_error") : std::vector<double>();
+  if (o.solver.reference_sweeps > 0 && err.size() == steps) {
     double e = 0, ea = 0, emax = 0;
-    for (size_t i = first; i < t.size(); ++i) {
+    for (size_t i = first; i < steps; ++i) {
       e += err[i];
       ea += std::abs(err[i]);
       emax = std::max(emax, std::abs(err[i]));
@@ -696,14 +704,14 @@ nlohmann::json summarize(const Model& model, const Results& r) {
                                        {"max_abs_N", emax},
                                        {"mean_over_mean_load", mean != 0 ? (e / n) / mean : 0.0}};
   }
-  s["steps"] = r.steps();
+  s["steps"] = steps;
   s["frames"] = r.frames();
   s["floes"] = model.floe_count();
   s["removed_floes"] = model.removed_floe_ids.size();
   s["removed_floe_ids"] = model.removed_floe_ids;
   s["small_floe_overlaps"] = model.small_overlaps;
   s["fracture"] = fracture_summary(o, r);
-  s["level_ice"] = level_ice_summary(model, r);
+  s["level_ice"] = level_ice_summary(model, r, series);
   const VesselParticulars& vp = model.vessel_info;
   s["vessel"] = {{"mass_kg", vp.mass_kg},
                  {"length_oa_m", vp.length_oa_m},
@@ -764,15 +772,18 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   checkpoints.dir = out_dir / "checkpoint";
   checkpoints.provenance = prov;
   checkpoints.resume = resume;
+  checkpoints.spill_series = true;
   RunStats stats;
   Results results = simulate(model, stats, &std::cout, &checkpoints);
   results.attributes["provenance"] = prov;
-  nlohmann::json summary = summarize(model, results);
+  // The series before the last checkpoint are read back from its chunks, one at a time.
+  const CheckpointSeries series(checkpoints.dir, prov, static_cast<long>(results.series_first_step), results);
+  nlohmann::json summary = summarize(model, results, series);
   summary["settings"] = options_to_json(o);
   summary["provenance"] = prov;
 
   // 3. Artefacts, atomically; then the checkpoint has served.
-  write_results(out_dir / "results.h5", results);
+  write_results(out_dir / "results.h5", results, series);
   write_text_atomic(out_dir / "summary.json", summary.dump(2) + "\n");
   remove_checkpoint(checkpoints.dir);
 

@@ -28,6 +28,10 @@ struct CheckpointPlan {
   std::filesystem::path dir;         // OUT/checkpoint
   nlohmann::json provenance;         // the stage's provenance: identifies the run (its inputs and settings)
   bool resume = false;               // continue from the checkpoint in dir (if there is one of this run)
+  // The series rows written to a checkpoint leave memory (Results::series then starts at series_first_step; read
+  // the whole series through CheckpointSeries, sim/checkpoint.h, before the checkpoint folder is removed): a long
+  // run's memory then holds one checkpoint interval of them, not 0.58 kB for every step.
+  bool spill_series = false;
 };
 
 // Simulates the model for options.duration_s and records every series per step, the body states at
@@ -39,12 +43,15 @@ struct CheckpointPlan {
 Results simulate(const Model& model, RunStats& stats, std::ostream* progress = nullptr,
                  const CheckpointPlan* checkpoints = nullptr);
 
-// Summary statistics of the results (steady part from options.steady_start_s).
+// Summary statistics of the results (steady part from options.steady_start_s); the series from `series` (one at a
+// time) or from results.series.
+nlohmann::json summarize(const Model& model, const Results& results, const SeriesSource& series);
 nlohmann::json summarize(const Model& model, const Results& results);
 
 // Level ice (summary.json "level_ice"): the sheet's tiles and area at the start and the channel the vessel broke:
 // from the sheet's edge on its path to its centre of mass in the last frame (behind midship the channel is formed),
 // the sheet area lost there over that length is the channel's mean width, against the waterline beam.
+nlohmann::json level_ice_summary(const Model& model, const Results& results, const SeriesSource& series);
 nlohmann::json level_ice_summary(const Model& model, const Results& results);
 
 // The stage: reads the inputs, builds the model, simulates, writes out_dir/results.h5 and out_dir/summary.json

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/geometry2d.h"
 #include "pipeline/options.h"
 #include "sim/hull.h"
 
@@ -191,8 +192,10 @@ struct VesselOptions {
   std::vector<PropellerOptions> propellers;  // none: no propeller wash on the floes
   template <class V>
   void visit(V& v) {
-    v.field("x_m", x_m, "m", "initial centre of mass, world x");
-    v.field("y_m", y_m, "m", "initial centre of mass, world y");
+    v.field("x_m", x_m, "m", "initial centre of mass, world x",
+            in_range(-kMaxWorldCoordinateM, kMaxWorldCoordinateM));
+    v.field("y_m", y_m, "m", "initial centre of mass, world y",
+            in_range(-kMaxWorldCoordinateM, kMaxWorldCoordinateM));
     v.field("heading_deg", heading_deg, "deg", "course: direction of the bow, CCW from +x", in_range(-360, 360));
     v.field("initial_speed_mps", initial_speed_mps, "m/s", "initial forward speed", non_negative());
     v.field("mass_kg", mass_kg, "kg", "vessel mass; 0 = rho_w x hull volume below the waterline", non_negative());
@@ -369,7 +372,7 @@ inline Check<std::vector<double>> rectangle_m(bool may_be_empty) {
     if (e.empty()) return may_be_empty ? "" : "must be [x_min, y_min, x_max, y_max]";
     if (e.size() != 4) return "must be [x_min, y_min, x_max, y_max]";
     for (double x : e)
-      if (!std::isfinite(x)) return "must hold finite numbers";
+      if (!std::isfinite(x) || std::abs(x) > kMaxWorldCoordinateM) return "must hold finite numbers within +-1e7 m";
     if (!(e[2] > e[0] && e[3] > e[1])) return "needs x_max > x_min and y_max > y_min";
     return "";
   };

@@ -60,6 +60,18 @@ TEST(FloesIo, RejectsSelfIntersectionNamingTheFloe) {
   EXPECT_NE(e.find("intersects itself"), std::string::npos) << e;
 }
 
+// A vertex farther than any ice field (10,000 km; a far larger one would overflow the collision detection's
+// bounding volumes): an error naming the floe and the vertex, not a crash in the simulation.
+TEST(FloesIo, RejectsAVertexBeyondAnyField) {
+  Json far = square_feature(5, 0);
+  far["geometry"]["coordinates"] = Json::array({Json::array({{0, 0}, {10, 0}, {10, 3.8e199}, {0, 10}, {0, 0}})});
+  const std::string e = error_of(collection({far}));
+  EXPECT_NE(e.find("floe id 5: vertex [10,3.8e+199] is more than 10000 km from the origin"), std::string::npos) << e;
+  Json utm = square_feature(6, 0);  // a UTM northing at 79 deg N is fine
+  utm["geometry"]["coordinates"] = Json::array({Json::array({{5e5, 8.77e6}, {5e5 + 10, 8.77e6}, {5e5, 8.77e6 + 10}})});
+  EXPECT_EQ(floes_from_geojson(collection({utm}), "f").floes.size(), 1u);
+}
+
 TEST(FloesIo, RejectsHolesDuplicatesAndBadThickness) {
   Json holed = square_feature(1, 0);
   holed["geometry"]["coordinates"].push_back(Json::array({{2, 2}, {3, 2}, {3, 3}, {2, 2}}));

@@ -100,9 +100,9 @@ class Checkpoint : public ::testing::Test {
     dir_ = testing::temp_dir("checkpoint_reseal") / "checkpoint";
     CheckpointPlan plan{dir_, provenance_, false};
     RunStats stats;
-    const Results full = simulate(model_, stats, nullptr, &plan);
+    full_ = simulate(model_, stats, nullptr, &plan);
     ASSERT_EQ(stats.checkpoints, 3);  // at 0.1, 0.2 and 0.3 s; none after the last step
-    ASSERT_GT(full.fracture_time_s.size(), 0u) << "the run must break ice before its last checkpoint";
+    ASSERT_GT(full_.fracture_time_s.size(), 0u) << "the run must break ice before its last checkpoint";
   }
   void TearDown() override { fs::remove_all(dir_.parent_path()); }
   std::unique_ptr<World> resume(Results& r) {
@@ -118,6 +118,7 @@ class Checkpoint : public ::testing::Test {
   const Model model_ = small_breaking_run();
   const nlohmann::json provenance_ = {{"program", "sim_checkpoint_test"}};
   fs::path dir_;
+  Results full_;  // the run with every series in memory
 };
 
 TEST_F(Checkpoint, AsWrittenItResumesAtItsLastStep) {
@@ -196,6 +197,50 @@ TEST_F(Checkpoint, ResealedPieceWithAnInfiniteOrientationIsRefused) {
 TEST_F(Checkpoint, ResealedPieceBeyondAnyFieldIsRefused) {
   reseal_first_piece(dir_, 0, 3.763892008866656e+199);
   expect_refused({"checkpoint.bin", "damaged (piece", "has no valid outline, thickness or pose)"});
+}
+
+// A run whose checkpoints take its series out of memory (what the simulate stage does, so that a long transit's
+// memory does not grow by 0.58 kB per step): it holds only the steps since its last checkpoint, and reads the rest
+// back from the chunks equal to the bit to the run that held them all; the results file written through them is the
+// same file, byte for byte, and so is the summary.
+TEST_F(Checkpoint, SpilledSeriesReadBackEqualTheSeriesHeldInMemory) {
+  const fs::path dir = dir_.parent_path() / "spilled";
+  CheckpointPlan plan{dir, provenance_, false, true};
+  RunStats stats;
+  const Results tail = simulate(model_, stats, nullptr, &plan);
+  EXPECT_EQ(tail.series_first_step, 30u);  // the last checkpoint
+  EXPECT_EQ(tail.steps(), 10u);            // steps 31 to 40
+  EXPECT_LE(tail.series.at("ice_load").capacity(), 10u * 6) << "reserved for the whole run, not one interval";
+  const CheckpointSeries series(dir, provenance_, 30, tail);
+  ASSERT_EQ(series.steps(), 40u);
+  for (const FieldSpec& f : series_fields()) {
+    const std::vector<double> a = series.get(f.name), &b = full_.series.at(f.name);
+    ASSERT_EQ(a.size(), b.size()) << f.name;
+    EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(double)), 0) << f.name;
+  }
+  EXPECT_EQ(summarize(model_, tail, series).dump(), summarize(model_, full_).dump());
+  write_results(dir_.parent_path() / "spilled.h5", tail, series);
+  write_results(dir_.parent_path() / "held.h5", full_);
+  EXPECT_TRUE(read_text(dir_.parent_path() / "spilled.h5") == read_text(dir_.parent_path() / "held.h5"));
+  // Without the rows on disk, the results cannot stand for the run: the functions that take them whole refuse.
+  testing::expect_error([&] { summarize(model_, tail); }, {"internal: these results hold the series from step 30"});
+  testing::expect_error([&] { CheckpointSeries(dir, provenance_, 20, tail); },
+                        {"internal: the series in memory start at step 30"});
+  testing::expect_error([&] { CheckpointSeries(dir, {{"program", "another"}}, 30, tail); },
+                        {"checkpoint.bin: is another run's checkpoint"});
+}
+
+// Resumed with its series left on disk, a run appends only the frames; the series are counted, not read, and the
+// checkpoint's chunks still add up (a chunk that lost a series value is damaged, not silently short).
+TEST_F(Checkpoint, ResumedWithSpilledSeriesItReadsOnlyTheFrames) {
+  Results r = fresh_results();
+  Checkpointer cp(dir_, provenance_, true);
+  RecorderSums sums;
+  const auto w = cp.resume(model_, r, sums, nullptr);
+  ASSERT_TRUE(w);
+  EXPECT_EQ(cp.series_steps_on_disk(), 30);
+  EXPECT_TRUE(r.series.at("time_s").empty());
+  EXPECT_EQ(r.frame_time_s.size(), 6u);
 }
 
 }  // namespace

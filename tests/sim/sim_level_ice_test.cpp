@@ -247,6 +247,9 @@ TEST(LevelIce, BadInputNamesTheKeyAndTheFix) {
   const std::vector<std::pair<std::string, std::string>> bad = {
       {R"({"level_ice": {"extent_m": [0, 0, 100]}})", "level_ice.extent_m"},
       {R"({"level_ice": {"extent_m": [0, 0, -100, 50]}})", "level_ice.extent_m"},
+      {R"({"level_ice": {"extent_m": [0, 0, 1e12, 50]}})", "level_ice.extent_m"},
+      {R"({"vessel": {"x_m": 2e7}})", "vessel.x_m"},
+      {R"({"domain": {"extent_m": [-1e300, 0, 100, 50]}})", "domain.extent_m"},
       {R"({"level_ice": {"thickness_m": 0}})", "level_ice.thickness_m"},
       {R"({"level_ice": {"tile_m": 0}})", "level_ice.tile_m"},
       {R"({"level_ice": {"openings": [{"rect_m": [5, 5, 1, 1]}]}})", "level_ice.openings[0].rect_m"},
@@ -272,6 +275,15 @@ TEST(LevelIce, BadInputNamesTheKeyAndTheFix) {
       "geometry": {"type": "Polygon", "coordinates": [[[0, 0], [10, 0], [10, 10], [0, 0]]]}}]})");
   testing::expect_error([&] { floes_from_geojson(fc, "floes.geojson"); },
                         {"floes.geojson", "floe id 1", "properties.kind", "level_ice"});
+  // A sheet of more tiles than any field has floes (10 km x 10 km at 5 m: 4 million tiles).
+  {
+    SimulateOptions o;
+    o.level_ice.extent_m = {0, -5000, 10000, 5000};
+    o.level_ice.tile_m = 5;
+    testing::expect_error([&] { build_model(FloeField{}, nullptr, o); },
+                          {"level_ice.extent_m: a sheet of 10000 m x 10000 m makes", "tiles of level_ice.tile_m = 5 m",
+                           "enlarge level_ice.tile_m"});
+  }
   // A sheet under the vessel's start.
   SimulateOptions o = testing::floe_options();
   o.level_ice.extent_m = {-200, -50, 200, 50};
