@@ -4,7 +4,9 @@
 //
 //   OUT/checkpoint/records-NNNNNN.bin  the per-step series and stored frames recorded since the previous checkpoint
 //                                      (the results so far are the concatenation of these chunks, each written once:
-//                                      a long run's checkpoints do not rewrite its history)
+//                                      a long run's checkpoints do not rewrite its history; the stage keeps
+//                                      only the series since the last chunk in memory and reads the rest back
+//                                      from the chunks when it writes its results: CheckpointSeries below)
 //   OUT/checkpoint/checkpoint.bin      the world after the last checkpointed step (World::save: body table with the
 //                                      pieces, state, warm-start cache, ...), the recorder's running sums, the list
 //                                      of chunks with their SHA-256, and the run's key

@@ -770,6 +770,14 @@ constexpr double kSectionExcessTarget = 0.02;
 // Neighbouring sections are merged into one part while the hull of both adds less than this fraction.
 constexpr double kMergeExcess = 0.001;
 
+HullModel hull_model_from_parts(std::vector<TriMesh> parts) {
+  HullModel h;
+  h.parts = std::move(parts);
+  h.surface = merge(h.parts);
+  h.mesh = h.surface;
+  return h;
+}
+
 HullModel load_hull(const fs::path& file, const HullLoadOptions& o, const HullPlacement& placement) {
   const std::string where = file.string();
   FLOESIM_REQUIRE(fs::exists(file), where, ": hull file not found");

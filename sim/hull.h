@@ -143,6 +143,10 @@ struct HullModel {
                                 // into N, volume error)
 };
 
+// A HullModel of convex parts made in the program (generate_hull): the parts and their merged surface, which is
+// also the reference mesh (no file, no placement).
+HullModel hull_model_from_parts(std::vector<TriMesh> parts);
+
 // Loads any mesh file assimp reads (OBJ first of all); each mesh is one part. Convex meshes are kept as they are;
 // non-convex ones are sliced or refused per the options, never silently replaced by their convex hull.
 // Details (vessel helper): node transforms are applied (mirroring ones too); vertices at equal positions are

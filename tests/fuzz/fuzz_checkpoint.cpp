@@ -7,9 +7,12 @@
 //   mode 1      sealed: each part is a payload, written with the magic and its correct SHA-256;
 //   mode 2, 3   sealed and fixed up: as 1, and where the payload's layout allows, the run's key and the chunk hashes
 //               that checkpoint.bin names are set to the right ones, so the parser behind them is what is fuzzed.
-// Parts are separated by kSeparator: part 0 is checkpoint.bin, part k is records-00000k.bin.
+// Bit 2 of the first byte reads the files as the simulate stage does (spill_series: the series are counted, left
+// on disk and read back through CheckpointSeries). Parts are separated by kSeparator: part 0 is checkpoint.bin,
+// part k is records-00000k.bin.
 //
-// The model the checkpoints belong to is built here (a coarse generated hull ramming small floes that break), and
+// The model the checkpoints belong to is tests/sim/small_breaking_run.h (a coarse generated hull ramming small
+// floes that break), and
 // FLOESIM_FUZZ_WRITE_SEED=DIR writes seeds from a real checkpoint of it: a short simulate() with checkpoints on,
 // stored both raw (mode 0) and as sealed payloads (mode 2). Then it exits.
 #include <cstdint>
@@ -30,6 +33,7 @@
 #include "sim/hull.h"
 #include "sim/model.h"
 #include "sim/simulate.h"
+#include "tests/sim/small_breaking_run.h"
 
 namespace fs = std::filesystem;
 using namespace floesim;
@@ -43,53 +47,9 @@ constexpr char kCheckpointMagic[] = "floesim-checkpoint/1\n";
 constexpr char kRecordsMagic[] = "floesim-checkpoint-records/1\n";
 constexpr size_t kHashChars = 64;
 
-// The run the checkpoints belong to: a small generated hull at 4 m/s over the first two of four 0.3 m floes (the
-// model removes floes the vessel starts on) and against the other two, which break at 0.08, 0.21 and 0.27 s, so the
-// last checkpoint (0.3 s) holds pieces in its body table, fracture events and cached contacts.
-SimulateOptions run_options() {
-  SimulateOptions o;
-  o.duration_s = 0.4;
-  o.output_interval_s = 0.05;
-  o.checkpoint_interval_s = 0.1;
-  o.steady_start_s = 0;
-  o.sleep.enabled = false;
-  o.vessel.propulsion.mode = "speed";
-  o.vessel.propulsion.speed_mps = 4;
-  o.vessel.initial_speed_mps = 4;
-  o.vessel.x_m = 5.0;
-  return o;
-}
-
+// The run the checkpoints belong to (tests/sim/small_breaking_run.h, shared with sim_checkpoint_test).
 const Model& the_model() {
-  static const Model model = [] {
-    HullGeneratorOptions g;
-    g.length_m = 40;
-    g.beam_m = 9;
-    g.reamer_beam_m = 11;
-    g.draught_m = 3;
-    g.depth_m = 6;
-    g.sections = 6;
-    HullModel h;
-    h.parts = generate_hull(g);
-    for (const TriMesh& p : h.parts) {
-      const int off = static_cast<int>(h.surface.vertices.size());
-      h.surface.vertices.insert(h.surface.vertices.end(), p.vertices.begin(), p.vertices.end());
-      for (auto t : p.triangles) h.surface.triangles.push_back({t[0] + off, t[1] + off, t[2] + off});
-    }
-    FloeField f;
-    int id = 1;
-    for (int i = 0; i < 2; ++i)
-      for (int j = 0; j < 2; ++j) {
-        Floe fl;
-        fl.id = id++;
-        const double x0 = 21 * i, y0 = -20 + 21 * j;
-        fl.outline = {Vec2(x0, y0), Vec2(x0 + 20, y0), Vec2(x0 + 20, y0 + 19), Vec2(x0, y0 + 19)};
-        fl.area_m2 = 20 * 19;
-        fl.thickness_m = 0.3;
-        f.floes.push_back(fl);
-      }
-    return build_model(f, &h, run_options());
-  }();
+  static const Model model = floesim::sim::testing::small_breaking_run();
   return model;
 }
 

@@ -170,13 +170,7 @@ TEST(SimCases, SingleFloeStruckOffCentreSplitsGloballyThenBendsLocally) {
   o.duration_s = 50;  // the strike (at ~43 s) and the failures it causes
   const FloeField field = read_floes(dir / "floes.geojson");
   ASSERT_EQ(field.floes.size(), 1u);
-  HullModel hull;
-  hull.parts = generate_hull(HullGeneratorOptions{});
-  for (const TriMesh& p : hull.parts) {
-    const int off = static_cast<int>(hull.surface.vertices.size());
-    hull.surface.vertices.insert(hull.surface.vertices.end(), p.vertices.begin(), p.vertices.end());
-    for (auto t : p.triangles) hull.surface.triangles.push_back({t[0] + off, t[1] + off, t[2] + off});
-  }
+  const HullModel hull = hull_model_from_parts(generate_hull(HullGeneratorOptions{}));
   const Model m = build_model(field, &hull, o);
   ASSERT_EQ(m.floe_count(), 1);  // not removed: the vessel starts clear of it
   ASSERT_TRUE(m.options.fracture.enabled);

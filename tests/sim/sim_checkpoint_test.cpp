@@ -1,8 +1,6 @@
 // The checkpoint reader (sim/checkpoint.h) against files whose SHA-256 is right but whose content is not what a run
 // writes (what fuzz_checkpoint feeds it, re-sealed): refused with a message naming the file, never accepted into a
-// world and results that disagree. The run: a small generated hull at 4 m/s into 0.3 m floes (the model removes
-// the two it starts on; it meets the others at once and breaks them), 0.4 s with a checkpoint every 0.1 s (the last
-// at step 30).
+// world and results that disagree. The run: tests/sim/small_breaking_run.h (checkpoints at steps 10, 20 and 30).
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -15,38 +13,14 @@
 #include "sim/checkpoint.h"
 #include "sim/simulate.h"
 #include "tests/sim/sim_fixtures.h"
+#include "tests/sim/small_breaking_run.h"
 
 namespace floesim::sim {
 namespace {
 
 namespace fs = std::filesystem;
 
-Model small_breaking_run() {
-  SimulateOptions o;
-  o.duration_s = 0.4;
-  o.output_interval_s = 0.05;
-  o.checkpoint_interval_s = 0.1;
-  o.steady_start_s = 0;
-  o.sleep.enabled = false;
-  o.vessel.propulsion.mode = "speed";
-  o.vessel.propulsion.speed_mps = 4;
-  o.vessel.initial_speed_mps = 4;
-  o.vessel.x_m = 5;
-  HullGeneratorOptions g;
-  g.length_m = 40, g.beam_m = 9, g.reamer_beam_m = 11, g.draught_m = 3, g.depth_m = 6, g.sections = 6;
-  HullModel h;
-  h.parts = generate_hull(g);
-  h.surface = h.parts[0];
-  for (size_t k = 1; k < h.parts.size(); ++k) {
-    const int off = static_cast<int>(h.surface.vertices.size());
-    h.surface.vertices.insert(h.surface.vertices.end(), h.parts[k].vertices.begin(), h.parts[k].vertices.end());
-    for (auto t : h.parts[k].triangles) h.surface.triangles.push_back({t[0] + off, t[1] + off, t[2] + off});
-  }
-  FloeField f;
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2; ++j) f.floes.push_back(testing::rect_floe(1 + 2 * i + j, 21 * i, -20 + 21 * j, 20, 19, 0.3));
-  return build_model(f, &h, o);
-}
+using testing::small_breaking_run;
 
 std::string read_text(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);

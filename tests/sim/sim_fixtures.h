@@ -39,14 +39,7 @@ inline SimulateOptions floe_options() {
 inline HullModel coarse_hull(int sections = 8) {
   HullGeneratorOptions g;
   g.sections = sections;
-  HullModel h;
-  h.parts = generate_hull(g);
-  for (const TriMesh& p : h.parts) {
-    const int off = static_cast<int>(h.surface.vertices.size());
-    h.surface.vertices.insert(h.surface.vertices.end(), p.vertices.begin(), p.vertices.end());
-    for (auto t : p.triangles) h.surface.triangles.push_back({t[0] + off, t[1] + off, t[2] + off});
-  }
-  return h;
+  return hull_model_from_parts(generate_hull(g));
 }
 
 // A vertical wall (box lx x ly x hz, centred on the origin in x and y, z from z0) as a single-part hull.
