@@ -95,15 +95,17 @@ struct SideSums {
 // tops of two floes of equal thickness) is then reliably on the boundary of the overlap, not flickering in and out.
 constexpr double kClipTolerance = 1e-9;
 
-// The faces of P (translated by tp) clipped by the half-spaces n.x <= d of Q (translated by tq): Sutherland-Hodgman
-// per face, a face leaving nothing as soon as one plane has it all outside. second_side: P's faces lying in the
-// plane of a face of Q with the same orientation are skipped, because Q's side (clipped first) already holds that
-// piece of the overlap's boundary; counting both would double it (e.g. the volume of two floes' common top).
+// Scratch buffers of clip_faces.
 struct ClipScratch {
   std::vector<Vec3> poly, tmp;
   std::vector<double> dist;  // signed distances of poly's vertices to the plane being clipped by
   std::vector<int> planes;   // Q's planes that can cut P
 };
+
+// The faces of P (translated by tp) clipped by the half-spaces n.x <= d of Q (translated by tq): Sutherland-Hodgman
+// per face, a face leaving nothing as soon as one plane has it all outside. second_side: P's faces lying in the
+// plane of a face of Q with the same orientation are skipped, because Q's side (clipped first) already holds that
+// piece of the overlap's boundary; counting both would double it (e.g. the volume of two floes' common top).
 void clip_faces(const ConvexPart& P, const PartWorld& pw, const Vec3& tp, const ConvexPart& Q, const PartWorld& qw,
                 const Vec3& tq, const Vec3& origin, bool second_side, ClipScratch& cs, SideSums& out) {
   std::vector<Vec3>& poly = cs.poly;
@@ -134,13 +136,9 @@ void clip_faces(const ConvexPart& P, const PartWorld& pw, const Vec3& tp, const 
     if (second_side) {
       const double df = pw.d[f] + pw.n[f].dot(shift_p);
       bool coplanar = false;
-      // Only Q's planes that can cut P: a face of P lying in a plane of Q touches that plane, so P's box is not
-      // inside it by the planes' margin.
-      for (size_t j = 0; j < cs.planes.size() && !coplanar; ++j) {
-        const int g = cs.planes[j];
+      for (size_t g = 0; g < nq && !coplanar; ++g)
         coplanar = pw.n[f].dot(qw.n[g]) > 1 - 1e-12 &&
                    std::abs(df - (qw.d[g] + qw.n[g].dot(shift_q))) <= kClipTolerance;
-      }
       if (coplanar) continue;
     }
     poly.clear();
