@@ -71,7 +71,9 @@ void reseal_with(const fs::path& dir, const char* chunk_name, const std::string&
 class Checkpoint : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = testing::temp_dir("checkpoint_reseal") / "checkpoint";
+    // A folder per test: ctest runs the fixture's tests as parallel processes.
+    dir_ = testing::temp_dir(std::string("checkpoint_") +
+                             ::testing::UnitTest::GetInstance()->current_test_info()->name()) / "checkpoint";
     CheckpointPlan plan{dir_, provenance_, false};
     RunStats stats;
     full_ = simulate(model_, stats, nullptr, &plan);
