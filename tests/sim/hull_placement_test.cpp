@@ -92,15 +92,17 @@ TEST(HullPlacement, TurnsTheBowToPlusXKeepingPortToPort) {
   }
 }
 
+// The error reading the case's hull section gives, or "no error".
+std::string problem(const char* text) {
+  try {
+    read_options<HullImportOptions>(Json::parse(text), "case.json", "hull");
+  } catch (const Error& e) {
+    return std::string(e.what());
+  }
+  return std::string("no error");
+}
+
 TEST(HullPlacement, OptionsAreCheckedNamingTheKey) {
-  auto problem = [](const char* text) {
-    try {
-      read_options<HullImportOptions>(Json::parse(text), "case.json", "hull");
-    } catch (const Error& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  };
   EXPECT_NE(problem(R"({"file": "h.obj", "bow_direction": "x+"})").find("hull.bow_direction"), std::string::npos);
   EXPECT_NE(problem(R"({"file": "h.obj", "scale": 0})").find("hull.scale must be > 0"), std::string::npos);
   EXPECT_NE(problem(R"({"file": "h.obj", "origin_m": [1]})").find("hull.origin_m"), std::string::npos);
@@ -163,14 +165,6 @@ TEST(HullPlacement, UpDirectionTurnsTheFilesVerticalToPlusZBeforeTheBowTurn) {
 }
 
 TEST(HullPlacement, BowAlongTheUpAxisIsRefusedNamingBothKeysAndTheFix) {
-  auto problem = [](const char* text) {
-    try {
-      read_options<HullImportOptions>(Json::parse(text), "case.json", "hull");
-    } catch (const Error& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  };
   for (const char* text : {R"({"file": "h.obj", "up_direction": "+y", "bow_direction": "-y"})",
                            R"({"file": "h.obj", "bow_direction": "+z"})",
                            R"({"file": "h.obj", "up_direction": "-x", "bow_direction": "+x"})"}) {
