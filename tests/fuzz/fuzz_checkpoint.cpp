@@ -48,6 +48,8 @@ constexpr char kRecordsMagic[] = "floesim-checkpoint-records/1\n";
 constexpr size_t kHashChars = 64;
 
 // The run the checkpoints belong to (tests/sim/small_breaking_run.h, shared with sim_checkpoint_test).
+using floesim::sim::testing::fresh_results;
+
 const Model& the_model() {
   static const Model model = floesim::sim::testing::small_breaking_run();
   return model;
@@ -128,13 +130,6 @@ fs::path records_file(const fs::path& dir, size_t k) {
   return dir / name;
 }
 
-// A fresh run's results before the first step, as simulate() holds them when it resumes.
-Results fresh_results() {
-  Results r;
-  for (const FieldSpec& f : series_fields()) r.series[f.name];
-  r.frame_offset.push_back(0);
-  return r;
-}
 
 // FLOESIM_FUZZ_WRITE_SEED=DIR: a real checkpoint of the_model(), as seeds.
 void write_seeds(const fs::path& dir) {

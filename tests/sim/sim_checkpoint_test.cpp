@@ -20,6 +20,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
+using testing::fresh_results;
 using testing::small_breaking_run;
 
 std::string read_text(const fs::path& p) {
@@ -37,12 +38,6 @@ void seal(const fs::path& p, const std::string& magic, const std::string& payloa
   std::ofstream(p, std::ios::binary) << magic << payload << sha256_bytes(payload);
 }
 
-Results fresh_results() {
-  Results r;
-  for (const FieldSpec& f : series_fields()) r.series[f.name];
-  r.frame_offset.push_back(0);
-  return r;
-}
 
 const char kRecordsMagic[] = "floesim-checkpoint-records/1\n";
 const char kCheckpointMagic[] = "floesim-checkpoint/1\n";

@@ -5,6 +5,7 @@
 // fracture events and cached contacts.
 #pragma once
 #include "pipeline/floes_io.h"
+#include "pipeline/results_io.h"
 #include "sim/hull.h"
 #include "sim/model.h"
 #include "sim/simulate_options.h"
@@ -41,6 +42,14 @@ inline Model small_breaking_run() {
       f.floes.push_back(fl);
     }
   return build_model(f, &h, small_breaking_run_options());
+}
+
+// A fresh run's results before the first step, as simulate() holds them when it resumes a checkpoint.
+inline Results fresh_results() {
+  Results r;
+  for (const FieldSpec& f : series_fields()) r.series[f.name];
+  r.frame_offset.push_back(0);
+  return r;
 }
 
 }  // namespace floesim::sim::testing
