@@ -3,83 +3,111 @@
 #include <array>
 #include <algorithm>
 #include <cmath>
+#include <cstdarg>
+#include <cstdio>
 #include <fstream>
+#include <memory>
 #include <opencv2/imgcodecs.hpp>
+#include <tiffio.h>
 
 #include "pipeline/error.h"
 
 namespace floesim::imaging {
 
 namespace {
-uint32_t be32(const unsigned char* p) {
-  return (uint32_t(p[0]) << 24) | (uint32_t(p[1]) << 16) | (uint32_t(p[2]) << 8) | p[3];
-}
 uint32_t be16(const unsigned char* p) { return (uint32_t(p[0]) << 8) | p[1]; }
+uint32_t be32(const unsigned char* p) { return (be16(p) << 16) | be16(p + 2); }
 
-// TIFF (classic, either byte order): ImageWidth (256) and ImageLength (257) of the first image file directory.
-bool read_tiff_size(std::ifstream& in, const unsigned char* h, int& width, int& height) {
-  const bool le = h[0] == 'I';
-  auto u16 = [le](const unsigned char* p) { return le ? uint32_t(p[0]) | (uint32_t(p[1]) << 8) : be16(p); };
-  auto u32 = [le](const unsigned char* p) {
-    return le ? uint32_t(p[0]) | (uint32_t(p[1]) << 8) | (uint32_t(p[2]) << 16) | (uint32_t(p[3]) << 24) : be32(p);
-  };
-  if (u16(h + 2) != 42) return false;  // 43 is BigTIFF: sized after decoding
+[[noreturn]] void undecodable(const std::string& f, const std::string& why) {
+  throw Error(f + ": cannot decode the image: " + why + "; re-export it as an 8-bit grayscale PNG");
+}
+
+// PNG: the IHDR chunk, which must come first (libpng refuses a file where it does not).
+ImageHeader png_header(const std::string& f, const unsigned char* h, std::streamsize got) {
+  if (got < 24 || std::string(reinterpret_cast<const char*>(h + 12), 4) != "IHDR")
+    undecodable(f, "the PNG has no IHDR chunk after its signature");
+  return {"PNG", static_cast<long>(be32(h + 16)), static_cast<long>(be32(h + 20))};
+}
+
+// JPEG: the frame header (SOFn), found the way libjpeg's next_marker() does: bytes before a marker are skipped
+// (libjpeg warns and goes on), so are 0xFF fill bytes and stand-alone markers. A scan (SOS) or the end (EOI) before
+// any frame header is an error to libjpeg, so it is one here.
+ImageHeader jpeg_header(const std::string& f, std::ifstream& in) {
   in.clear();
-  in.seekg(u32(h + 4));
-  unsigned char n[2];
-  if (!in.read(reinterpret_cast<char*>(n), 2)) return false;
-  long w = -1, l = -1;
-  for (uint32_t k = 0, count = u16(n); k < count && k < 4096; ++k) {
-    unsigned char e[12];
-    if (!in.read(reinterpret_cast<char*>(e), 12)) return false;
-    const uint32_t tag = u16(e), type = u16(e + 2);
-    const long value = type == 3 ? long(u16(e + 8)) : type == 4 ? long(u32(e + 8)) : -1;
-    if (tag == 256) w = value;
-    if (tag == 257) l = value;
+  in.seekg(2);  // after SOI
+  auto byte = [&]() -> int {
+    const int c = in.get();
+    if (c == std::char_traits<char>::eof()) undecodable(f, "the JPEG ends before its frame header (SOF)");
+    return c;
+  };
+  for (;;) {
+    int c = byte();
+    while (c != 0xFF) c = byte();
+    while (c == 0xFF) c = byte();
+    if (c == 0) continue;  // a stuffed 0xFF 0x00 is data, not a marker
+    const int marker = c;
+    if (marker == 0xDA || marker == 0xD9) undecodable(f, "the JPEG has no frame header (SOF) before its scan");
+    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) continue;  // stand-alone: no length
+    unsigned char len_bytes[2] = {static_cast<unsigned char>(byte()), static_cast<unsigned char>(byte())};
+    const uint32_t len = be16(len_bytes);
+    const bool sof = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
+    if (sof) {
+      unsigned char s[5];
+      for (auto& b : s) b = static_cast<unsigned char>(byte());
+      return {"JPEG", static_cast<long>(be16(s + 3)), static_cast<long>(be16(s + 1))};
+    }
+    if (len < 2) undecodable(f, "a JPEG marker segment has a length below 2");
+    in.seekg(len - 2, std::ios::cur);
   }
-  if (w < 0 || l < 0) return false;
-  width = static_cast<int>(std::min<long>(w, 0x7fffffff));
-  height = static_cast<int>(std::min<long>(l, 0x7fffffff));
-  return true;
+}
+
+// TIFF (classic and BigTIFF): the first directory as libtiff, which decodes it for OpenCV, reads it. A hand-written
+// reader differed from libtiff on a directory holding ImageWidth twice (tests/fuzz/crashes/fuzz_image), so the
+// decoder's own library answers. Its messages are caught per file instead of going to stderr.
+int keep_tiff_message(TIFF*, void* user, const char* module, const char* fmt, va_list ap) {
+  auto& first = *static_cast<std::string*>(user);
+  if (first.empty()) {
+    char buf[512];
+    std::vsnprintf(buf, sizeof buf, fmt, ap);
+    first = std::string(module ? module : "libtiff") + ": " + buf;
+  }
+  return 1;  // handled: the process-wide handler is not called
+}
+int drop_tiff_warning(TIFF*, void*, const char*, const char*, va_list) { return 1; }
+
+ImageHeader tiff_header(const std::string& f) {
+  std::string error;
+  std::unique_ptr<TIFFOpenOptions, void (*)(TIFFOpenOptions*)> opts(TIFFOpenOptionsAlloc(), TIFFOpenOptionsFree);
+  TIFFOpenOptionsSetErrorHandlerExtR(opts.get(), keep_tiff_message, &error);
+  TIFFOpenOptionsSetWarningHandlerExtR(opts.get(), drop_tiff_warning, nullptr);
+  std::unique_ptr<TIFF, void (*)(TIFF*)> tif(TIFFOpenExt(f.c_str(), "r", opts.get()), TIFFClose);
+  if (!tif) undecodable(f, error.empty() ? "libtiff cannot read its first directory" : error);
+  uint32_t w = 0, l = 0;
+  if (TIFFGetField(tif.get(), TIFFTAG_IMAGEWIDTH, &w) != 1 || TIFFGetField(tif.get(), TIFFTAG_IMAGELENGTH, &l) != 1)
+    undecodable(f, "the TIFF's first directory has no ImageWidth or ImageLength");
+  return {"TIFF", static_cast<long>(w), static_cast<long>(l)};
 }
 }  // namespace
 
-bool read_image_size(const std::filesystem::path& file, int& width, int& height) {
+ImageHeader read_image_header(const std::filesystem::path& file) {
+  const std::string f = file.string();
   std::ifstream in(file, std::ios::binary);
-  if (!in) return false;
+  FLOESIM_REQUIRE(static_cast<bool>(in), f, ": cannot open the image (check its permissions)");
   std::array<unsigned char, 24> h{};
   in.read(reinterpret_cast<char*>(h.data()), h.size());
-  const auto got = in.gcount();
+  const std::streamsize got = in.gcount();
+  // The signatures OpenCV's decoders recognise a file by (imgcodecs grfmt_png, grfmt_jpeg, grfmt_tiff).
   static const unsigned char png_sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  if (got >= 24 && std::equal(png_sig, png_sig + 8, h.begin())) {
-    if (std::string(reinterpret_cast<const char*>(&h[12]), 4) != "IHDR") return false;
-    width = static_cast<int>(std::min<uint32_t>(be32(&h[16]), 0x7fffffff));
-    height = static_cast<int>(std::min<uint32_t>(be32(&h[20]), 0x7fffffff));
-    return true;
+  if (got >= 8 && std::equal(png_sig, png_sig + 8, h.begin())) return png_header(f, h.data(), got);
+  if (got >= 3 && h[0] == 0xFF && h[1] == 0xD8 && h[2] == 0xFF) return jpeg_header(f, in);
+  const bool ii = h[0] == 'I' && h[1] == 'I' && (h[2] == 42 || h[2] == 43) && h[3] == 0;
+  const bool mm = h[0] == 'M' && h[1] == 'M' && h[2] == 0 && (h[3] == 42 || h[3] == 43);
+  if (got >= 4 && (ii || mm)) {
+    in.close();
+    return tiff_header(f);
   }
-  if (got >= 8 && ((h[0] == 'I' && h[1] == 'I') || (h[0] == 'M' && h[1] == 'M')))
-    return read_tiff_size(in, h.data(), width, height);
-  if (got >= 2 && h[0] == 0xFF && h[1] == 0xD8) {
-    // JPEG: walk the marker segments to the first start-of-frame (SOFn) segment.
-    in.clear();
-    in.seekg(2);
-    for (int guard = 0; guard < 10000; ++guard) {
-      unsigned char m[4];
-      if (!in.read(reinterpret_cast<char*>(m), 4) || m[0] != 0xFF) return false;
-      const unsigned marker = m[1], len = be16(m + 2);
-      const bool sof = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
-      if (sof) {
-        unsigned char s[5];
-        if (!in.read(reinterpret_cast<char*>(s), 5)) return false;
-        height = static_cast<int>(be16(s + 1));
-        width = static_cast<int>(be16(s + 3));
-        return true;
-      }
-      if (len < 2) return false;
-      in.seekg(len - 2, std::ios::cur);
-    }
-  }
-  return false;
+  undecodable(f, "it is not a PNG, JPEG or TIFF file (the formats digitise reads, each sized from its header "
+                 "before the pixels are decoded)");
 }
 
 cv::Mat load_grayscale_image(const std::filesystem::path& file, double max_pixels, std::vector<std::string>* warnings) {
@@ -91,13 +119,12 @@ cv::Mat load_grayscale_image(const std::filesystem::path& file, double max_pixel
     std::ifstream probe(file, std::ios::binary);
     FLOESIM_REQUIRE(static_cast<bool>(probe), f, ": cannot open the image (check its permissions)");
   }
-  int w = 0, h = 0;
-  if (read_image_size(file, w, h))
-    FLOESIM_REQUIRE(double(w) * double(h) <= max_pixels, f, ": the image has ", w, " x ", h, " = ",
-                    double(w) * double(h) / 1e6, " megapixels, more than max_pixels = ", max_pixels / 1e6,
-                    " megapixels (digitise needs about 80 bytes per pixel: ",
-                    std::lround(double(w) * double(h) * 80 / 1e9 * 10) / 10.0,
-                    " GB for this image); digitise it in tiles or raise max_pixels in the config if memory allows");
+  const ImageHeader head = read_image_header(file);
+  const double pixels = double(head.width) * double(head.height);
+  FLOESIM_REQUIRE(pixels <= max_pixels, f, ": the ", head.format, " header gives ", head.width, " x ", head.height,
+                  " = ", pixels / 1e6, " megapixels, more than max_pixels = ", max_pixels / 1e6,
+                  " megapixels (digitise needs about 80 bytes per pixel: ", std::lround(pixels * 80 / 1e9 * 10) / 10.0,
+                  " GB for this image); digitise it in tiles or raise max_pixels in the config if memory allows");
 
   cv::Mat img;
   try {
@@ -108,8 +135,10 @@ cv::Mat load_grayscale_image(const std::filesystem::path& file, double max_pixel
   FLOESIM_REQUIRE(!img.empty(), f,
                   ": cannot decode the image (truncated, corrupt or not an image format OpenCV reads); "
                   "re-export it as an 8-bit grayscale PNG");
-  FLOESIM_REQUIRE(double(img.rows) * double(img.cols) <= max_pixels, f, ": the image has ", img.cols, " x ", img.rows,
-                  " pixels, more than max_pixels = ", max_pixels, "; digitise it in tiles");
+  // The header was read as the decoder reads it; a decoder that disagreed would make the size check above void.
+  FLOESIM_REQUIRE(img.cols == head.width && img.rows == head.height, f, ": decoded as ", img.cols, " x ", img.rows,
+                  " pixels but its ", head.format, " header gives ", head.width, " x ", head.height,
+                  "; re-export it as an 8-bit grayscale PNG");
   const int depth = img.depth();
   FLOESIM_REQUIRE(depth == CV_8U, f, ": is a ",
                   depth == CV_16U || depth == CV_16S ? "16-bit"

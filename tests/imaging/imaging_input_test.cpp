@@ -64,7 +64,7 @@ TEST_F(DigitiseBadInput, MissingFile) {
 TEST_F(DigitiseBadInput, NotAnImage) {
   const auto f = dir_.path / "text.png";
   std::ofstream(f) << "this is not a PNG\n";
-  expect_refused(request(f), {"text.png", "cannot decode"});
+  expect_refused(request(f), {"text.png", "cannot decode", "not a PNG, JPEG or TIFF"});
 }
 
 TEST_F(DigitiseBadInput, TruncatedPng) {
@@ -120,10 +120,10 @@ TEST_F(DigitiseBadInput, LargerThanMaxPixels) {
   DigitiseRequest r = request(good_);
   r.config = {{"max_pixels", 10000}};
   expect_refused(r, {"good.png", "160 x 120", "max_pixels"});
-  int w = 0, h = 0;
-  ASSERT_TRUE(read_image_size(good_, w, h));
-  EXPECT_EQ(w, 160);
-  EXPECT_EQ(h, 120);
+  const ImageHeader head = read_image_header(good_);
+  EXPECT_EQ(head.format, "PNG");
+  EXPECT_EQ(head.width, 160);
+  EXPECT_EQ(head.height, 120);
 }
 
 TEST_F(DigitiseBadInput, HugeImageRefusedFromItsHeaderWithDefaults) {
@@ -184,13 +184,90 @@ TEST_F(DigitiseBadInput, HugeTiffRefusedFromItsHeader) {
   t += std::string(4, '\0');
   const auto f = dir_.path / "huge.tif";
   std::ofstream(f, std::ios::binary) << t;
-  int w = 0, h = 0;
-  ASSERT_TRUE(read_image_size(f, w, h));
-  EXPECT_EQ(w, 30000);
-  EXPECT_EQ(h, 30000);
+  const ImageHeader head = read_image_header(f);
+  EXPECT_EQ(head.format, "TIFF");
+  EXPECT_EQ(head.width, 30000);
+  EXPECT_EQ(head.height, 30000);
   DigitiseRequest r = request(f);
   r.config = {{"max_pixels", 1e8}};
   expect_refused(r, {"huge.tif", "30000 x 30000", "900 megapixels", "max_pixels"});
+}
+
+std::string read_bytes(const std::filesystem::path& f) {
+  std::ifstream in(f, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+TEST_F(DigitiseBadInput, TiffWithImageWidthTwiceIsSizedAsLibtiffReadsIt) {
+  // tests/fuzz/crashes/fuzz_image/oom-09ee...: a TIFF announcing 30000 x 30000 whose directory holds ImageWidth a
+  // second time with an unknown field type. The hand-written header reader took the second entry, found no size and
+  // let OpenCV decode, which allocated 3.6 GB. libtiff ignores the bad entry; the header is now read by libtiff.
+  const auto crasher = std::filesystem::path(FLOESIM_SOURCE_DIR) / "tests/fuzz/crashes/fuzz_image" /
+                       "oom-09eefeba5999f92997400fee46305ddcd03aab12";
+  const auto f = dir_.path / "twice.tif";
+  std::filesystem::copy_file(crasher, f);
+  const ImageHeader head = read_image_header(f);
+  EXPECT_EQ(head.width, 30000);
+  EXPECT_EQ(head.height, 30000);
+  expect_refused(request(f), {"twice.tif", "TIFF header gives 30000 x 30000", "max_pixels"});
+}
+
+TEST_F(DigitiseBadInput, BigTiffRefusedFromItsHeader) {
+  // BigTIFF (version 43, 8-byte offsets) was not sized before: a 30000 x 30000 claim went to the decoder.
+  std::string t = std::string("II+\0\x08\0\0\0", 8);
+  auto u64 = [&](uint64_t v) {
+    for (int i = 0; i < 8; ++i) t += char((v >> (8 * i)) & 0xFF);
+  };
+  auto u16 = [&](uint16_t v) { t += char(v & 0xFF), t += char(v >> 8); };
+  u64(16);  // first directory
+  u64(6);   // entries
+  auto entry = [&](uint16_t tag, uint16_t type, uint64_t value) { u16(tag), u16(type), u64(1), u64(value); };
+  const uint64_t data = 16 + 8 + 6 * 20 + 8;
+  entry(256, 4, 30000);
+  entry(257, 4, 30000);
+  entry(258, 3, 8);
+  entry(262, 3, 1);
+  entry(273, 16, data);
+  entry(279, 16, 16);
+  u64(0);
+  t += std::string(16, '\x80');
+  const auto f = dir_.path / "big.tif";
+  std::ofstream(f, std::ios::binary) << t;
+  const ImageHeader head = read_image_header(f);
+  EXPECT_EQ(head.format, "TIFF");
+  EXPECT_EQ(head.width, 30000);
+  EXPECT_EQ(head.height, 30000);
+  expect_refused(request(f), {"big.tif", "30000 x 30000", "max_pixels"});
+}
+
+TEST_F(DigitiseBadInput, JpegSizedPastPaddingAndStrayBytes) {
+  // libjpeg skips stray bytes and 0xFF fill before a marker; the header reader must find the same frame header,
+  // or a JPEG it gave up on would be decoded unsized. The size is checked against OpenCV's decoding of the file.
+  cv::Mat img(37, 53, CV_8U);
+  cv::randu(img, 0, 255);
+  const auto plain = dir_.path / "plain.jpg";
+  ASSERT_TRUE(cv::imwrite(plain.string(), img));
+  std::string bytes = read_bytes(plain);
+  // After SOI: a COM segment, three stray bytes, then fill bytes before the next marker.
+  bytes.insert(2, std::string("\xFF\xFE\x00\x06" "abcd" "xyz" "\xFF\xFF\xFF", 14));
+  const auto f = dir_.path / "padded.jpg";
+  std::ofstream(f, std::ios::binary) << bytes;
+  const cv::Mat decoded = cv::imread(f.string(), cv::IMREAD_UNCHANGED);
+  ASSERT_FALSE(decoded.empty());
+  const ImageHeader head = read_image_header(f);
+  EXPECT_EQ(head.format, "JPEG");
+  EXPECT_EQ(head.width, decoded.cols);
+  EXPECT_EQ(head.height, decoded.rows);
+  EXPECT_EQ(head.width, 53);
+  EXPECT_EQ(head.height, 37);
+}
+
+TEST_F(DigitiseBadInput, FormatsThatCannotBeSizedFirstAreRefused) {
+  // BMP (and PNM, WebP, ...) decode in OpenCV but were not sized before decoding, so a header claiming gigapixels
+  // was decoded: refused by format, with the conversion to use.
+  const auto f = dir_.path / "field.bmp";
+  ASSERT_TRUE(cv::imwrite(f.string(), cv::imread(good_.string(), cv::IMREAD_GRAYSCALE)));
+  expect_refused(request(f), {"field.bmp", "not a PNG, JPEG or TIFF", "PNG"});
 }
 }  // namespace
 }  // namespace floesim::imaging
