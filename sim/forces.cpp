@@ -128,6 +128,24 @@ Wrench hydrostatic_damping(const Model& m, const Body& b, const BodyKinematics& 
   return w;
 }
 
+double disc_heave_radiation_damping(double rho_w, double g, double radius_m, double draft_m, double omega_radps) {
+  const double k = omega_radps * omega_radps / g;
+  const double ka = k * radius_m;
+  // 2 J1(x)/x -> 1 as x -> 0 (the long-wave limit: the whole waterplane sees the same pressure).
+  const double shape = ka > 1e-8 ? 2 * std::cyl_bessel_j(1.0, ka) / ka : 1.0;
+  const double area = kPi * radius_m * radius_m;
+  const double x3 = rho_w * g * area * std::exp(-k * draft_m) * shape;  // |X3| per unit wave amplitude, N/m
+  const double cg = g / (2 * omega_radps);
+  return k * x3 * x3 / (4 * rho_w * g * cg);
+}
+
+double heave_radiation_force(const Body& b, double heave_velocity_mps, double& lowpass_mps, double dt) {
+  if (b.heave_radiation_gain <= 0) return 0.0;
+  const double wc_dt = b.heave_radiation_corner_radps * dt;
+  lowpass_mps = (lowpass_mps + wc_dt * heave_velocity_mps) / (1 + wc_dt);
+  return -b.heave_radiation_gain * (heave_velocity_mps - lowpass_mps);
+}
+
 namespace {
 // Form drag and skin friction on one submerged face of a floe slab (outward normal n, area, relative velocity vrel
 // of the face through the water), PHYSICS.md §3.2. Form drag is the lumped ½ rho_w C_d A_proj |v| v of the seed

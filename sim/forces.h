@@ -75,6 +75,23 @@ bool prism_submerged(const Body& b, const BodyKinematics& k, double& volume, Vec
 Wrench buoyancy_force(const Model& m, const Body& b, const BodyKinematics& k, ForceScratch& s);
 // Linear heave (world z) and roll/pitch (body x, y) damping from the damping ratios.
 Wrench hydrostatic_damping(const Model& m, const Body& b, const BodyKinematics& k);
+
+// Wave radiation damping in heave of a floating truncated vertical cylinder (radius a, draft T) in deep water at
+// frequency omega, N s/m: Haskind's relation for an axisymmetric body, B33 = k |X3|^2 / (4 rho g c_g), with the
+// Froude-Krylov heave exciting force X3 = rho g pi a^2 e^(-kT) 2 J1(ka)/(ka) (the incident wave's pressure under
+// the bottom; diffraction left out), k = omega^2/g and c_g = g/(2 omega). That is
+//   B33 = rho omega^3 (pi a^2)^2 e^(-2kT) (2 J1(ka)/(ka))^2 / (2 g),
+// the long-wave limit rho omega^3 A^2/(2g) as ka, kT -> 0; at the natural frequency, B33 / (2 (C33/omega)) =
+// pi J1(ka)^2 e^(-2kT) of critical.
+double disc_heave_radiation_damping(double rho_w, double g, double radius_m, double draft_m, double omega_radps);
+
+// The radiation force on the heave velocity, a state-space stand-in for Cummins' retardation integral: the heave
+// velocity v through a first-order high-pass filter, F = -G (v - u), u the low-passed velocity (State's
+// heave_lowpass_mps) with du/dt = w_c (v - u), stepped by backward Euler (stable at any dt). Its damping at
+// frequency w is G w^2 / (w^2 + w_c^2): G and w_c (Body::heave_radiation_gain, heave_radiation_corner_radps) make
+// it B33 at the natural frequency, and zero for steady motion, as radiation is (no waves at zero frequency).
+// Updates `lowpass` to the end of the step; returns the force along world z, N.
+double heave_radiation_force(const Body& b, double heave_velocity_mps, double& lowpass_mps, double dt);
 // Form drag and skin friction on the submerged faces of a floe slab, relative to the water (§3.2): face by face, the
 // form drag sums to the lumped ½ rho_w C_d A_proj |u| u of a convex floe for in-plane flow u (A_proj: the submerged
 // area projected across the flow) and to ½ rho_w C_d A |w| w on the bottom for heave. In closed form (body frame)

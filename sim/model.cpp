@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "pipeline/error.h"
+#include "sim/forces.h"
 #include "sim/geometry.h"
 #include "pipeline/geometry2d.h"
 
@@ -53,6 +54,26 @@ void set_damping(Body& b, const SimulateOptions& o, double zeta_heave, double ze
   b.heave_damping = 2 * zeta_heave * std::sqrt(c33 * (b.mass_kg + b.added_mass.z()));
   b.roll_damping = 2 * zeta_roll * std::sqrt(c44 * (b.inertia(0, 0) + b.added_inertia.x()));
   b.pitch_damping = 2 * zeta_pitch * std::sqrt(c55 * (b.inertia(1, 1) + b.added_inertia.y()));
+}
+
+// The radiation filter's corner frequency as a fraction of the heave natural frequency. The real retardation kernel
+// of a floating disc lasts about one natural period; w_c = w_n/2 forgets a steady push in 1/w_c = T_n/pi (0.6-1.2 s
+// for 1-40 m floes) while the filter's reactive part, an extra mass G w_c/(w_n^2 + w_c^2) = 2 zeta r (m + A33) at
+// w_n (r = w_c/w_n, zeta the radiation damping ratio), stays at zeta (m + A33). A lower corner would keep that mass
+// smaller but let a steady push be damped for longer.
+constexpr double kRadiationCornerRatio = 0.5;
+
+// Floe heave radiation damping (water.floe_heave_damping "radiation"): the floating disc of the floe's area (a =
+// sqrt(A/pi)) at its floating draft T = m/(rho_w A), its B33 at the heave natural frequency w_n = sqrt(C33/(m +
+// A33)) (disc_heave_radiation_damping), and the filter gain G = B33 (1 + r^2) that gives B33 there through the
+// high-pass G w^2/(w^2 + w_c^2).
+void set_heave_radiation(Body& b, const SimulateOptions& o) {
+  const double rho = o.water.density_kg_m3, g = o.water.gravity_mps2, area = b.section_area;
+  if (!(g > 0) || !(area > 0)) return;
+  const double omega_n = std::sqrt(rho * g * area / (b.mass_kg + b.added_mass.z()));
+  const double b33 = disc_heave_radiation_damping(rho, g, std::sqrt(area / kPi), b.mass_kg / (rho * area), omega_n);
+  b.heave_radiation_corner_radps = kRadiationCornerRatio * omega_n;
+  b.heave_radiation_gain = b33 * (1 + kRadiationCornerRatio * kRadiationCornerRatio);
 }
 
 struct Aabb2 {
@@ -351,9 +372,12 @@ Body make_floe_body(const Polygon& outline, double h, int id, int body_index, co
     add_face({i, j, n + j, n + i}, nrm);
     b.drag_faces.back().side = i;
   }
-  if (o.water.enabled)
-    set_damping(b, o, o.water.floe_heave_damping_ratio, o.water.floe_roll_pitch_damping_ratio,
+  if (o.water.enabled) {
+    const bool radiation = o.water.floe_heave_damping == "radiation";
+    set_damping(b, o, radiation ? 0.0 : o.water.floe_heave_damping_ratio, o.water.floe_roll_pitch_damping_ratio,
                 o.water.floe_roll_pitch_damping_ratio);
+    if (radiation) set_heave_radiation(b, o);
+  }
   return b;
 }
 

@@ -79,6 +79,10 @@ struct Body {
   double heave_damping = 0;            // N s/m, along world z
   double roll_damping = 0;             // N m s/rad, about body x
   double pitch_damping = 0;            // N m s/rad, about body y
+  // Floes, water.floe_heave_damping "radiation" (heave_radiation_force): the gain G on the high-passed heave
+  // velocity (N s/m) and the filter's corner frequency w_c (rad/s); G = 0: none (then heave_damping acts).
+  double heave_radiation_gain = 0;
+  double heave_radiation_corner_radps = 0;
   Vec3 initial_position = Vec3::Zero();
   Quat initial_orientation = Quat::Identity();
   // Level ice (issue #10): a tile of a sheet, held by the ice around it (hold_fixed). Like a wall it has infinite

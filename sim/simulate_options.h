@@ -46,7 +46,10 @@ struct WaterOptions {
   double form_drag_cd = 0.5;             // C_d on submerged floe faces advancing into the water
   double current_speed_mps = 0.0;        // uniform current speed
   double current_direction_deg = 0.0;    // direction the current flows to
-  double floe_heave_damping_ratio = 0.2;  // linear heave damping, fraction of critical
+  // Floe heave damping: "radiation" (wave radiation, B33 at the heave natural frequency through a high-pass filter,
+  // so it vanishes for steady motion; sim/forces.h) or "linear" (the old dashpot, floe_heave_damping_ratio).
+  std::string floe_heave_damping = "radiation";
+  double floe_heave_damping_ratio = 0.2;  // "linear" only: heave damping, fraction of critical
   double floe_roll_pitch_damping_ratio = 0.2;
   double vessel_heave_damping_ratio = 0.2;
   double vessel_roll_damping_ratio = 0.08;
@@ -66,8 +69,13 @@ struct WaterOptions {
     v.field("current_speed_mps", current_speed_mps, "m/s", "uniform current speed", non_negative());
     v.field("current_direction_deg", current_direction_deg, "deg", "direction the current flows to (CCW from +x)",
             in_range(-360, 360));
-    v.field("floe_heave_damping_ratio", floe_heave_damping_ratio, "-", "floe heave damping, fraction of critical",
-            in_range(0, 2));
+    v.field("floe_heave_damping", floe_heave_damping, "-",
+            "radiation (wave radiation damping of the floating disc of the floe's area at its heave natural "
+            "frequency, Haskind relation with the Froude-Krylov force, acting on the high-passed heave velocity: "
+            "zero for steady motion) | linear (a dashpot of floe_heave_damping_ratio of critical)",
+            one_of({"radiation", "linear"}));
+    v.field("floe_heave_damping_ratio", floe_heave_damping_ratio, "-",
+            "floe heave damping, fraction of critical (floe_heave_damping linear only)", in_range(0, 2));
     v.field("floe_roll_pitch_damping_ratio", floe_roll_pitch_damping_ratio, "-",
             "floe roll and pitch damping, fraction of critical", in_range(0, 2));
     v.field("vessel_heave_damping_ratio", vessel_heave_damping_ratio, "-", "vessel heave damping, fraction of critical",

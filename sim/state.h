@@ -90,6 +90,8 @@ struct State {
   std::vector<uint8_t> alive;           // 0: broken up (replaced by its pieces) or removed as brash: never again
                                         // awake, in the broad phase or in the results
   std::vector<double> still_time_s;     // time spent below the sleep thresholds without contacts
+  std::vector<double> heave_lowpass_mps;  // forces: heave velocity through the radiation filter's low pass
+                                          // (heave_radiation_force); 0 while asleep, a piece takes its parent's
   std::vector<CachedContact> contact_cache;  // sorted by (body_a, part_a, body_b, part_b)
   // Vessel controllers.
   double speed_error_integral = 0;      // m, integral of the speed error (PI thrust controller)

@@ -45,6 +45,7 @@ World::World(const Model& model) : model_(model), pool_(model.options.threads) {
   state_.angular_velocity.assign(n, Vec3::Zero());
   state_.awake.assign(n, start_asleep ? 0 : 1);
   state_.still_time_s.assign(n, 0.0);
+  state_.heave_lowpass_mps.assign(n, 0.0);
   state_.alive.assign(n, 1);
   ended_s_.assign(n, std::numeric_limits<double>::infinity());
   for (const Body& b : model.bodies) next_floe_id_ = std::max(next_floe_id_, b.id + 1);
@@ -209,6 +210,7 @@ void World::stage_forces() {
       if (water) {
         w += buoyancy_force(model_, body, k, s);
         w += hydrostatic_damping(model_, body, k);
+        w.force.z() += heave_radiation_force(body, k.v.z(), state_.heave_lowpass_mps[b], dt);
         w += floe_water_drag(model_, body, k, s, jets_);
       }
       w += floe_wind_drag(model_, body, k, s);
@@ -301,6 +303,7 @@ void World::grow_body_arrays() {
   state_.awake.resize(n, 1);
   state_.alive.resize(n, 1);
   state_.still_time_s.resize(n, 0.0);
+  state_.heave_lowpass_mps.resize(n, 0.0);
   solver_bodies_.inv_mass.resize(n, Mat3::Zero());
   solver_bodies_.inv_inertia_world.resize(n, Mat3::Zero());
   external_.resize(n);
@@ -361,6 +364,9 @@ void World::apply_fracture(FractureCut& cut) {
     state_.orientation[index] = q;
     state_.velocity[index] = v + w.cross(r);
     state_.angular_velocity[index] = w;
+    // The water under the piece has the parent's heave history: the radiation filter carries on from the parent's
+    // (starting it at 0 would give the piece a jolt of -G v_z at its birth).
+    state_.heave_lowpass_mps[index] = state_.heave_lowpass_mps[parent];
     state_.awake[index] = fixed ? 0 : 1;
     solver_bodies_.inv_mass[index] = R * model_.bodies[index].inv_mass_added.asDiagonal() * R.transpose();
     solver_bodies_.inv_inertia_world[index] = R * model_.bodies[index].inv_inertia_added * R.transpose();
@@ -439,6 +445,7 @@ void World::stage_sleep() {
     state_.awake[b] = 0;
     state_.velocity[b].setZero();
     state_.angular_velocity[b].setZero();
+    state_.heave_lowpass_mps[b] = 0;  // at rest, as its velocity: it wakes with no radiation memory
   }
 }
 
@@ -531,6 +538,7 @@ void World::save(ByteWriter& w) const {
   w.vec(s.awake);
   w.vec(s.alive);
   w.vec(s.still_time_s);
+  w.vec(s.heave_lowpass_mps);
   w.size(s.contact_cache.size());
   for (const CachedContact& c : s.contact_cache) {
     for (int i : {c.body_a, c.part_a, c.body_b, c.part_b, c.row}) w.pod<int32_t>(i);
@@ -651,6 +659,12 @@ std::unique_ptr<World> World::restore(const Model& base, ByteReader& r) {
   require_bodies(r, s.alive.size(), n, "alive flags");
   s.still_time_s = r.vec<double>();
   require_bodies(r, s.still_time_s.size(), n, "still times");
+  s.heave_lowpass_mps = r.vec<double>();
+  require_bodies(r, s.heave_lowpass_mps.size(), n, "heave filter states");
+  for (size_t b = 0; b < n; ++b)
+    FLOESIM_REQUIRE(std::isfinite(s.heave_lowpass_mps[b]) && std::abs(s.heave_lowpass_mps[b]) <= health.max_speed_mps,
+                    r.what(), ": damaged (body ", b, " has a heave filter state no run reaches: non-finite or beyond "
+                    "health.max_speed_mps)");
   s.contact_cache.resize(r.size(1));
   for (CachedContact& c : s.contact_cache) {
     for (int* i : {&c.body_a, &c.part_a, &c.body_b, &c.part_b, &c.row}) *i = r.pod<int32_t>();

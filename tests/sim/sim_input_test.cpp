@@ -39,6 +39,14 @@ TEST(SimInput, OptionErrorsNameTheKey) {
   expect_error([] { options_from({{"water", {{"floe_added_mass_scale", -1}}}}); }, {"water.floe_added_mass_scale"});
   expect_error([] { options_from({{"water", {{"floe_heave_added_mass_ratio", 1}}}}); },
                {"water.floe_heave_added_mass_ratio"});  // the old key is unknown now
+  // The floe heave damping model: a choice of two, its ratio (linear) in range.
+  expect_error([] { options_from({{"water", {{"floe_heave_damping", "quadratic"}}}}); },
+               {"water.floe_heave_damping", "radiation", "linear"});
+  expect_error([] { options_from({{"water", {{"floe_heave_damping", 0.2}}}}); }, {"water.floe_heave_damping"});
+  expect_error([] { options_from({{"water", {{"floe_heave_damping", "linear"}, {"floe_heave_damping_ratio", 3}}}}); },
+               {"water.floe_heave_damping_ratio"});
+  expect_error([] { options_from({{"water", {{"floe_heave_radiation", "on"}}}}); }, {"water.floe_heave_radiation"});
+  EXPECT_EQ(options_from({{"duration_s", 30}}).water.floe_heave_damping, "radiation");
   expect_error([] { options_from({{"vessel", {{"heave_pitch_added_mass_scale", 9}}}}); },
                {"vessel.heave_pitch_added_mass_scale"});
   expect_error([] { options_from({{"vessel", {{"propellers", {{{"position_m", {1, 2}}}}}}}}); },
