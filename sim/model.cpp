@@ -57,10 +57,10 @@ void set_damping(Body& b, const SimulateOptions& o, double zeta_heave, double ze
 }
 
 // The radiation filter's corner frequency as a fraction of the heave natural frequency. The real retardation kernel
-// of a floating disc lasts about one natural period; w_c = w_n/2 forgets a steady push in 1/w_c = T_n/pi (0.6-1.2 s
-// for 1-40 m floes) while the filter's reactive part, an extra mass G w_c/(w_n^2 + w_c^2) = 2 zeta r (m + A33) at
-// w_n (r = w_c/w_n, zeta the radiation damping ratio), stays at zeta (m + A33). A lower corner would keep that mass
-// smaller but let a steady push be damped for longer.
+// of a floating disc lasts about one natural period; w_c = w_n/2 forgets a steady push in 1/w_c = T_n/pi (0.7-2.1 s
+// for 1-40 m floes 1 m thick), while the filter's reactive part, an extra mass G w_c/(w_n^2 + w_c^2) =
+// 2 zeta r (m + A33) at w_n (r = w_c/w_n, zeta the radiation damping ratio), stays at zeta (m + A33). A lower corner
+// would keep that mass smaller but damp a steady push for longer.
 constexpr double kRadiationCornerRatio = 0.5;
 
 // Floe heave radiation damping (water.floe_heave_damping "radiation"): the floating disc of the floe's area (a =
