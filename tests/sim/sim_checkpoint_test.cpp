@@ -157,6 +157,59 @@ void reseal_first_piece(const fs::path& dir, int field, double value) {
   seal(dir / "checkpoint.bin", kCheckpointMagic, c);
 }
 
+// Where the heave radiation filter's states (State::heave_lowpass_mps, one double per body) start in checkpoint.bin:
+// after the body table (counts, then each piece: outline, thickness, 4 ints, created_s, position, quaternion,
+// fixed) and the state arrays before it (time, step, positions, orientations, velocities, angular velocities, awake,
+// alive, still times). Returns the offset of its count.
+size_t heave_filter_offset(const std::string& c) {
+  auto u64 = [&](size_t where) {
+    uint64_t v;
+    std::memcpy(&v, c.data() + where, 8);
+    return static_cast<size_t>(v);
+  };
+  size_t at = world_offset(c);
+  const size_t pieces = u64(at + 16);
+  at += 24;
+  for (size_t k = 0; k < pieces; ++k) at += 8 + 16 * u64(at) + 8 + 16 + 8 + 24 + 32 + 1;
+  at += 16;                     // time, step
+  at += 8 + 24 * u64(at);       // positions
+  at += 8 + 32 * u64(at);       // orientations
+  at += 8 + 24 * u64(at);       // velocities
+  at += 8 + 24 * u64(at);       // angular velocities
+  at += 8 + u64(at);            // awake
+  at += 8 + u64(at);            // alive
+  at += 8 + 8 * u64(at);        // still times
+  return at;
+}
+
+// The radiation filter's state is part of what a checkpoint carries (a resumed run equal to the bit needs it; the
+// floes heave as the bow meets them, so some are not 0), and one no run reaches (NaN) is refused.
+TEST_F(Checkpoint, HeaveFilterStatesAreSavedAndADamagedOneIsRefused) {
+  std::string c = payload_of(read_text(dir_ / "checkpoint.bin"), kCheckpointMagic);
+  const size_t at = heave_filter_offset(c);
+  uint64_t n;
+  std::memcpy(&n, c.data() + at, 8);
+  ASSERT_LT(at + 8, c.size());
+  const auto w = [&] {
+    Results r = fresh_results();
+    return resume(r);
+  }();
+  ASSERT_EQ(n, w->state().heave_lowpass_mps.size()) << "the layout walked here is not the one saved";
+  double largest = 0;
+  for (size_t b = 0; b < n; ++b) {
+    double u;
+    std::memcpy(&u, c.data() + at + 8 + 8 * b, 8);
+    EXPECT_EQ(u, w->state().heave_lowpass_mps[b]);
+    largest = std::max(largest, std::abs(u));
+  }
+  std::printf("[measured] largest heave filter state saved: %.3g m/s over %zu bodies\n", largest, size_t(n));
+  EXPECT_GT(largest, 0.0);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::memcpy(&c[at + 8], &nan, 8);
+  seal(dir_ / "checkpoint.bin", kCheckpointMagic, c);
+  expect_refused({"checkpoint.bin", "damaged (body 0 has a heave filter state no run reaches"});
+}
+
 // What fuzz_checkpoint found twice (crashes/fuzz_checkpoint/): a piece remade with a non-finite pose (an infinite
 // quaternion component) or one near the largest double (z = 3.8e199) gave a box that crashed the build of the broad
 // phase's tree (SEGV in fcl's HierarchyTree::bottomup).
