@@ -13,6 +13,7 @@
 #include "sim/fracture.h"
 #include "sim/simulate.h"
 #include "sim_fixtures.h"
+#include "tests/sim/small_breaking_run.h"
 #include "pipeline/geometry2d.h"
 
 namespace floesim::sim {
@@ -393,6 +394,40 @@ TEST(Fracture, BadOptionsNameTheKey) {
       EXPECT_NE(std::string(e.what()).find("fracture"), std::string::npos) << e.what();
     }
   }
+}
+
+}  // namespace
+}  // namespace floesim::sim
+
+namespace floesim::sim {
+namespace {
+
+// A piece carries on the radiation filter of the floe it broke from (the water under it has the parent's heave
+// history; a filter started at 0 would push the piece with -G v_z at its birth): on the small breaking run (the
+// bow breaks two floes at once), every piece's heave filter state equals its parent's at the step it was made,
+// and the parent's is not 0 (the bow has set it heaving), so the equality is not the trivial one.
+TEST(FracturePieces, InheritTheParentsHeaveFilterState) {
+  const Model model = testing::small_breaking_run();
+  World w(model);
+  int pieces = 0;
+  double largest = 0;
+  while (w.state().time_s < model.options.duration_s - 1e-9) {
+    const size_t before = w.model().bodies.size();
+    w.step();
+    for (size_t k = before; k < w.model().bodies.size(); ++k) {
+      const int parent_id = w.model().bodies[k].parent_id;
+      int parent = -1;
+      for (size_t b = 0; b < before; ++b)
+        if (w.model().bodies[b].id == parent_id) parent = static_cast<int>(b);
+      ASSERT_GE(parent, 0);
+      EXPECT_EQ(w.state().heave_lowpass_mps[k], w.state().heave_lowpass_mps[parent]);
+      largest = std::max(largest, std::abs(w.state().heave_lowpass_mps[parent]));
+      ++pieces;
+    }
+  }
+  std::printf("[measured] %d pieces, largest parent heave filter state %.3g m/s\n", pieces, largest);
+  EXPECT_GT(pieces, 0);
+  EXPECT_GT(largest, 0.0);
 }
 
 }  // namespace
