@@ -45,7 +45,7 @@ const std::vector<FieldSpec>& series_fields() {
       {"relax_capped", 1, "-", "1 if the relax pass stopped at its sweep cap with the tolerance unmet, else 0", 3},
       {"relax_complementarity", 1, "m/s", "largest contact-law violation left by the relax pass", 3},
       {"solver_surge_load_error", 1, "N",
-       "surge ice load minus the same with the relax pass converged (simulate.solver.reference_sweeps; NaN if off)", 3},
+       "surge ice load minus the same from a second solve of the step (simulate.solver.reference; NaN if off)", 3},
       {"ice_load_level_ice", 6, "N, N m",
        "part of ice_load from contacts with level ice tiles (breaking the sheet's edge; the rest is the floes and "
        "broken pieces being cleared, turned and submerged), body axes",

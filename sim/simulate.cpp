@@ -687,18 +687,19 @@ nlohmann::json summarize(const Model& model, const Results& r, const SeriesSourc
   s["mean_contacts"] = co / n;
   s["mean_vessel_contacts"] = vc / n;
   s["solver"] = solver_summary(o.solver, series);
-  // The solver's error on the mean load (solver.reference_sweeps > 0): recorded minus converged, over the steady
-  // part, against the mean surge ice load.
-  const std::vector<double> err =
-      o.solver.reference_sweeps > 0 ? series.get("solver_surge_load_error") : std::vector<double>();
-  if (o.solver.reference_sweeps > 0 && err.size() == steps) {
+  // What the solver's settings change in the mean load (solver.reference): recorded minus the reference, over the
+  // steady part, against the mean surge ice load.
+  const bool reference = o.solver.reference != "off";
+  const std::vector<double> err = reference ? series.get("solver_surge_load_error") : std::vector<double>();
+  if (reference && err.size() == steps) {
     double e = 0, ea = 0, emax = 0;
     for (size_t i = first; i < steps; ++i) {
       e += err[i];
       ea += std::abs(err[i]);
       emax = std::max(emax, std::abs(err[i]));
     }
-    s["solver"]["surge_load_error"] = {{"reference_sweeps", o.solver.reference_sweeps},
+    s["solver"]["surge_load_error"] = {{"reference", o.solver.reference},
+                                       {"reference_sweeps", o.solver.reference_sweeps},
                                        {"mean_N", e / n},
                                        {"mean_abs_N", ea / n},
                                        {"max_abs_N", emax},

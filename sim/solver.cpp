@@ -523,10 +523,10 @@ SolverReport solve_island(const SolverOptions& o, const SolverBodies& sb, State&
 
 SolverReport solve_contacts(const Model& model, const SolverBodies& sb, State& state, std::vector<Contact>& contacts,
                             const ContactIslands& is, double dt, bool use_bias, int iterations, double tolerance,
-                            ThreadPool* pool) {
+                            ThreadPool* pool, const SolverOptions* options) {
   SolverReport rep;
   if (contacts.empty()) return rep;
-  const SolverOptions& o = model.options.solver;
+  const SolverOptions& o = options ? *options : model.options.solver;
   // Islands are independent problems: each sweeps until it has converged (a pair of floes touching far from the
   // bow stops after a few sweeps while the bow's rubble takes the cap), and they run on the pool's threads. An
   // island's result depends only on its own contacts, so it does not depend on the thread count or the schedule.

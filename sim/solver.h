@@ -62,10 +62,12 @@ ContactIslands prepare_contacts(const Model& model, const SolverBodies& bodies, 
 // gaps), no push-out; crushing rows have the same local law in both passes (their bias is only the free approach to
 // the crushed depth).
 // The contacts are solved as islands (joined by bodies that move), each to its own convergence, on the pool's
-// threads if one is given; the report is that of the worst island (sweeps, residual, violation).
+// threads if one is given; the report is that of the worst island (sweeps, residual, violation). `options`
+// replaces model.options.solver (the reference solves of solver.reference).
 SolverReport solve_contacts(const Model& model, const SolverBodies& bodies, State& state,
                             std::vector<Contact>& contacts, const ContactIslands& islands, double dt, bool use_bias,
-                            int iterations, double tolerance, ThreadPool* pool = nullptr);
+                            int iterations, double tolerance, ThreadPool* pool = nullptr,
+                            const SolverOptions* options = nullptr);
 
 // 4. Keeps the impulses for the next step's warm start (sorted, as the contacts are).
 void store_impulses(const Model& model, State& state, const std::vector<Contact>& contacts);

@@ -223,6 +223,11 @@ void World::stage_solve() {
   const SolverOptions& o = model_.options.solver;
   const double dt = model_.options.time_step_s;
   islands_ = prepare_contacts(model_, solver_bodies_, state_, contacts_, dt);
+  // A paired reference solve of the whole step starts where this one does: after the warm start.
+  if (o.reference == "double_cap" || o.reference == "reverse_order") {
+    reference_state_ = state_;
+    reference_contacts_ = contacts_;
+  }
   report_.solve = solve_contacts(model_, solver_bodies_, state_, contacts_, islands_, dt, true, o.iterations,
                                  o.tolerance_mps, &pool_);
 }
@@ -252,19 +257,40 @@ void World::stage_relax() {
                                             &report_.ice_load_level_ice);
   report_.ice_load = report_.ice_load_rigid;
   report_.ice_load += report_.ice_load_compliant;
-  // The solver's error on the recorded load (solver.reference_sweeps, a diagnostic): the relax pass continued on
-  // copies until converged; the difference in the vessel's surge load is what the sweep cap left.
+  // What the solver's settings change in the recorded load (solver.reference, a diagnostic).
   report_.surge_load_error_n = std::numeric_limits<double>::quiet_NaN();
-  if (o.reference_sweeps > 0 && model_.vessel >= 0) {
-    State s = state_;
-    std::vector<Contact> c = contacts_;
+  if (o.reference != "off" && model_.vessel >= 0) {
+    const Vec3 surge = state_.orientation[model_.vessel] * Vec3::UnitX();
+    report_.surge_load_error_n = surge.dot(report_.ice_load.force) - reference_surge_load(surge);
+  }
+}
+
+double World::reference_surge_load(const Vec3& surge) {
+  const SolverOptions& o = model_.options.solver;
+  const double dt = model_.options.time_step_s;
+  State s;
+  std::vector<Contact> c;
+  if (o.reference == "converged_relax") {
+    // The relax pass continued on copies until converged: what its sweep cap left.
+    s = state_;
+    c = contacts_;
     solve_contacts(model_, solver_bodies_, s, c, islands_, dt, false, o.reference_sweeps, o.tolerance_mps * 1e-3,
                    &pool_);
-    Wrench rigid, compliant;
-    vessel_ice_load(c, &rigid, &compliant);
-    const Vec3 surge = state_.orientation[model_.vessel] * Vec3::UnitX();
-    report_.surge_load_error_n = surge.dot(report_.ice_load.force - rigid.force - compliant.force);
+  } else {
+    // The step's solve and relax passes again, from the state the solve started from, with twice the caps or the
+    // other sweep order. The relax pass does not read positions, so the copy taken before integration serves it.
+    SolverOptions v = o;
+    int cap = o.iterations, relax = o.relax_iterations;
+    if (o.reference == "double_cap") cap *= 2, relax *= 2;
+    else v.reverse_order = !o.reverse_order;
+    s = std::move(reference_state_);
+    c = std::move(reference_contacts_);
+    solve_contacts(model_, solver_bodies_, s, c, islands_, dt, true, cap, o.tolerance_mps, &pool_, &v);
+    if (relax > 0) solve_contacts(model_, solver_bodies_, s, c, islands_, dt, false, relax, o.tolerance_mps, &pool_, &v);
   }
+  Wrench rigid, compliant;
+  vessel_ice_load(c, &rigid, &compliant);
+  return surge.dot(rigid.force + compliant.force);
 }
 
 int World::vessel_ice_load(const std::vector<Contact>& contacts, Wrench* rigid, Wrench* compliant,

@@ -45,8 +45,8 @@ struct StepReport {
   int fracture_events = 0;   // floes broken in this step
   int floe_bodies = 0;       // floe bodies alive at the end of the step
   SolverReport solve, relax;
-  // Vessel surge ice load minus the same with the relax pass converged (solver.reference_sweeps > 0), N; NaN when
-  // not measured. The solver's error on the recorded load.
+  // Vessel surge ice load minus the same from the reference solve of solver.reference (the relax pass converged,
+  // twice the sweep caps, or the other sweep order), N; NaN when not measured.
   double surge_load_error_n = 0;
   Wrench ice_load, ice_load_rigid, ice_load_compliant;
   Wrench ice_load_level_ice;  // part of ice_load from contacts with level ice tiles (breaking the sheet's edge)
@@ -120,6 +120,8 @@ class World {
   // Grows the per-body arrays to the body table's size (new bodies awake, at rest in their own frame).
   void grow_body_arrays();
   [[noreturn]] void fail(int body, const std::string& what) const;
+  // The vessel's surge ice load (along `surge`) from the reference solve of solver.reference, on copies.
+  double reference_surge_load(const Vec3& surge);
   std::string body_name(int body) const;
 
   Model model_;
@@ -127,6 +129,8 @@ class World {
   ThreadPool pool_;
   std::unique_ptr<CollisionWorld> collision_;
   std::vector<Contact> contacts_;
+  State reference_state_;                   // solver.reference: the state and contacts the step's solve started
+  std::vector<Contact> reference_contacts_;  // from (double_cap, reverse_order)
   ContactIslands islands_;          // of contacts_ (solve stage), for the solve, relax and reference passes
   std::vector<int> awake_list_;     // bodies integrated this step (ascending)
   std::vector<int> moved_;          // bodies integrated in the previous step (broad phase refresh)
