@@ -1,4 +1,4 @@
-// Plane-geometry helpers the imaging module needs beyond pipeline/geometry2d.h: convex hull, point-in-polygon,
+// Plane-geometry helpers the imaging module needs beyond pipeline/geometry2d.h: point-in-polygon,
 // polygon distance (floe placement and the no-overlap check of digitised outlines) and clipping to the image.
 #pragma once
 #include "pipeline/geometry2d.h"
@@ -12,9 +12,6 @@ struct BBox {
   }
 };
 BBox bounding_box(const Polygon& p);
-
-// Counter-clockwise convex hull (Andrew's monotone chain); collinear points dropped.
-Polygon convex_hull(Polygon pts);
 
 // Even-odd rule; points exactly on an edge may go either way.
 bool point_in_polygon(const Vec2& p, const Polygon& poly);

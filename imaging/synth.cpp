@@ -45,7 +45,7 @@ Polygon random_outline(std::mt19937_64& rng, int n, double aspect, double irregu
     const double x = r * c, y = r * s;
     p.emplace_back(cr * x - sr * y, sr * x + cr * y);
   }
-  if (convex) p = convex_hull(p);
+  if (convex) p = convex_hull_2d(p);
   const double k = std::sqrt(area / signed_area(p));
   for (Vec2& v : p) v *= k;
   return p;
@@ -177,7 +177,7 @@ SynthResult synthesize(const SynthOptions& o) {
     // A non-convex floe cut by the border with its star centre outside the image could leave several pieces in
     // the image; there it takes its convex hull, scaled to the same area (rejecting the position instead would
     // leave the border band short of ice).
-    Polygon hull = convex_hull(shape);
+    Polygon hull = convex_hull_2d(shape);
     for (Vec2& v : hull) v *= std::sqrt(std::abs(signed_area(shape)) / signed_area(hull));
     bool ok = false;
     for (int attempt = 0; attempt < o.placement_attempts && !ok; ++attempt) {

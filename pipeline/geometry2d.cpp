@@ -27,6 +27,29 @@ double point_segment_distance(const Vec2& v, const Vec2& p, const Vec2& q) {
   return (v - (p + t * e)).norm();
 }
 
+Polygon convex_hull_2d(Polygon pts) {
+  std::sort(pts.begin(), pts.end(),
+            [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  if (pts.size() < 3) return pts;
+  // (b - a) x (c - a): > 0 for a left turn a -> b -> c.
+  auto turn = [](const Vec2& a, const Vec2& b, const Vec2& c) {
+    return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
+  };
+  Polygon h(2 * pts.size());
+  size_t k = 0;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    while (k >= 2 && turn(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
+    h[k++] = pts[i];
+  }
+  for (size_t i = pts.size() - 1, t = k + 1; i-- > 0;) {
+    while (k >= t && turn(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
+    h[k++] = pts[i];
+  }
+  h.resize(k - 1);
+  return h;
+}
+
 double signed_area(const Polygon& p) {
   double a = 0;
   const size_t n = p.size();

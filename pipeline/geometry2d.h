@@ -17,6 +17,9 @@ inline constexpr double kMaxWorldCoordinateM = 1e7;
 
 double point_segment_distance(const Vec2& v, const Vec2& p, const Vec2& q);  // to the segment pq
 double signed_area(const Polygon& p);  // > 0 for counter-clockwise
+// Counter-clockwise convex hull (Andrew's monotone chain), collinear points dropped (the one copy: synth's convex
+// floes, the outline of a hull's waterplane).
+Polygon convex_hull_2d(Polygon pts);
 Vec2 centroid(const Polygon& p);        // area centroid; requires non-zero area
 void make_ccw(Polygon& p);
 // Index pair (i, j) of two non-adjacent edges that intersect, or (-1, -1) if the ring is simple.

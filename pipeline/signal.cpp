@@ -67,6 +67,18 @@ std::vector<double> moving_average_causal(const std::vector<double>& x, size_t n
   return y;
 }
 
+std::vector<double> moving_average_full_windows(const std::vector<double>& x, size_t n) {
+  std::vector<double> y;
+  if (n == 0 || x.size() < n) return y;
+  y.reserve(x.size() - n + 1);
+  for (size_t i = 0; i + n <= x.size(); ++i) {
+    double s = 0;
+    for (size_t k = i; k < i + n; ++k) s += x[k];
+    y.push_back(s / static_cast<double>(n));
+  }
+  return y;
+}
+
 SteadyMean mean_from(const std::vector<double>& t, const std::vector<double>& x, double t_start) {
   FLOESIM_REQUIRE(t.size() == x.size(), "internal: time and value series differ in length");
   long double sum = 0;

@@ -24,6 +24,12 @@ std::pair<size_t, size_t> full_window_range(size_t n, size_t window_samples);
 // Causal moving average: y_n = mean of x_{n-N+1} .. x_n (fewer samples at the start).
 std::vector<double> moving_average_causal(const std::vector<double>& x, size_t window_samples);
 
+// The moving average over whole windows only: y_k = mean of x_k .. x_{k+N-1}, size - N + 1 values (none when the
+// series is shorter than N or N = 0). Each window is summed afresh, so that a window of zeros averages to exactly 0
+// (no residue of a running or prefix sum, as the two above have): for the peak of a load series in a summary,
+// O(size x N) additions, a few tens of millions at most.
+std::vector<double> moving_average_full_windows(const std::vector<double>& x, size_t window_samples);
+
 // Arithmetic mean of x[i] over the samples with t[i] >= t_start (the steady part). Error if there are none.
 struct SteadyMean {
   double mean = 0;

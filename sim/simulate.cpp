@@ -15,6 +15,7 @@
 #include "pipeline/ice_resistance.h"
 #include "pipeline/interrupt.h"
 #include "pipeline/provenance.h"
+#include "pipeline/signal.h"
 #include "pipeline/units.h"
 #include "sim/checkpoint.h"
 #include "sim/fracture.h"
@@ -272,20 +273,6 @@ nlohmann::json level_ice_summary(const Model& model, const Results& r, const Ser
                              {"clearing_pieces_N", (sum_all - sum_sheet) / n},
                              {"breaking_share", sum_all != 0 ? sum_sheet / sum_all : 0.0}};
   return j;
-}
-
-std::vector<double> moving_average(const std::vector<double>& x, size_t n) {
-  std::vector<double> y;
-  if (n == 0 || x.size() < n) return y;
-  // Each window summed afresh (no running-sum residue: a window of zeros averages to exactly 0); O(size x n)
-  // additions, a few tens of millions at most for the summary.
-  y.reserve(x.size() - n + 1);
-  for (size_t i = 0; i + n <= x.size(); ++i) {
-    double s = 0;
-    for (size_t k = i; k < i + n; ++k) s += x[k];
-    y.push_back(s / static_cast<double>(n));
-  }
-  return y;
 }
 
 namespace {
@@ -654,7 +641,7 @@ nlohmann::json summarize(const Model& model, const Results& r, const SeriesSourc
   nlohmann::json windows = nlohmann::json::array();
   for (double w : {kCompliantWindowS, kRigidWindowS}) {
     const size_t nw = static_cast<size_t>(std::lround(w / o.time_step_s));
-    const std::vector<double> ma = moving_average(fx, nw);
+    const std::vector<double> ma = moving_average_full_windows(fx, nw);
     const std::string kind = w == kRigidWindowS ? "rigid" : "compliant";
     nlohmann::json j = {{"window_s", w}, {"samples", nw}, {"kind", kind},
                         // the window the seed uses for this run's vessel contacts (rigid: 20 s, else 0.5 s)

@@ -61,8 +61,4 @@ std::string run_simulate(const std::filesystem::path& floes_file, const std::fil
                          const std::filesystem::path& config_file, const std::filesystem::path& out_dir,
                          bool resume = false);
 
-// Centred moving average of x with a window of n samples (n odd or even: n samples ending n/2 after the centre);
-// only the positions where the window fits are returned.
-std::vector<double> moving_average(const std::vector<double>& x, size_t n);
-
 }  // namespace floesim::sim

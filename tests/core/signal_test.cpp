@@ -71,6 +71,19 @@ TEST(Signal, CausalAverageOfARampLagsByHalfTheWindow) {
   EXPECT_NEAR(y[3], (0 + 2 + 4 + 6) / 4.0, 1e-12);  // first samples: mean of what exists
 }
 
+TEST(Signal, FullWindowAverageOfARampAndOfZerosAfterLoads) {
+  // Whole windows only: size - N + 1 values, y_k the mean of x_k .. x_{k+N-1} (a ramp 2k: 2k + N - 1); a window of
+  // zeros after large values averages to exactly 0 (a running or prefix sum would leave its residue).
+  const auto x = ramp(100, 0.0, 2.0);
+  const auto y = moving_average_full_windows(x, 10);
+  ASSERT_EQ(y.size(), 91u);
+  for (size_t k = 0; k < y.size(); ++k) EXPECT_NEAR(y[k], 2.0 * k + 9.0, 1e-12);
+  std::vector<double> z = {1e17, -3e16, 7.1e15, 0, 0, 0, 0};
+  EXPECT_EQ(moving_average_full_windows(z, 4).back(), 0.0);
+  EXPECT_TRUE(moving_average_full_windows(z, 8).empty());
+  EXPECT_TRUE(moving_average_full_windows(z, 0).empty());
+}
+
 TEST(Signal, EvenCentredWindowRemovesAnAlternationExactly) {
   // +-1 alternation: the half-weighted end samples make an even window cancel it (an odd one leaves 1/N).
   std::vector<double> x(60);

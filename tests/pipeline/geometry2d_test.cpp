@@ -483,5 +483,24 @@ TEST(EqualAreaWedge, ReachAreaAndShape) {
   EXPECT_THROW(equal_area_wedge(apex, axis, 0.5, 0), Error);
 }
 
+TEST(ConvexHull2d, PointsInsideASquareAndOnItsEdgesLeaveItsFourCorners) {
+  // Random points inside [0, 4] x [0, 3], others on its edges (collinear: dropped), repeats, and the corners: the
+  // hull is the rectangle, counter-clockwise from the lowest-leftmost corner.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.01, 0.99);
+  Polygon pts;
+  for (int i = 0; i < 300; ++i) pts.push_back({4 * u(rng), 3 * u(rng)});
+  for (int i = 0; i < 20; ++i) pts.push_back({4 * u(rng), 0.0}), pts.push_back({4.0, 3 * u(rng)});
+  for (const Vec2& c : {Vec2(4, 3), Vec2(0, 0), Vec2(0, 3), Vec2(4, 0), Vec2(0, 0)}) pts.push_back(c);
+  const Polygon h = convex_hull_2d(pts);
+  ASSERT_EQ(h.size(), 4u);
+  EXPECT_EQ(h[0], Vec2(0, 0));
+  EXPECT_EQ(h[1], Vec2(4, 0));
+  EXPECT_EQ(h[2], Vec2(4, 3));
+  EXPECT_EQ(h[3], Vec2(0, 3));
+  EXPECT_DOUBLE_EQ(signed_area(h), 12.0);
+  EXPECT_EQ(convex_hull_2d({Vec2(1, 1), Vec2(2, 2)}).size(), 2u);  // fewer than three points: returned as they are
+}
+
 }  // namespace
 }  // namespace floesim
