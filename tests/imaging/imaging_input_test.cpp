@@ -46,6 +46,16 @@ class DigitiseBadInput : public ::testing::Test {
     }
     EXPECT_TRUE(test::list_dir(out_).empty()) << "files were left in the output directory";
   }
+  // Writes a hand-built TIFF claiming 30000 x 30000 pixels and checks that its header reads as such.
+  std::filesystem::path write_tiff_of_30000_squared(const std::string& name, const std::string& bytes) {
+    const auto f = dir_.path / name;
+    std::ofstream(f, std::ios::binary) << bytes;
+    const ImageHeader head = read_image_header(f);
+    EXPECT_EQ(head.format, "TIFF");
+    EXPECT_EQ(head.width, 30000);
+    EXPECT_EQ(head.height, 30000);
+    return f;
+  }
   test::ScratchDir dir_;
   std::filesystem::path good_, out_;
 };
@@ -182,12 +192,7 @@ TEST_F(DigitiseBadInput, HugeTiffRefusedFromItsHeader) {
   entry(273, 4, 8);
   entry(279, 4, 16);
   t += std::string(4, '\0');
-  const auto f = dir_.path / "huge.tif";
-  std::ofstream(f, std::ios::binary) << t;
-  const ImageHeader head = read_image_header(f);
-  EXPECT_EQ(head.format, "TIFF");
-  EXPECT_EQ(head.width, 30000);
-  EXPECT_EQ(head.height, 30000);
+  const auto f = write_tiff_of_30000_squared("huge.tif", t);
   DigitiseRequest r = request(f);
   r.config = {{"max_pixels", 1e8}};
   expect_refused(r, {"huge.tif", "30000 x 30000", "900 megapixels", "max_pixels"});
@@ -231,12 +236,7 @@ TEST_F(DigitiseBadInput, BigTiffRefusedFromItsHeader) {
   entry(279, 16, 16);
   u64(0);
   t += std::string(16, '\x80');
-  const auto f = dir_.path / "big.tif";
-  std::ofstream(f, std::ios::binary) << t;
-  const ImageHeader head = read_image_header(f);
-  EXPECT_EQ(head.format, "TIFF");
-  EXPECT_EQ(head.width, 30000);
-  EXPECT_EQ(head.height, 30000);
+  const auto f = write_tiff_of_30000_squared("big.tif", t);
   expect_refused(request(f), {"big.tif", "30000 x 30000", "max_pixels"});
 }
 
