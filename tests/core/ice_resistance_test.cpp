@@ -11,6 +11,7 @@
 
 #include "pipeline/error.h"
 #include "pipeline/ice_resistance.h"
+#include "tests/error_of.h"
 
 using namespace floesim;
 
@@ -48,14 +49,7 @@ LevelIce example_ice() {
 
 double kn(double n) { return n / 1e3; }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using floesim::tests::error_of;
 
 }  // namespace
 

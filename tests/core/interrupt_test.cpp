@@ -7,7 +7,6 @@
 #include <unistd.h>
 
 #include <filesystem>
-#include <functional>
 #include <fstream>
 #include <set>
 
@@ -15,6 +14,7 @@
 #include "pipeline/error.h"
 #include "pipeline/interrupt.h"
 #include "pipeline/runner/plan.h"
+#include "tests/error_of.h"
 
 using namespace floesim;
 namespace fs = std::filesystem;
@@ -40,14 +40,7 @@ int exit_code(pid_t pid) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using floesim::tests::error_of;
 
 }  // namespace
 

@@ -11,6 +11,7 @@
 #include "pipeline/provenance.h"
 #include "pipeline/results_io.h"
 #include "pipeline/options.h"
+#include "tests/error_of.h"
 
 using namespace floesim;
 namespace fs = std::filesystem;
@@ -138,15 +139,8 @@ void replace_attributes(const fs::path& file, const nlohmann::json& attrs) {
   H5Fclose(f);
 }
 
-// The error of `f`, or "" if it did not throw.
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using floesim::tests::error_of;
+
 }  // namespace
 
 TEST(ResultsIo, RoundTripAndBitIdenticalRewrites) {

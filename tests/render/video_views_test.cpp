@@ -14,6 +14,7 @@
 #include "render/strip_chart.h"
 #include "render/video.h"
 #include "synthetic_results.h"
+#include "tests/error_of.h"
 
 using namespace floesim;
 using namespace floesim::render;
@@ -62,14 +63,7 @@ cv::Vec3d bgr(const std::string& hex) {
   return {255.0 * rgb[2], 255.0 * rgb[1], 255.0 * rgb[0]};
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using floesim::tests::error_of;
 
 }  // namespace
 

@@ -10,6 +10,7 @@
 #include "sim/simulate.h"
 #include "sim/world.h"
 #include "sim_fixtures.h"
+#include "tests/error_of.h"
 
 namespace floesim::sim {
 namespace {
@@ -18,15 +19,7 @@ using testing::coarse_hull;
 using testing::floe_options;
 using testing::rect_floe;
 
-template <class F>
-std::string error_of(F f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using floesim::tests::error_of;
 
 // Started with the current (an established drift), a free floe has no relative velocity, hence no drag: it keeps
 // the current's velocity to rounding, and stays level at its draught.
