@@ -298,11 +298,14 @@ struct SolverOptions {
   // Diagnostic (costly): a second solve of every step on copies, from the same state, and the difference in the
   // vessel's surge ice load recorded (solver_surge_load_error). "converged_relax": the relax pass continued up to
   // reference_sweeps; "double_cap": solve and relax with twice their sweep caps; "reverse_order": the rows swept
-  // in the other order. Paired on one trajectory, it measures what the cap or the order changes in the load
+  // in the other order; "every_contact": every contact in every sweep (skip_settled 0). Paired on one trajectory, it measures what the cap or the order changes in the load
   // without the chaos of a transit, which makes two runs differ by far more (5-15 % between starts).
   std::string reference = "off";
   int reference_sweeps = 2000;     // sweeps of the "converged_relax" reference
   bool reverse_order = false;      // sweep the rows last to first (to check that results do not hang on the order)
+  // A sweep leaves out a contact that has settled: its last update changed its row velocities by less than this
+  // fraction of tolerance_mps, and its relative velocity has moved by less than that since (see solve_island).
+  double skip_settled = 0.5;
   template <class V>
   void visit(V& v) {
     v.field("method", method, "-",
@@ -326,11 +329,17 @@ struct SolverOptions {
             "diagnostic (costly): each step is solved a second time on copies from the same state and the "
             "vessel's surge ice load minus the reference's is recorded (solver_surge_load_error): off, "
             "converged_relax (the relax pass continued to reference_sweeps), double_cap (solve and relax with "
-            "twice their sweep caps) or reverse_order (the rows swept in the other order)",
-            one_of({"off", "converged_relax", "double_cap", "reverse_order"}));
+            "twice their sweep caps), reverse_order (the rows swept in the other order) or every_contact (no "
+            "settled contact left out of a sweep: skip_settled 0)",
+            one_of({"off", "converged_relax", "double_cap", "reverse_order", "every_contact"}));
     v.field("reference_sweeps", reference_sweeps, "-",
             "sweeps of the converged_relax reference (tolerance 1e-3 of tolerance_mps)", int_in_range(1, 1000000));
     v.field("reverse_order", reverse_order, "-", "sweep the contact rows in reverse order (an order-dependence check)");
+    v.field("skip_settled", skip_settled, "-",
+            "a sweep leaves out a contact whose last update and whose relative velocity since then both changed by "
+            "less than this fraction of tolerance_mps (its update would change nothing that counts); 0: every "
+            "contact in every sweep",
+            in_range(0, 1));
     v.field("iterations", iterations, "-", "largest number of Gauss-Seidel sweeps per step", int_in_range(1, 10000));
     v.field("relax_iterations", relax_iterations, "-",
             "sweeps without push-out bias after the position update, so that push-out leaves no velocity",

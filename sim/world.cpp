@@ -224,7 +224,7 @@ void World::stage_solve() {
   const double dt = model_.options.time_step_s;
   islands_ = prepare_contacts(model_, solver_bodies_, state_, contacts_, dt);
   // A paired reference solve of the whole step starts where this one does: after the warm start.
-  if (o.reference == "double_cap" || o.reference == "reverse_order") {
+  if (o.reference == "double_cap" || o.reference == "reverse_order" || o.reference == "every_contact") {
     reference_state_ = state_;
     reference_contacts_ = contacts_;
   }
@@ -277,11 +277,13 @@ double World::reference_surge_load(const Vec3& surge) {
     solve_contacts(model_, solver_bodies_, s, c, islands_, dt, false, o.reference_sweeps, o.tolerance_mps * 1e-3,
                    &pool_);
   } else {
-    // The step's solve and relax passes again, from the state the solve started from, with twice the caps or the
-    // other sweep order. The relax pass does not read positions, so the copy taken before integration serves it.
+    // The step's solve and relax passes again, from the state the solve started from, with twice the caps, the
+    // other sweep order or every contact in every sweep. The relax pass does not read positions, so the copy taken
+    // before integration serves it.
     SolverOptions v = o;
     int cap = o.iterations, relax = o.relax_iterations;
     if (o.reference == "double_cap") cap *= 2, relax *= 2;
+    else if (o.reference == "every_contact") v.skip_settled = 0;
     else v.reverse_order = !o.reverse_order;
     s = std::move(reference_state_);
     c = std::move(reference_contacts_);

@@ -130,7 +130,7 @@ class World {
   std::unique_ptr<CollisionWorld> collision_;
   std::vector<Contact> contacts_;
   State reference_state_;                   // solver.reference: the state and contacts the step's solve started
-  std::vector<Contact> reference_contacts_;  // from (double_cap, reverse_order)
+  std::vector<Contact> reference_contacts_;  // from (double_cap, reverse_order, every_contact)
   ContactIslands islands_;          // of contacts_ (solve stage), for the solve, relax and reference passes
   std::vector<int> awake_list_;     // bodies integrated this step (ascending)
   std::vector<int> moved_;          // bodies integrated in the previous step (broad phase refresh)

@@ -35,8 +35,9 @@ TEST(SimInput, OptionErrorsNameTheKey) {
   expect_error([] { options_from({{"solver", {{"subspace_above_mps", -1}}}}); }, {"solver.subspace_above_mps"});
   expect_error([] { options_from({{"solver", {{"subspace_max_rows", 0}}}}); }, {"solver.subspace_max_rows"});
   expect_error([] { options_from({{"solver", {{"reference_sweeps", 0}}}}); }, {"solver.reference_sweeps"});
+  expect_error([] { options_from({{"solver", {{"skip_settled", 1.5}}}}); }, {"solver.skip_settled"});
   expect_error([] { options_from({{"solver", {{"reference", "converged"}}}}); },
-               {"solver.reference", "converged_relax", "double_cap", "reverse_order"});
+               {"solver.reference", "converged_relax", "double_cap", "reverse_order", "every_contact"});
   // The added-mass factors and the propellers (a list: errors name the item).
   expect_error([] { options_from({{"water", {{"floe_added_mass_scale", -1}}}}); }, {"water.floe_added_mass_scale"});
   expect_error([] { options_from({{"water", {{"floe_heave_added_mass_ratio", 1}}}}); },
