@@ -371,11 +371,20 @@ struct PairCandidate {
   }
 };
 
+// A chunk of pairs a worker ran: its contacts are contacts[first, end) of that worker's scratch.
+struct ChunkRange {
+  int chunk, first, end;
+};
+struct ChunkOfWorker {
+  int chunk, worker, first, end;
+};
+
 // Scratch of one worker.
 struct Scratch {
   std::vector<Vec3> poly, tmp;
   PatchScratch patch;
-  std::vector<Contact> contacts;      // contacts of this worker's pairs, in pair order
+  std::vector<Contact> contacts;      // contacts of this worker's chunks, each chunk's in pair order
+  std::vector<ChunkRange> chunks;     // the chunks this worker ran, in the order it ran them
   long hits = 0, edges = 0, crushing = 0;
 };
 
@@ -398,6 +407,7 @@ struct CollisionWorld::Impl {
   const State* state = nullptr;  // during find_contacts (the broad-phase callback reads the awake flags)
   ThreadPool& pool;
   std::vector<Scratch> scratch;
+  std::vector<ChunkOfWorker> chunk_order;
 
   bool compliant_structure, compliant_ice;  // options.contact, per pair of body classes
 
@@ -862,14 +872,18 @@ void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out
   stats_ = CollisionStats{};
   stats_.broadphase_pairs = static_cast<long>(m.pairs.size());
 
-  // Narrow phase per pair (parallel over contiguous chunks; each worker keeps its pairs' contacts in order).
+  // Narrow phase per pair, in chunks of pairs handed to whichever thread is free; each chunk's contacts are kept in
+  // pair order in its thread's buffer, and the chunks are put together in chunk order.
   const int npairs = static_cast<int>(m.pairs.size());
   for (auto& sc : m.scratch) {
     sc.contacts.clear();
+    sc.chunks.clear();
     sc.hits = sc.edges = sc.crushing = 0;
   }
-  m.pool.parallel_for(npairs, [&](int begin, int end, int w) {
+  constexpr int kChunk = 16;
+  m.pool.parallel_chunks(npairs, kChunk, [&](int begin, int end, int w, int chunk) {
     Scratch& sc = m.scratch[w];
+    const int first = static_cast<int>(sc.contacts.size());
     fcl::CollisionRequestd req(1, true);
     req.gjk_solver_type = fcl::GST_LIBCCD;
     for (int i = begin; i < end; ++i) {
@@ -888,10 +902,19 @@ void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out
       // FCL's normal points from its first object to its second: part_a to part_b here.
       if (m.manifold(pc, axes, res.getContact(0), sc, sc.contacts)) ++sc.edges;
     }
-  }, 8);
-  // Workers hold contiguous, increasing ranges of pairs: concatenating in worker order keeps the sorted order.
+    sc.chunks.push_back({chunk, first, static_cast<int>(sc.contacts.size())});
+  });
+  // The chunks in pair order, whichever thread ran them: the contacts are in sorted pair order, as with one thread.
+  m.chunk_order.clear();
+  for (size_t w = 0; w < m.scratch.size(); ++w)
+    for (const ChunkRange& r : m.scratch[w].chunks) m.chunk_order.push_back({r.chunk, static_cast<int>(w), r.first, r.end});
+  std::sort(m.chunk_order.begin(), m.chunk_order.end(),
+            [](const ChunkOfWorker& x, const ChunkOfWorker& y) { return x.chunk < y.chunk; });
+  for (const ChunkOfWorker& r : m.chunk_order) {
+    const std::vector<Contact>& cs = m.scratch[r.worker].contacts;
+    out.insert(out.end(), cs.begin() + r.first, cs.begin() + r.end);
+  }
   for (auto& sc : m.scratch) {
-    out.insert(out.end(), sc.contacts.begin(), sc.contacts.end());
     stats_.narrowphase_hits += sc.hits;
     stats_.edge_contacts += sc.edges;
     stats_.crushing_contacts += sc.crushing;
