@@ -907,7 +907,8 @@ void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out
   // The chunks in pair order, whichever thread ran them: the contacts are in sorted pair order, as with one thread.
   m.chunk_order.clear();
   for (size_t w = 0; w < m.scratch.size(); ++w)
-    for (const ChunkRange& r : m.scratch[w].chunks) m.chunk_order.push_back({r.chunk, static_cast<int>(w), r.first, r.end});
+    for (const ChunkRange& r : m.scratch[w].chunks)
+      m.chunk_order.push_back({r.chunk, static_cast<int>(w), r.first, r.end});
   std::sort(m.chunk_order.begin(), m.chunk_order.end(),
             [](const ChunkOfWorker& x, const ChunkOfWorker& y) { return x.chunk < y.chunk; });
   for (const ChunkOfWorker& r : m.chunk_order) {

@@ -1,5 +1,6 @@
-// A small persistent thread pool for the per-body and per-pair stages. Work is split into contiguous chunks by
-// index and every result goes to its own slot, so results do not depend on the number of threads.
+// A small persistent thread pool for the per-body and per-pair stages. Work is split into chunks by index and
+// every result goes to its own slot (per index, or per chunk: parallel_chunks), so results do not depend on the
+// number of threads or on which thread ran what.
 //
 // A step hands the pool five short jobs (poses, narrow phase, forces, solve, relax) of 0.05-1 ms each, with serial
 // work between them. Waking a thread blocked on a condition variable takes tens of microseconds (a futex call and a

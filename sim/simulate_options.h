@@ -298,8 +298,9 @@ struct SolverOptions {
   // Diagnostic (costly): a second solve of every step on copies, from the same state, and the difference in the
   // vessel's surge ice load recorded (solver_surge_load_error). "converged_relax": the relax pass continued up to
   // reference_sweeps; "double_cap": solve and relax with twice their sweep caps; "reverse_order": the rows swept
-  // in the other order; "every_contact": every contact in every sweep (skip_settled 0). Paired on one trajectory, it measures what the cap or the order changes in the load
-  // without the chaos of a transit, which makes two runs differ by far more (5-15 % between starts).
+  // in the other order; "every_contact": every contact in every sweep (skip_settled 0). Paired on one trajectory,
+  // it measures what the setting changes in the load without the chaos of a transit, which makes two runs differ
+  // by far more (5-15 % between starts).
   std::string reference = "off";
   int reference_sweeps = 2000;     // sweeps of the "converged_relax" reference
   bool reverse_order = false;      // sweep the rows last to first (to check that results do not hang on the order)
