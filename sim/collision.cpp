@@ -141,8 +141,8 @@ void clip_faces(const ConvexPart& P, const PartWorld& pw, const Vec3& tp, const 
                    std::abs(df - (qw.d[g] + qw.n[g].dot(shift_q))) <= kClipTolerance;
       if (coplanar) continue;
     }
-    poly.clear();
-    for (int i : P.faces[f]) poly.push_back(pw.v[i] + shift_p);
+    poly.resize(P.faces[f].size());
+    for (size_t i = 0; i < poly.size(); ++i) poly[i] = pw.v[P.faces[f][i]] + shift_p;
     for (size_t j = 0; j < cs.planes.size() && poly.size() >= 3; ++j) {
       const int g = cs.planes[j];
       const Vec3& qn = qw.n[g];
@@ -157,17 +157,20 @@ void clip_faces(const ConvexPart& P, const PartWorld& pw, const Vec3& tp, const 
         poly.clear();
         break;
       }
+      // Each edge gives at most two vertices: sized once and written by index (no push_back in the innermost loop).
       tmp.swap(poly);
-      poly.clear();
+      poly.resize(2 * k);
+      size_t m = 0;
       double sp = dist[k - 1];  // previous vertex (edge tmp[k-1] -> tmp[0] first)
       for (size_t i = 0; i < k; ++i) {
         const Vec3& p = tmp[i == 0 ? k - 1 : i - 1];
         const Vec3& q = tmp[i];
         const double sq = dist[i];
-        if ((sp <= 0) != (sq <= 0)) poly.push_back(p + (sp / (sp - sq)) * (q - p));
-        if (sq <= 0) poly.push_back(q);
+        if ((sp <= 0) != (sq <= 0)) poly[m++] = p + (sp / (sp - sq)) * (q - p);
+        if (sq <= 0) poly[m++] = q;
         sp = sq;
       }
+      poly.resize(m);
     }
     if (poly.size() < 3) continue;
     // Area (signed about the face normal: clipping keeps the winding) and centroid of the clipped face.

@@ -71,15 +71,19 @@ inline int clip_polygon_z(const Vec3* p, int n, double z0, bool below, Vec3* out
 }
 
 // Part of the polygon p[0..n) in the half-space u.x <= d, written to out (any plane; clip_polygon_z is z alone).
+// Each edge gives at most two points, so out is sized once and written by index (no push_back in the loop: this
+// runs for every face of every crushing contact, every step).
 inline void clip_polygon_plane(const Vec3* p, int n, const Vec3& u, double d, std::vector<Vec3>& out) {
-  out.clear();
+  out.resize(2 * static_cast<size_t>(n));
+  int k = 0;
   for (int i = 0; i < n; ++i) {
     const Vec3& a = p[i];
     const Vec3& b = p[i + 1 == n ? 0 : i + 1];
     const double sa = u.dot(a) - d, sb = u.dot(b) - d;
-    if (sa <= 0) out.push_back(a);
-    if ((sa <= 0) != (sb <= 0)) out.push_back(a + (sa / (sa - sb)) * (b - a));
+    if (sa <= 0) out[k++] = a;
+    if ((sa <= 0) != (sb <= 0)) out[k++] = a + (sa / (sa - sb)) * (b - a);
   }
+  out.resize(k);
 }
 
 // 2D cross product of (b - a) and (c - a).
