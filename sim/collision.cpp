@@ -399,7 +399,8 @@ struct CollisionWorld::Impl {
   std::vector<std::unique_ptr<PartObject>> objects;
   std::vector<PartWorld> world;
   // Two trees (Box2D's static/dynamic split): parts of sleeping bodies do not move and are never paired with each
-  // other, so the per-step cost scales with the awake bodies: awake x awake and awake x sleeping.
+  // other, so the per-step cost scales with the awake bodies. The trees give the awake x sleeping pairs; the awake
+  // x awake pairs come from a grid rebuilt every step (awake_pairs_in_grid).
   fcl::DynamicAABBTreeCollisionManagerd awake_tree, sleeping_tree;
   // Per body: which tree holds its parts (the body table grows with fracture; removed bodies are in neither).
   static constexpr uint8_t kSleepingTree = 0, kAwakeTree = 1, kRemoved = 2;
@@ -572,19 +573,85 @@ struct CollisionWorld::Impl {
     return true;
   }
 
+  // The awake parts' pairs whose exact boxes overlap (those the tree of awake parts would give the callback), from a
+  // uniform grid in x and y rebuilt every step. FCL's tree collided with itself cost 1.5 ms per step on a field with
+  // every floe awake (5,500 parts), a third of the step and serial; the grid (one pass to count the parts per cell,
+  // one to fill the cells, and the pairs within each cell) takes that step from 4.34 to 3.9-4.05 ms. A pair sharing several cells is taken in one of them,
+  // the cell holding the corner (max lo.x, max lo.y) of the two boxes' overlap, which both boxes cover.
+  struct GridItem {
+    int part, i0, j0;  // the part, and the cell of its box's low corner
+  };
+  std::vector<int> grid_parts, grid_start;
+  std::vector<GridItem> grid_items;
+  void awake_pairs_in_grid() {
+    grid_parts.clear();
+    for (size_t b = 0; b < model.bodies.size(); ++b) {
+      if (tree_of[b] != kAwakeTree) continue;
+      const Body& body = model.bodies[b];
+      for (int p = body.first_part; p < body.first_part + body.part_count; ++p) grid_parts.push_back(p);
+    }
+    const size_t n = grid_parts.size();
+    if (n < 2) return;
+    // Cells as large as a part is on average (so a part covers a few cells), over the parts' extent; fewer cells
+    // than ~4 per part whatever the spread.
+    double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300, size = 0;
+    for (int p : grid_parts) {
+      const PartWorld& w = world[p];
+      x0 = std::min(x0, w.lo.x()), y0 = std::min(y0, w.lo.y());
+      x1 = std::max(x1, w.hi.x()), y1 = std::max(y1, w.hi.y());
+      size += std::max(w.hi.x() - w.lo.x(), w.hi.y() - w.lo.y());
+    }
+    double cell = std::max(size / static_cast<double>(n), 0.5);
+    const double max_cells = 4.0 * static_cast<double>(n) + 1024;
+    while (((x1 - x0) / cell + 1) * ((y1 - y0) / cell + 1) > max_cells) cell *= 1.5;
+    const int nx = static_cast<int>((x1 - x0) / cell) + 1, ny = static_cast<int>((y1 - y0) / cell) + 1;
+    auto ix = [&](double x) { return std::clamp(static_cast<int>((x - x0) / cell), 0, nx - 1); };
+    auto iy = [&](double y) { return std::clamp(static_cast<int>((y - y0) / cell), 0, ny - 1); };
+    grid_start.assign(static_cast<size_t>(nx) * ny + 1, 0);
+    for (int p : grid_parts) {
+      const PartWorld& w = world[p];
+      for (int j = iy(w.lo.y()); j <= iy(w.hi.y()); ++j)
+        for (int i = ix(w.lo.x()); i <= ix(w.hi.x()); ++i) ++grid_start[static_cast<size_t>(j) * nx + i + 1];
+    }
+    for (size_t c = 1; c < grid_start.size(); ++c) grid_start[c] += grid_start[c - 1];
+    grid_items.resize(grid_start.back());
+    std::vector<int> fill(grid_start.begin(), grid_start.end() - 1);
+    for (int p : grid_parts) {
+      const PartWorld& w = world[p];
+      const int i0 = ix(w.lo.x()), j0 = iy(w.lo.y());
+      for (int j = j0; j <= iy(w.hi.y()); ++j)
+        for (int i = i0; i <= ix(w.hi.x()); ++i) grid_items[fill[static_cast<size_t>(j) * nx + i]++] = {p, i0, j0};
+    }
+    // The cell of the overlap's corner is (max of the two i0, max of the two j0): ix and iy never decrease.
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const size_t c = static_cast<size_t>(j) * nx + i;
+        for (int a = grid_start[c]; a < grid_start[c + 1]; ++a)
+          for (int b = a + 1; b < grid_start[c + 1]; ++b) {
+            const GridItem& g1 = grid_items[a];
+            const GridItem& g2 = grid_items[b];
+            if (std::max(g1.i0, g2.i0) != i || std::max(g1.j0, g2.j0) != j) continue;
+            add_candidate(g1.part, g2.part);
+          }
+      }
+  }
+
+  // A part pair of the broad phase: kept if the parts are of two bodies, one of them awake, with overlapping exact
+  // boxes (the tree's boxes are enlarged and depend on the history of the leaf; the exact boxes make the candidate
+  // set a function of the current poses only).
+  void add_candidate(int p1, int p2) {
+    const int b1 = model.parts[p1].body, b2 = model.parts[p2].body;
+    if (b1 == b2) return;
+    if (!state->awake[b1] && !state->awake[b2]) return;
+    const PartWorld& w1 = world[p1];
+    const PartWorld& w2 = world[p2];
+    if ((w1.lo.array() > w2.hi.array()).any() || (w2.lo.array() > w1.hi.array()).any()) return;
+    pairs.push_back(b1 < b2 ? PairCandidate{b1, p1, b2, p2} : PairCandidate{b2, p2, b1, p1});
+  }
+
   static bool broadphase_callback(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) {
     auto* self = static_cast<Impl*>(data);
-    const int p1 = static_cast<PartObject*>(o1)->part, p2 = static_cast<PartObject*>(o2)->part;
-    int b1 = self->model.parts[p1].body, b2 = self->model.parts[p2].body;
-    if (b1 == b2) return false;
-    if (!self->state->awake[b1] && !self->state->awake[b2]) return false;
-    // The tree's boxes are enlarged and depend on the history of the leaf; the exact boxes make the candidate set a
-    // function of the current poses only.
-    const PartWorld& w1 = self->world[p1];
-    const PartWorld& w2 = self->world[p2];
-    if ((w1.lo.array() > w2.hi.array()).any() || (w2.lo.array() > w1.hi.array()).any()) return false;
-    PairCandidate c = b1 < b2 ? PairCandidate{b1, p1, b2, p2} : PairCandidate{b2, p2, b1, p1};
-    self->pairs.push_back(c);
+    self->add_candidate(static_cast<PartObject*>(o1)->part, static_cast<PartObject*>(o2)->part);
     return false;  // keep going
   }
 
@@ -869,7 +936,7 @@ void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out
   // Broad phase: candidate part pairs, then a fixed order so that runs are deterministic.
   m.pairs.clear();
   m.state = &state;
-  m.awake_tree.collide(&m, &Impl::broadphase_callback);
+  m.awake_pairs_in_grid();
   m.awake_tree.collide(&m.sleeping_tree, &m, &Impl::broadphase_callback);
   std::sort(m.pairs.begin(), m.pairs.end());
   stats_ = CollisionStats{};

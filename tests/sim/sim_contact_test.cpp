@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "pipeline/geometry2d.h"
 #include "sim/world.h"
 #include "sim_fixtures.h"
 
@@ -125,6 +126,88 @@ TEST(SimContact, SharedFacesAreMarked) {
   ASSERT_EQ(m.bodies[1].part_count, 2);
   EXPECT_EQ(shared(1), 2);
   EXPECT_EQ(shared(0), 2 * (m.bodies[0].part_count - 1));
+}
+
+// The broad phase's candidate pairs (a grid over the awake parts, FCL's tree for awake against sleeping) against a
+// second algorithm: every pair of parts of two bodies tested, their exact boxes from the poses the step starts
+// from. Up to 900 floes (those that leave 0.5 m to the others), half of them L-shaped (several convex parts each, whose seams must not pair), rotated so that
+// their boxes overlap their neighbours' (the floes themselves do not touch); a quarter asleep, so that the three
+// kinds of pairs (awake-awake, awake-asleep, asleep-asleep: none) all occur.
+TEST(BroadPhase, CandidatePairsAreEveryPartPairWhoseBoxesOverlap) {
+  FloeField field;
+  uint64_t h = 12345;
+  auto next = [&] {  // deterministic uniform [0, 1)
+    h = h * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(h >> 11) * 0x1.0p-53;
+  };
+  std::vector<Vec2> centre;
+  std::vector<double> radius;
+  for (int k = 0; k < 900; ++k) {
+    const double cx = 10.0 * (k % 30), cy = 10.0 * (k / 30), a = 2 * kPi * next(), s = 4 + 3 * next();
+    std::vector<Vec2> shape = k % 2 ? std::vector<Vec2>{{-1, -1}, {1, -1}, {1, 0}, {0, 0}, {0, 1}, {-1, 1}}
+                                    : std::vector<Vec2>{{-1, -0.5}, {1, -0.5}, {1, 0.5}, {-1, 0.5}};
+    Floe f;
+    f.id = k + 1;
+    for (const Vec2& q : shape)
+      f.outline.push_back(Vec2(cx + s * (std::cos(a) * q.x() - std::sin(a) * q.y()),
+                               cy + s * (std::sin(a) * q.x() + std::cos(a) * q.y())));
+    // Kept only if it leaves 0.5 m to every floe kept so far (the floes must not overlap; their boxes may).
+    bool clear = true;
+    for (size_t j = 0; j < field.floes.size() && clear; ++j) {
+      if ((centre[j] - Vec2(cx, cy)).norm() > radius[j] + s * std::sqrt(2.0) + 0.5) continue;
+      const Polygon& g = field.floes[j].outline;
+      clear = polygon_intersection(f.outline, g).empty();
+      auto vertices_clear = [](const Polygon& a, const Polygon& b) {  // every vertex of a 0.5 m from b's edges
+        for (const Vec2& v : a)
+          for (size_t e = 0; e < b.size(); ++e)
+            if (point_segment_distance(v, b[e], b[(e + 1) % b.size()]) <= 0.5) return false;
+        return true;
+      };
+      clear = clear && vertices_clear(f.outline, g) && vertices_clear(g, f.outline);
+    }
+    if (!clear) continue;
+    f.area_m2 = signed_area(f.outline);
+    f.thickness_m = 1.0;
+    field.floes.push_back(f);
+    centre.push_back(Vec2(cx, cy));
+    radius.push_back(s * std::sqrt(2.0));
+  }
+  SimulateOptions o = floe_options();
+  o.fracture.enabled = false;
+  const Model m = build_model(field, nullptr, o);
+  ASSERT_GT(m.parts.size(), m.bodies.size() + 50);  // the L-shapes are cut into convex parts
+  World w(m);
+  State& st = w.mutable_state();
+  for (size_t b = 0; b < m.bodies.size(); ++b) st.awake[b] = b % 4 != 0;
+  w.sync();
+  const State start = w.state();
+  w.step();
+  // Brute force over all part pairs, boxes from the start poses.
+  std::vector<Vec3> lo(m.parts.size()), hi(m.parts.size());
+  for (size_t p = 0; p < m.parts.size(); ++p) {
+    const int b = m.parts[p].body;
+    const Mat3 R = start.orientation[b].toRotationMatrix();
+    lo[p] = Vec3::Constant(1e300), hi[p] = Vec3::Constant(-1e300);
+    for (const Vec3& v : m.parts[p].vertices) {
+      const Vec3 x = start.position[b] + R * v;
+      lo[p] = lo[p].cwiseMin(x), hi[p] = hi[p].cwiseMax(x);
+    }
+  }
+  long expected = 0, awake_awake = 0, with_sleeper = 0;
+  for (size_t p = 0; p < m.parts.size(); ++p)
+    for (size_t q = p + 1; q < m.parts.size(); ++q) {
+      const int bp = m.parts[p].body, bq = m.parts[q].body;
+      if (bp == bq || (!start.awake[bp] && !start.awake[bq])) continue;
+      if ((lo[p].array() > hi[q].array()).any() || (lo[q].array() > hi[p].array()).any()) continue;
+      ++expected;
+      (start.awake[bp] && start.awake[bq] ? awake_awake : with_sleeper)++;
+    }
+  std::printf("[measured] %zu parts of %zu floes: %ld candidate pairs (%ld awake-awake, %ld with a sleeper), "
+              "brute force %ld\n", m.parts.size(), m.bodies.size(), w.collision_stats().broadphase_pairs, awake_awake,
+              with_sleeper, expected);
+  EXPECT_GT(awake_awake, 100);
+  EXPECT_GT(with_sleeper, 50);
+  EXPECT_EQ(w.collision_stats().broadphase_pairs, expected);
 }
 
 }  // namespace
