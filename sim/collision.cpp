@@ -374,12 +374,9 @@ struct PairCandidate {
   }
 };
 
-// A chunk of pairs a worker ran: its contacts are contacts[first, end) of that worker's scratch.
+// Where the contacts of one chunk of pairs went: contacts[first, end) of the scratch of the worker that ran it.
 struct ChunkRange {
-  int chunk, first, end;
-};
-struct ChunkOfWorker {
-  int chunk, worker, first, end;
+  int worker, first, end;
 };
 
 // Scratch of one worker.
@@ -387,7 +384,6 @@ struct Scratch {
   std::vector<Vec3> poly, tmp;
   PatchScratch patch;
   std::vector<Contact> contacts;      // contacts of this worker's chunks, each chunk's in pair order
-  std::vector<ChunkRange> chunks;     // the chunks this worker ran, in the order it ran them
   long hits = 0, edges = 0, crushing = 0;
 };
 
@@ -411,7 +407,7 @@ struct CollisionWorld::Impl {
   const State* state = nullptr;  // during find_contacts (the broad-phase callback reads the awake flags)
   ThreadPool& pool;
   std::vector<Scratch> scratch;
-  std::vector<ChunkOfWorker> chunk_order;
+  std::vector<ChunkRange> chunk_ranges;  // per chunk of the narrow phase (written by the thread that ran it)
 
   bool compliant_structure, compliant_ice;  // options.contact, per pair of body classes
 
@@ -576,12 +572,13 @@ struct CollisionWorld::Impl {
   // The awake parts' pairs whose exact boxes overlap (those the tree of awake parts would give the callback), from a
   // uniform grid in x and y rebuilt every step. FCL's tree collided with itself cost 1.5 ms per step on a field with
   // every floe awake (5,500 parts), a third of the step and serial; the grid (one pass to count the parts per cell,
-  // one to fill the cells, and the pairs within each cell) takes that step from 4.34 to 3.9-4.05 ms. A pair sharing several cells is taken in one of them,
-  // the cell holding the corner (max lo.x, max lo.y) of the two boxes' overlap, which both boxes cover.
+  // one to fill the cells, and the pairs within each cell) takes that step from 4.34 to 3.9-4.05 ms. A pair sharing
+  // several cells is taken in one of them, the cell holding the corner (max lo.x, max lo.y) of the two boxes'
+  // overlap, which both boxes cover.
   struct GridItem {
     int part, i0, j0;  // the part, and the cell of its box's low corner
   };
-  std::vector<int> grid_parts, grid_start;
+  std::vector<int> grid_parts, grid_start, grid_fill;
   std::vector<GridItem> grid_items;
   void awake_pairs_in_grid() {
     grid_parts.clear();
@@ -615,12 +612,12 @@ struct CollisionWorld::Impl {
     }
     for (size_t c = 1; c < grid_start.size(); ++c) grid_start[c] += grid_start[c - 1];
     grid_items.resize(grid_start.back());
-    std::vector<int> fill(grid_start.begin(), grid_start.end() - 1);
+    grid_fill.assign(grid_start.begin(), grid_start.end() - 1);
     for (int p : grid_parts) {
       const PartWorld& w = world[p];
       const int i0 = ix(w.lo.x()), j0 = iy(w.lo.y());
       for (int j = j0; j <= iy(w.hi.y()); ++j)
-        for (int i = i0; i <= ix(w.hi.x()); ++i) grid_items[fill[static_cast<size_t>(j) * nx + i]++] = {p, i0, j0};
+        for (int i = i0; i <= ix(w.hi.x()); ++i) grid_items[grid_fill[static_cast<size_t>(j) * nx + i]++] = {p, i0, j0};
     }
     // The cell of the overlap's corner is (max of the two i0, max of the two j0): ix and iy never decrease.
     for (int j = 0; j < ny; ++j)
@@ -947,10 +944,10 @@ void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out
   const int npairs = static_cast<int>(m.pairs.size());
   for (auto& sc : m.scratch) {
     sc.contacts.clear();
-    sc.chunks.clear();
     sc.hits = sc.edges = sc.crushing = 0;
   }
   constexpr int kChunk = 16;
+  m.chunk_ranges.resize((npairs + kChunk - 1) / kChunk);
   m.pool.parallel_chunks(npairs, kChunk, [&](int begin, int end, int w, int chunk) {
     Scratch& sc = m.scratch[w];
     const int first = static_cast<int>(sc.contacts.size());
@@ -972,16 +969,10 @@ void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out
       // FCL's normal points from its first object to its second: part_a to part_b here.
       if (m.manifold(pc, axes, res.getContact(0), sc, sc.contacts)) ++sc.edges;
     }
-    sc.chunks.push_back({chunk, first, static_cast<int>(sc.contacts.size())});
+    m.chunk_ranges[chunk] = {w, first, static_cast<int>(sc.contacts.size())};
   });
   // The chunks in pair order, whichever thread ran them: the contacts are in sorted pair order, as with one thread.
-  m.chunk_order.clear();
-  for (size_t w = 0; w < m.scratch.size(); ++w)
-    for (const ChunkRange& r : m.scratch[w].chunks)
-      m.chunk_order.push_back({r.chunk, static_cast<int>(w), r.first, r.end});
-  std::sort(m.chunk_order.begin(), m.chunk_order.end(),
-            [](const ChunkOfWorker& x, const ChunkOfWorker& y) { return x.chunk < y.chunk; });
-  for (const ChunkOfWorker& r : m.chunk_order) {
+  for (const ChunkRange& r : m.chunk_ranges) {
     const std::vector<Contact>& cs = m.scratch[r.worker].contacts;
     out.insert(out.end(), cs.begin() + r.first, cs.begin() + r.end);
   }

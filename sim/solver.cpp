@@ -501,19 +501,17 @@ SolverReport solve_island(const SolverOptions& o, const SolverBodies& sb, State&
   // `skip`, it is updated again). In a capped solve most contacts sit still while a few light pieces creep between
   // heavy bodies; the test costs one relative velocity, about a quarter of an update. A sweep after a subspace
   // step visits every contact (the step moves impulses outside this bookkeeping).
+  // (skip 0: no change is below it, so every contact is updated.)
   const double skip = o.skip_settled * tolerance;
-  std::vector<Vec3> dv_seen(skip > 0 ? n : 0);  // relative velocity when the contact's last update began
-  std::vector<double> last_change(skip > 0 ? n : 0);
+  std::vector<Vec3> dv_seen(n);  // relative velocity when the contact's last update began
+  std::vector<double> last_change(n);
   bool full = true;
   auto visit = [&](int i) {
     Contact& c = island[i];
     const Vec3 dv = rel_velocity(state, c);
-    if (skip > 0) {
-      if (!full && last_change[i] < skip && (dv - dv_seen[i]).cwiseAbs().maxCoeff() < skip) return 0.0;
-      dv_seen[i] = dv;
-      return last_change[i] = sweep_contact(state, sb, c, dt, use_bias, dv);
-    }
-    return sweep_contact(state, sb, c, dt, use_bias, dv);
+    if (!full && last_change[i] < skip && (dv - dv_seen[i]).cwiseAbs().maxCoeff() < skip) return 0.0;
+    dv_seen[i] = dv;
+    return last_change[i] = sweep_contact(state, sb, c, dt, use_bias, dv);
   };
   for (int it = 0; it < iterations; ++it) {
     double change = 0;

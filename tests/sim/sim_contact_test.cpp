@@ -130,15 +130,22 @@ TEST(SimContact, SharedFacesAreMarked) {
 
 // The broad phase's candidate pairs (a grid over the awake parts, FCL's tree for awake against sleeping) against a
 // second algorithm: every pair of parts of two bodies tested, their exact boxes from the poses the step starts
-// from. Up to 900 floes (those that leave 0.5 m to the others), half of them L-shaped (several convex parts each, whose seams must not pair), rotated so that
-// their boxes overlap their neighbours' (the floes themselves do not touch); a quarter asleep, so that the three
-// kinds of pairs (awake-awake, awake-asleep, asleep-asleep: none) all occur.
+// from. Up to 900 floes (those that leave 0.5 m to the others), half of them L-shaped (several convex parts each,
+// whose seams must not pair), rotated so that their boxes overlap their neighbours' (the floes themselves do not
+// touch); a quarter asleep, so that the three kinds of pairs (awake-awake, awake-asleep, asleep-asleep: none) all
+// occur.
 TEST(BroadPhase, CandidatePairsAreEveryPartPairWhoseBoxesOverlap) {
   FloeField field;
   uint64_t h = 12345;
   auto next = [&] {  // deterministic uniform [0, 1)
     h = h * 6364136223846793005ULL + 1442695040888963407ULL;
     return static_cast<double>(h >> 11) * 0x1.0p-53;
+  };
+  auto vertices_clear = [](const Polygon& a, const Polygon& b) {  // every vertex of a 0.5 m from b's edges
+    for (const Vec2& v : a)
+      for (size_t e = 0; e < b.size(); ++e)
+        if (point_segment_distance(v, b[e], b[(e + 1) % b.size()]) <= 0.5) return false;
+    return true;
   };
   std::vector<Vec2> centre;
   std::vector<double> radius;
@@ -156,14 +163,8 @@ TEST(BroadPhase, CandidatePairsAreEveryPartPairWhoseBoxesOverlap) {
     for (size_t j = 0; j < field.floes.size() && clear; ++j) {
       if ((centre[j] - Vec2(cx, cy)).norm() > radius[j] + s * std::sqrt(2.0) + 0.5) continue;
       const Polygon& g = field.floes[j].outline;
-      clear = polygon_intersection(f.outline, g).empty();
-      auto vertices_clear = [](const Polygon& a, const Polygon& b) {  // every vertex of a 0.5 m from b's edges
-        for (const Vec2& v : a)
-          for (size_t e = 0; e < b.size(); ++e)
-            if (point_segment_distance(v, b[e], b[(e + 1) % b.size()]) <= 0.5) return false;
-        return true;
-      };
-      clear = clear && vertices_clear(f.outline, g) && vertices_clear(g, f.outline);
+      clear = polygon_intersection(f.outline, g).empty() && vertices_clear(f.outline, g) &&
+              vertices_clear(g, f.outline);
     }
     if (!clear) continue;
     f.area_m2 = signed_area(f.outline);
