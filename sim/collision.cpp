@@ -222,10 +222,11 @@ struct RowSums {
   }
 };
 
-void row_sums(const SurfacePolygons& s, const Vec3& c, const Vec3& u, const double side_weight[2],
+// Adds the polygons [first, last) of s to `out`.
+void row_sums(const SurfacePolygons& s, int first, int last, const Vec3& c, const Vec3& u, const double side_weight[2],
               const bool point_side[2], std::vector<Vec3>& half, RowSums& out) {
-  int begin = 0;
-  for (size_t k = 0; k < s.end.size(); ++k) {
+  int begin = first > 0 ? s.end[first - 1] : 0;
+  for (int k = first; k < last; ++k) {
     const Vec3* p = s.v.data() + begin;
     const int n = s.end[k] - begin;
     begin = s.end[k];
@@ -245,106 +246,147 @@ void row_sums(const SurfacePolygons& s, const Vec3& c, const Vec3& u, const doub
   }
 }
 
-// Scratch buffers of the patch computation, and the two sides of the last overlap clipped (with `surface`).
+// One part pair of a contact: its two parts where they are, which sides of its overlap carry the contact surface,
+// and the sums of its clipped overlap (about the contact's local origin). A contact is the part pairs of one body
+// pair that press in about one direction (crushing_contacts): its area, normal, point, rows and secant are sums
+// over its members, so that how the bodies are cut into convex parts does not change it.
+struct PatchMember {
+  const ConvexPart* A = nullptr;
+  const PartWorld* wa = nullptr;
+  const ConvexPart* B = nullptr;
+  const PartWorld* wb = nullptr;
+  int pair = -1;                     // the collision stage's part pair (its index in the sorted candidates)
+  double side_weight[2] = {0, 0};    // weight of a's and b's faces in the vector area
+  bool point_side[2] = {false, false};  // whose faces place the point
+  Vec3 vec_area = Vec3::Zero();      // the patch's vector area: the overlap projected on the plane normal to it
+  Vec3 moment = Vec3::Zero();        // sum of area x centroid over the faces that place the point
+  double area = 0;                   // sum of their areas
+  double volume = 0;                 // overlap volume
+  int poly_first = 0, poly_end = 0;  // its contact-surface faces in the SurfacePolygons it was clipped into
+};
+
+// Clips the member's parts, b translated by shift_b, about `origin`: both sides, their contact-surface faces appended
+// to `surface`. Sets which sides carry the contact (PatchSide), the vector area, the point's sums and the volume.
+// Returns whether the parts press on each other (a vector area of at least kMinPatchArea).
+bool clip_member(PatchMember& m, const Vec3& shift_b, const Vec3& origin, PatchSide side, ClipScratch& cs,
+                 SurfacePolygons& surface) {
+  const Vec3 zero = Vec3::Zero();
+  SideSums sa, sb;
+  sa.surface = sb.surface = &surface;
+  sb.side = 1;
+  m.poly_first = static_cast<int>(surface.end.size());
+  clip_faces(*m.A, *m.wa, zero, *m.B, *m.wb, shift_b, origin, false, cs, sa);
+  clip_faces(*m.B, *m.wb, shift_b, *m.A, *m.wa, zero, origin, true, cs, sb);
+  m.poly_end = static_cast<int>(surface.end.size());
+  m.volume = sa.volume + sb.volume;
+  // The boundary of the overlap is closed, so sa.vec_area = -sb.vec_area up to the internal faces left out: the
+  // vector area of one side is the overlap projected on the plane normal to it, which is the nominal contact area
+  // (a wedge of half-angle phi pushed delta into a wall: 2 h delta tan(phi); a flat edge: h w). A structure's side
+  // carries the contact; it is empty only when b reaches through a's internal faces, and then b's side does.
+  const bool from_b = side == PatchSide::a_is_structure && sa.vec_area.norm() < kMinPatchArea;
+  if (side == PatchSide::symmetric) {
+    m.side_weight[0] = 0.5, m.side_weight[1] = -0.5;
+    m.point_side[0] = m.point_side[1] = true;
+    m.vec_area = 0.5 * (sa.vec_area - sb.vec_area);
+    m.moment = sa.moment + sb.moment;
+    m.area = sa.area + sb.area;
+  } else {
+    m.side_weight[0] = from_b ? 0.0 : 1.0, m.side_weight[1] = from_b ? -1.0 : 0.0;
+    m.point_side[0] = !from_b, m.point_side[1] = from_b;
+    m.vec_area = from_b ? Vec3(-sb.vec_area) : sa.vec_area;
+    m.moment = from_b ? sb.moment : sa.moment;
+    m.area = from_b ? sb.area : sa.area;
+  }
+  return m.vec_area.norm() >= kMinPatchArea && m.area > 0;
+}
+
+// The sides the member uses, b translated by shift_b, their faces appended to `surface` (the secant's re-clip).
+// Returns their weighted vector area.
+Vec3 reclip_member(PatchMember& m, const Vec3& shift_b, const Vec3& origin, ClipScratch& cs, SurfacePolygons& surface) {
+  const Vec3 zero = Vec3::Zero();
+  SideSums sa, sb;
+  sa.surface = sb.surface = &surface;
+  sb.side = 1;
+  m.poly_first = static_cast<int>(surface.end.size());
+  if (m.side_weight[0] != 0 || m.point_side[0]) clip_faces(*m.A, *m.wa, zero, *m.B, *m.wb, shift_b, origin, false, cs, sa);
+  if (m.side_weight[1] != 0 || m.point_side[1]) clip_faces(*m.B, *m.wb, shift_b, *m.A, *m.wa, zero, origin, true, cs, sb);
+  m.poly_end = static_cast<int>(surface.end.size());
+  return m.side_weight[0] * sa.vec_area + m.side_weight[1] * sb.vec_area;
+}
+
+// Scratch buffers of the patch computation: the clipped faces of the members as they are (surface), at a crushed
+// depth (shifted), after the secant's step (secant), and the members of the contact being built.
 struct PatchScratch {
   ClipScratch clip;
   std::vector<Vec3> half;
-  SurfacePolygons surface;
-  SideSums sa, sb;
+  SurfacePolygons surface, shifted, secant;
+  std::vector<PatchMember> members, contact;
+  std::vector<Vec3> contact_dir;  // per contact of a body pair: the sum of its members' vector areas
+  std::vector<int> contact_of;    // per member: its contact
 };
 
-// step_of(point, normal) gives the penetration step of the area's secant (see ContactPatch::area_step_m). b is
-// measured translated by shift_b (a crushed pair: moved back to its crushed depth). probe: only whether the parts
-// overlap, the area, normal and point (no span, rows or secant). reuse_sides: the same parts at the same shift as
-// the last call (a probe): its clipped sides, still in `ps`, are taken as they are.
-template <class StepFn>
-ContactPatch overlap_patch(const ConvexPart& A, const PartWorld& wa, const ConvexPart& B, const PartWorld& wb,
-                           const Vec3& shift_b, PatchSide side, StepFn step_of, PatchScratch& ps,
-                           bool probe = false, bool reuse_sides = false) {
+// The area, normal, point and volume of the contact of members ms[0, n), sums over them; `centre` gets the point
+// about the local origin.
+ContactPatch patch_sums(const PatchMember* ms, int n, const Vec3& origin, Vec3& centre) {
   ContactPatch r;
-  // Local origin: the centre of the intersection of the two boxes.
-  const Vec3 origin = 0.5 * (wa.lo.cwiseMax(wb.lo + shift_b) + wa.hi.cwiseMin(wb.hi + shift_b));
-  const Vec3 zero = Vec3::Zero();
-  if (!reuse_sides) {
-    ps.surface.clear();
-    ps.sa = ps.sb = SideSums{};
-    ps.sa.surface = ps.sb.surface = &ps.surface;
-    ps.sb.side = 1;
-    clip_faces(A, wa, zero, B, wb, shift_b, origin, false, ps.clip, ps.sa);
-    clip_faces(B, wb, shift_b, A, wa, zero, origin, true, ps.clip, ps.sb);
-  }
-  const SideSums& sa = ps.sa;
-  const SideSums& sb = ps.sb;
-  // The boundary of the overlap is closed, so sa.vec_area = -sb.vec_area up to the internal faces left out: the
-  // vector area of one side is the overlap projected on the plane normal to it, which is the nominal contact area
-  // (a wedge of half-angle phi pushed delta into a wall: 2 h delta tan(phi); a flat edge: h w).
-  Vec3 S;
-  bool from_b = false;  // structure side empty (only possible when b reaches through a's internal faces)
-  if (side == PatchSide::a_is_structure) {
-    S = sa.vec_area;
-    if (S.norm() < kMinPatchArea) {
-      S = -sb.vec_area;
-      from_b = true;
-    }
-  } else {
-    S = 0.5 * (sa.vec_area - sb.vec_area);
+  Vec3 S = Vec3::Zero(), moment = Vec3::Zero();
+  double point_area = 0, volume = 0;
+  for (int k = 0; k < n; ++k) {
+    S += ms[k].vec_area;
+    moment += ms[k].moment;
+    point_area += ms[k].area;
+    volume += ms[k].volume;
   }
   const double area = S.norm();
-  if (!(area >= kMinPatchArea)) return r;
+  if (!(area >= kMinPatchArea) || !(point_area > 0)) return r;
   r.valid = true;
   r.area_m2 = area;
   r.normal = S / area;
-  r.volume_m3 = std::max(0.0, sa.volume + sb.volume);
-  if (side == PatchSide::symmetric) {
-    r.point = (sa.moment + sb.moment) / (sa.area + sb.area);
-  } else {
-    r.point = from_b ? Vec3(sb.moment / sb.area) : Vec3(sa.moment / sa.area);
-  }
-  const Vec3 centre = r.point;  // local origin
-  r.point += origin;
-  if (probe) return r;
+  r.volume_m3 = std::max(0.0, volume);
+  centre = moment / point_area;
+  r.point = centre + origin;
+  return r;
+}
+
+// The span, rows and secant of patch r of members ms[0, n), clipped with b at shift_b into `surface`.
+// step_of(point, normal) gives the penetration step of the area's secant (see ContactPatch::area_step_m).
+template <class StepFn>
+void complete_patch(ContactPatch& r, const Vec3& centre, PatchMember* ms, int n, const SurfacePolygons& surface,
+                    const Vec3& shift_b, const Vec3& origin, StepFn step_of, PatchScratch& ps) {
   // Horizontal extent of the contact surface across the normal (the contact width of PHYSICS.md §2.1). A normal
   // close to vertical (a floe under a flat bottom) has no horizontal tangent: the span is then taken along x.
   Vec3 u1 = Vec3::UnitZ().cross(r.normal);
   u1 = u1.norm() > 1e-6 ? Vec3(u1.normalized()) : Vec3::UnitX();
-  {
-    double lo = 1e300, hi = -1e300;
-    for (const Vec3& p : ps.surface.v) {
+  double lo = 1e300, hi = -1e300;
+  r.span_lo = r.span_hi = r.point;
+  for (int k = 0; k < n; ++k) {
+    const int first = ms[k].poly_first > 0 ? surface.end[ms[k].poly_first - 1] : 0;
+    const int last = ms[k].poly_end > 0 ? surface.end[ms[k].poly_end - 1] : 0;
+    for (int i = first; i < last; ++i) {
+      const Vec3& p = surface.v[i];
       const double s = u1.dot(p);
       if (s < lo) lo = s, r.span_lo = p + origin;
       if (s > hi) hi = s, r.span_hi = p + origin;
     }
-    if (ps.surface.v.empty()) r.span_lo = r.span_hi = r.point;
   }
   // The rows: the same sides as the patch, cut in halves across u1 through its centroid.
-  double side_weight[2];
-  bool point_side[2];
-  if (side == PatchSide::symmetric) {
-    side_weight[0] = 0.5, side_weight[1] = -0.5;
-    point_side[0] = point_side[1] = true;
-  } else {
-    side_weight[0] = from_b ? 0.0 : 1.0, side_weight[1] = from_b ? -1.0 : 0.0;
-    point_side[0] = !from_b, point_side[1] = from_b;
-  }
   RowSums rows;
-  row_sums(ps.surface, centre, u1, side_weight, point_side, ps.half, rows);
+  for (int k = 0; k < n; ++k)
+    row_sums(surface, ms[k].poly_first, ms[k].poly_end, centre, u1, ms[k].side_weight, ms[k].point_side, ps.half,
+             rows);
   // dA/d(delta): b moved by the step towards a along the normal, the same sides re-clipped, projected on this normal
   // (in total and per half, with the same cutting plane).
   const double eps = step_of(r.point, r.normal);
   const Vec3 t = shift_b - eps * r.normal;
-  SideSums fa, fb;
-  ps.surface.clear();
-  fa.surface = fb.surface = &ps.surface;
-  fb.side = 1;
-  if (side == PatchSide::symmetric || !from_b)
-    clip_faces(A, wa, zero, B, wb, t, origin, false, ps.clip, fa);
-  if (side == PatchSide::symmetric || from_b)
-    clip_faces(B, wb, t, A, wa, zero, origin, true, ps.clip, fb);
-  double area_eps;
-  if (side == PatchSide::symmetric) area_eps = 0.5 * (fa.vec_area - fb.vec_area).dot(r.normal);
-  else area_eps = from_b ? -fb.vec_area.dot(r.normal) : fa.vec_area.dot(r.normal);
+  ps.secant.clear();
+  Vec3 S_eps = Vec3::Zero();
   RowSums rows_end;
-  row_sums(ps.surface, centre, u1, side_weight, point_side, ps.half, rows_end);
+  for (int k = 0; k < n; ++k) {
+    PatchMember m = ms[k];
+    S_eps += reclip_member(m, t, origin, ps.clip, ps.secant);
+    row_sums(ps.secant, m.poly_first, m.poly_end, centre, u1, m.side_weight, m.point_side, ps.half, rows_end);
+  }
+  const double area = r.area_m2, area_eps = S_eps.dot(r.normal);
   // A shrinking area (a corner passing through a thin part) would soften the implicit row and could make it
   // unstable; the hardening is kept >= 0 (constant-force crushing in that case).
   r.area_step_m = eps;
@@ -361,20 +403,27 @@ ContactPatch overlap_patch(const ConvexPart& A, const PartWorld& wa, const Conve
     row.area_m2 = aq;
     row.area_end_m2 = std::max(aq, rows_end.vec_area[q].dot(r.normal));
   }
-  return r;
 }
 
+// The local origin of the overlaps of two placed parts (b translated by shift_b): the centre of the intersection of
+// their boxes, so that the sums do not cancel large world offsets.
+Vec3 overlap_origin(const PartWorld& wa, const PartWorld& wb, const Vec3& shift_b) {
+  return 0.5 * (wa.lo.cwiseMax(wb.lo + shift_b) + wa.hi.cwiseMin(wb.hi + shift_b));
+}
+
+// A candidate part pair, ordered by body pair first: a body pair's part pairs are adjacent (one crushing contact
+// per direction is made of them).
 struct PairCandidate {
   int body_a, part_a, body_b, part_b;
   bool operator<(const PairCandidate& o) const {
     if (body_a != o.body_a) return body_a < o.body_a;
-    if (part_a != o.part_a) return part_a < o.part_a;
     if (body_b != o.body_b) return body_b < o.body_b;
+    if (part_a != o.part_a) return part_a < o.part_a;
     return part_b < o.part_b;
   }
 };
 
-// Where the contacts of one chunk of pairs went: contacts[first, end) of the scratch of the worker that ran it.
+// Where the contacts of one chunk of body pairs went: contacts[first, end) of the scratch of the worker that ran it.
 struct ChunkRange {
   int worker, first, end;
 };
@@ -404,6 +453,7 @@ struct CollisionWorld::Impl {
   std::vector<fcl::CollisionObjectd*> moved_awake, moved_sleeping;
   std::vector<uint8_t> box_changed;    // per part, written by update_bodies
   std::vector<PairCandidate> pairs;
+  std::vector<int> group_start;  // the body pairs: pairs[group_start[g], group_start[g + 1]) share one
   const State* state = nullptr;  // during find_contacts (the broad-phase callback reads the awake flags)
   ThreadPool& pool;
   std::vector<Scratch> scratch;
@@ -428,74 +478,142 @@ struct CollisionWorld::Impl {
     return is_structure_pair(pc) ? compliant_structure : compliant_ice;
   }
 
-  // The crushed state of a part pair kept from the previous step (any of its cached crushing rows), or null.
-  const CachedContact* crushed_state(const PairCandidate& pc) const {
-    const std::vector<CachedContact>& cache = state->contact_cache;
-    auto it = std::lower_bound(cache.begin(), cache.end(), pc, [](const CachedContact& c, const PairCandidate& k) {
-      return PairCandidate{c.body_a, c.part_a, c.body_b, c.part_b} < k;
-    });
-    if (it == cache.end() || it->body_a != pc.body_a || it->part_a != pc.part_a || it->body_b != pc.body_b ||
-        it->part_b != pc.part_b || it->type != ContactType::crushing)
-      return nullptr;
-    return &*it;
-  }
-
-  // The crushing contact of a compliant pair: two rows over the contact surface (its halves, see row_sums).
-  // Returns false if the parts do not overlap. The vessel is body 0, so in a vessel-floe pair it is always a (the
-  // structure side of the patch).
-  //
-  // Crushed state: the ice crushed so far is gone. The pair remembers where it crushed last: the contact point as a
-  // material point of a and of b (where the crushed face of b met a) and the normal, in a's frame. How far b's
-  // point has moved away from a's along that normal is how far the pair has backed off from its crushed depth, g
-  // (local to the contact: a floe tilting about it does not back off). A pair with g > 0 is measured at the crushed
-  // depth (b moved back by g along the normal: the crushed face, not a fresh overlap), and its rows let it approach
-  // over g without force. A pair pressing at or beyond its crushed depth is measured as it is and remembers its
-  // current contact point and normal. The state lives as long as the parts overlap and the contact keeps its place
-  // and direction (in the cache, like the warm start): a pair that backs off beyond its crushed depth separates and
-  // forgets it.
+  // The crushed state kept from the previous step for a contact of bodies (a, b) with this normal and point: a
+  // cached crushing row of the pair whose remembered normal is within kSameDirection of the normal and whose
+  // remembered point is within kSameSpot of the point (in a's frame: a floe that slides or turns meets fresh ice),
+  // the nearest; or null.
   static constexpr double kSameDirection = 0.9994;  // cos 2 deg
   static constexpr double kSameSpot = 0.1;          // m
-  bool crushing_contact(const PairCandidate& pc, Scratch& sc, std::vector<Contact>& out) {
-    const bool structure = is_structure_pair(pc);
+  const CachedContact* crushed_state(int a, int b, const Vec3& normal, const Vec3& point) const {
+    const State& s = *state;
+    const std::vector<CachedContact>& cache = s.contact_cache;
+    auto it = std::lower_bound(cache.begin(), cache.end(), std::make_pair(a, b),
+                               [](const CachedContact& c, const std::pair<int, int>& k) {
+                                 return std::make_pair(c.body_a, c.body_b) < k;
+                               });
+    const Quat& qa = s.orientation[a];
+    const CachedContact* best = nullptr;
+    double best_d = kSameSpot;
+    for (; it != cache.end() && it->body_a == a && it->body_b == b; ++it) {
+      if (it->type != ContactType::crushing || (qa * it->crush_normal_a).dot(normal) < kSameDirection) continue;
+      const double d = (qa * it->crush_point_a + s.position[a] - point).norm();
+      if (d < best_d || (!best && d <= best_d)) best_d = d, best = &*it;
+    }
+    return best;
+  }
+
+  // The crushing contacts of a compliant body pair, whose candidate part pairs are pairs[first, last), into out;
+  // returns how many. `touching` counts the part pairs that press.
+  //
+  // One contact per direction, not per part pair. The part pairs of a body pair that press in about one direction
+  // (their normals within kSameContactCos of the contact's: a floe against one flank of the bow, across however many
+  // hull sections and floe parts) make one contact: one normal, one point, two rows over their surfaces together,
+  // one crushed state. A floe wedged in a notch, pressed on two faces at an angle, gets one contact per face. Per
+  // part pair, a light piece pressed into its parent floe or the hull had 4-12 nearly dependent rows across part
+  // seams, on which Gauss-Seidel crept at 1-2 % a sweep to the sweep cap (issue #7's stall); the force is the same
+  // sum (p A per member: their vector areas add up).
+  //
+  // Crushed state: the ice crushed so far is gone. A contact remembers where it crushed last: its point as a
+  // material point of a and of b (where the crushed face of b met a) and its normal, in a's frame. How far b's
+  // point has moved away from a's along that normal is how far the pair has backed off from its crushed depth, g
+  // (local to the contact: a floe tilting about it does not back off). A contact with g > 0 is measured at the
+  // crushed depth (b moved back by g along the normal: the crushed face, not a fresh overlap), and its rows let it
+  // approach over g without force. A contact pressing at or beyond its crushed depth is measured as it is and
+  // remembers its current point and normal. The state lives as long as the parts overlap and the contact keeps its
+  // place and direction (in the cache, like the warm start): a pair that backs off beyond its crushed depth
+  // separates and forgets it.
+  int crushing_contacts(int first, int last, Scratch& sc, std::vector<Contact>& out, long& touching) {
+    const PairCandidate& pc0 = pairs[first];
+    const int a = pc0.body_a, b = pc0.body_b;
+    const bool structure = is_structure_pair(pc0);
+    const PatchSide side = structure ? PatchSide::a_is_structure : PatchSide::symmetric;
+    PatchScratch& ps = sc.patch;
+    // 1. Each part pair's overlap as it is, about one local origin for the body pair. The vessel is body 0, so in
+    // a vessel-floe pair it is always a (the structure side of the patch).
+    const Vec3 origin = overlap_origin(world[pc0.part_a], world[pc0.part_b], Vec3::Zero());
+    ps.surface.clear();
+    ps.members.clear();
+    for (int i = first; i < last; ++i) {
+      const PairCandidate& pc = pairs[i];
+      // A separating face axis proves the parts apart: most box-overlapping neighbours end here.
+      if (separated(pc)) continue;
+      PatchMember m;
+      m.A = &model.parts[pc.part_a], m.wa = &world[pc.part_a];
+      m.B = &model.parts[pc.part_b], m.wb = &world[pc.part_b];
+      m.pair = i;
+      if (clip_member(m, Vec3::Zero(), origin, side, ps.clip, ps.surface)) ps.members.push_back(m);
+    }
+    const int n = static_cast<int>(ps.members.size());
+    touching += n;
+    // 2. The members into contacts by direction (in pair order: deterministic).
+    ps.contact_dir.clear();
+    ps.contact_of.resize(n);
+    for (int k = 0; k < n; ++k) {
+      const Vec3 dir = ps.members[k].vec_area.normalized();
+      int c = 0;
+      while (c < static_cast<int>(ps.contact_dir.size()) && ps.contact_dir[c].normalized().dot(dir) < kSameContactCos)
+        ++c;
+      if (c == static_cast<int>(ps.contact_dir.size())) ps.contact_dir.push_back(Vec3::Zero());
+      ps.contact_dir[c] += ps.members[k].vec_area;
+      ps.contact_of[k] = c;
+    }
+    // 3. Each contact.
+    int made = 0;
+    for (int c = 0; c < static_cast<int>(ps.contact_dir.size()); ++c) {
+      ps.contact.clear();
+      for (int k = 0; k < n; ++k)
+        if (ps.contact_of[k] == c) ps.contact.push_back(ps.members[k]);
+      made += crushing_contact(a, b, structure, side, origin, ps, out);
+    }
+    return made;
+  }
+
+  // One crushing contact, of the members in ps.contact (clipped as they are into ps.surface), into out: its rows.
+  // Returns false if it has none.
+  bool crushing_contact(int a, int b, bool structure, PatchSide side, const Vec3& origin, PatchScratch& ps,
+                        std::vector<Contact>& out) {
+    const State& s = *state;
     // The area's secant spans the penetration this step is about to add at the current approach speed (at least
     // the finite-difference step): the implicit force F_0 + K_t dt (-v) then follows the clipped geometry up to
     // the end-of-step penetration instead of extrapolating a tangent taken over a few millimetres (a hull face
     // meeting a floe edge almost flat gets all its area within millimetres: the tangent would overshoot it many
     // times over), and the crushing force is capped at p_c A at the end of that step.
     const double dt = model.options.time_step_s, eps = model.options.contact.area_gradient_step_m;
-    const State& s = *state;
-    auto step_of = [&](const Vec3& p, const Vec3& n) {
-      const int a = pc.body_a, b = pc.body_b;
+    auto step_of = [&](const Vec3& p, const Vec3& nrm) {
       const Vec3 va = s.velocity[a] + s.angular_velocity[a].cross(p - s.position[a]);
       const Vec3 vb = s.velocity[b] + s.angular_velocity[b].cross(p - s.position[b]);
-      return std::max(eps, dt * std::max(0.0, -n.dot(vb - va)));
+      return std::max(eps, dt * std::max(0.0, -nrm.dot(vb - va)));
     };
-    const Quat& qa = s.orientation[pc.body_a];
-    const PatchSide side = structure ? PatchSide::a_is_structure : PatchSide::symmetric;
-    auto patch_at = [&](const Vec3& shift_b, bool probe, bool reuse_sides = false) {
-      return overlap_patch(model.parts[pc.part_a], world[pc.part_a], model.parts[pc.part_b], world[pc.part_b],
-                           shift_b, side, step_of, sc.patch, probe, reuse_sides);
-    };
-    const CachedContact* mem = crushed_state(pc);
-    // The overlap as it is: no overlap, no contact (and the crushed state is forgotten).
-    ContactPatch patch = patch_at(Vec3::Zero(), mem != nullptr);
+    std::vector<PatchMember>& ms = ps.contact;
+    const PairCandidate key = pairs[ms.front().pair];  // the cache's key of the contact: its first part pair
+    Vec3 centre;
+    ContactPatch patch = patch_sums(ms.data(), static_cast<int>(ms.size()), origin, centre);
     if (!patch.valid) return false;
-    // The crushed state holds while the contact keeps its place and direction (within kSameSpot and kSameDirection
-    // of the remembered point and normal, in a's frame): a floe that slides or turns meets fresh ice.
-    const Vec3 xa = s.position[pc.body_a], xb = s.position[pc.body_b];
-    const Quat& qb = s.orientation[pc.body_b];
+    const Vec3 xa = s.position[a], xb = s.position[b];
+    const Quat &qa = s.orientation[a], &qb = s.orientation[b];
+    const CachedContact* mem = crushed_state(a, b, patch.normal, patch.point);
     double gap = 0;
     Vec3 n = patch.normal;
-    if (mem && (qa * mem->crush_normal_a).dot(patch.normal) >= kSameDirection &&
-        (qa * mem->crush_point_a + xa - patch.point).norm() <= kSameSpot) {
+    if (mem) {
       n = qa * mem->crush_normal_a;
       gap = std::max(0.0, n.dot((xb + qb * mem->crush_point_b) - (xa + qa * mem->crush_point_a)));
     }
-    // With a gap: the crushed face (b moved back to the crushed depth); else the overlap as it is, in full (the
-    // probe's clipped sides are that overlap's).
-    if (gap > 0) patch = patch_at(-gap * n, false);
-    else if (mem) patch = patch_at(Vec3::Zero(), false, true);
-    if (!patch.valid || patch.row_count == 0) return false;
+    // With a gap: the crushed face (b moved back to the crushed depth); else the overlap as it is.
+    const SurfacePolygons* surface = &ps.surface;
+    Vec3 shift = Vec3::Zero();
+    if (gap > 0) {
+      shift = -gap * n;
+      ps.shifted.clear();
+      size_t kept = 0;
+      for (PatchMember& m : ms)
+        if (clip_member(m, shift, origin, side, ps.clip, ps.shifted)) ms[kept++] = m;
+      ms.resize(kept);
+      patch = patch_sums(ms.data(), static_cast<int>(ms.size()), origin, centre);
+      if (!patch.valid) return false;
+      surface = &ps.shifted;
+    }
+    complete_patch(patch, centre, ms.data(), static_cast<int>(ms.size()), *surface, shift, origin, step_of, ps);
+    if (patch.row_count == 0) return false;
     // At or beyond the crushed depth: the current contact point and normal are the new crushed state.
     const Vec3 normal_a = gap > 0 ? mem->crush_normal_a : Vec3(qa.conjugate() * patch.normal);
     const Vec3 point_a = gap > 0 ? mem->crush_point_a : Vec3(qa.conjugate() * (patch.point - xa));
@@ -503,10 +621,10 @@ struct CollisionWorld::Impl {
     for (int k = 0; k < patch.row_count; ++k) {
       const PatchRow& pr = patch.rows[k];
       Contact c;
-      c.body_a = pc.body_a;
-      c.part_a = pc.part_a;
-      c.body_b = pc.body_b;
-      c.part_b = pc.part_b;
+      c.body_a = a;
+      c.part_a = key.part_a;
+      c.body_b = b;
+      c.part_b = key.part_b;
       c.row = pr.half;
       c.point = pr.point;  // with a gap: on the crushed face (where the force acts once the gap is closed)
       c.normal = patch.normal;
@@ -939,35 +1057,44 @@ void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out
   stats_ = CollisionStats{};
   stats_.broadphase_pairs = static_cast<long>(m.pairs.size());
 
-  // Narrow phase per pair, in chunks of pairs handed to whichever thread is free; each chunk's contacts are kept in
-  // pair order in its thread's buffer, and the chunks are put together in chunk order.
+  // Narrow phase per body pair, in chunks of body pairs handed to whichever thread is free; each chunk's contacts
+  // are kept in pair order in its thread's buffer, and the chunks are put together in chunk order.
   const int npairs = static_cast<int>(m.pairs.size());
+  m.group_start.clear();
+  for (int i = 0; i < npairs; ++i)
+    if (i == 0 || m.pairs[i].body_a != m.pairs[i - 1].body_a || m.pairs[i].body_b != m.pairs[i - 1].body_b)
+      m.group_start.push_back(i);
+  m.group_start.push_back(npairs);
+  const int ngroups = static_cast<int>(m.group_start.size()) - 1;
   for (auto& sc : m.scratch) {
     sc.contacts.clear();
     sc.hits = sc.edges = sc.crushing = 0;
   }
-  constexpr int kChunk = 16;
-  m.chunk_ranges.resize((npairs + kChunk - 1) / kChunk);
-  m.pool.parallel_chunks(npairs, kChunk, [&](int begin, int end, int w, int chunk) {
+  constexpr int kChunk = 8;
+  m.chunk_ranges.resize((ngroups + kChunk - 1) / kChunk);
+  m.pool.parallel_chunks(ngroups, kChunk, [&](int begin, int end, int w, int chunk) {
     Scratch& sc = m.scratch[w];
     const int first = static_cast<int>(sc.contacts.size());
     fcl::CollisionRequestd req(1, true);
     req.gjk_solver_type = fcl::GST_LIBCCD;
-    for (int i = begin; i < end; ++i) {
-      const PairCandidate& pc = m.pairs[i];
-      // A separating face axis proves the parts apart: most box-overlapping neighbours end here, before GJK.
-      if (m.is_compliant(pc)) {
-        if (!m.separated(pc) && m.crushing_contact(pc, sc, sc.contacts)) ++sc.hits, ++sc.crushing;
+    for (int g = begin; g < end; ++g) {
+      const int pair_begin = m.group_start[g], pair_end = m.group_start[g + 1];
+      if (m.is_compliant(m.pairs[pair_begin])) {  // the law is one per pair of body classes
+        sc.crushing += m.crushing_contacts(pair_begin, pair_end, sc, sc.contacts, sc.hits);
         continue;
       }
-      const Impl::FaceAxes axes = m.face_axes(pc);
-      if (axes.sa > 0 || axes.sb > 0) continue;
-      fcl::CollisionResultd res;
-      fcl::collide(m.objects[pc.part_a].get(), m.objects[pc.part_b].get(), req, res);
-      if (!res.isCollision() || res.numContacts() == 0) continue;
-      ++sc.hits;
-      // FCL's normal points from its first object to its second: part_a to part_b here.
-      if (m.manifold(pc, axes, res.getContact(0), sc, sc.contacts)) ++sc.edges;
+      for (int i = pair_begin; i < pair_end; ++i) {
+        const PairCandidate& pc = m.pairs[i];
+        // A separating face axis proves the parts apart: most box-overlapping neighbours end here, before GJK.
+        const Impl::FaceAxes axes = m.face_axes(pc);
+        if (axes.sa > 0 || axes.sb > 0) continue;
+        fcl::CollisionResultd res;
+        fcl::collide(m.objects[pc.part_a].get(), m.objects[pc.part_b].get(), req, res);
+        if (!res.isCollision() || res.numContacts() == 0) continue;
+        ++sc.hits;
+        // FCL's normal points from its first object to its second: part_a to part_b here.
+        if (m.manifold(pc, axes, res.getContact(0), sc, sc.contacts)) ++sc.edges;
+      }
     }
     m.chunk_ranges[chunk] = {w, first, static_cast<int>(sc.contacts.size())};
   });
@@ -990,7 +1117,16 @@ ContactPatch convex_overlap(const ConvexPart& pa, const Vec3& xa, const Quat& qa
   transform_part(pa, xa, qa.toRotationMatrix(), wa);
   transform_part(pb, xb, qb.toRotationMatrix(), wb);
   PatchScratch ps;
-  return overlap_patch(pa, wa, pb, wb, Vec3::Zero(), side, [eps](const Vec3&, const Vec3&) { return eps; }, ps);
+  PatchMember m;
+  m.A = &pa, m.wa = &wa, m.B = &pb, m.wb = &wb;
+  const Vec3 origin = overlap_origin(wa, wb, Vec3::Zero());
+  if (!clip_member(m, Vec3::Zero(), origin, side, ps.clip, ps.surface)) return ContactPatch{};
+  Vec3 centre;
+  ContactPatch r = patch_sums(&m, 1, origin, centre);
+  if (r.valid)
+    complete_patch(r, centre, &m, 1, ps.surface, Vec3::Zero(), origin, [eps](const Vec3&, const Vec3&) { return eps; },
+                   ps);
+  return r;
 }
 
 }  // namespace floesim::sim

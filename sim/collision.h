@@ -68,7 +68,7 @@ struct CollisionStats {
   long broadphase_pairs = 0;   // AABB-overlapping part pairs with at least one awake body
   long narrowphase_hits = 0;   // part pairs that touch
   long edge_contacts = 0;      // pairs that kept FCL's single point
-  long crushing_contacts = 0;  // touching pairs with a compliant (crushing) contact
+  long crushing_contacts = 0;  // compliant (crushing) contacts: one per body pair and direction
 };
 
 class CollisionWorld {
@@ -85,8 +85,8 @@ class CollisionWorld {
   void add_bodies(const State& state, int first_new);
   // Body b left the world (broken up or removed as brash): its parts leave the broad phase for good.
   void remove_body(int b);
-  // Contacts of the current poses, sorted by (body_a, part_a, body_b, part_b, point order); pairs of two sleeping
-  // bodies are skipped. Solver fields are left for the solver to fill.
+  // Contacts of the current poses, sorted by (body_a, body_b, part_a, part_b, point order; a crushing contact under
+  // its first part pair); pairs of two sleeping bodies are skipped. Solver fields are left for the solver to fill.
   void find_contacts(const State& state, std::vector<Contact>& out);
   const CollisionStats& stats() const { return stats_; }
 

@@ -20,10 +20,14 @@ void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
   t2 = n.cross(t1);
 }
 
-bool key_less(const CachedContact& c, const Contact& k) {
+// The cache's order: by body pair, then part pair.
+bool body_pair_less(const CachedContact& c, const Contact& k) {
   if (c.body_a != k.body_a) return c.body_a < k.body_a;
+  return c.body_b < k.body_b;
+}
+bool key_less(const CachedContact& c, const Contact& k) {
+  if (c.body_a != k.body_a || c.body_b != k.body_b) return body_pair_less(c, k);
   if (c.part_a != k.part_a) return c.part_a < k.part_a;
-  if (c.body_b != k.body_b) return c.body_b < k.body_b;
   return c.part_b < k.part_b;
 }
 bool same_key(const CachedContact& c, const Contact& k) {
@@ -201,20 +205,31 @@ ContactIslands prepare_contacts(const Model& model, const SolverBodies& sb, Stat
     c.local_a = state.orientation[c.body_a].conjugate() * c.ra;
     c.pn = c.pt1 = c.pt2 = 0;
 
-    // 2. Warm start: the nearest cached point of the same part pair, projected on the new rows.
+    // 2. Warm start: the cached row this one continues, its impulse projected on the new rows.
     if (!o.warm_start) continue;
-    auto it = std::lower_bound(state.contact_cache.begin(), state.contact_cache.end(), c, key_less);
+    const std::vector<CachedContact>& cache = state.contact_cache;
     const CachedContact* best = nullptr;
-    // A crushing row carries a half of the pair's contact surface (its centroid may slide): the cached row of the
-    // same half is its predecessor. Rigid points: the nearest cached point within match_tol.
-    double bd = match_tol2;
-    for (; it != state.contact_cache.end() && same_key(*it, c); ++it) {
-      if (c.type == ContactType::crushing) {
-        if (it->type == ContactType::crushing && it->row == c.row) best = &*it;
-        continue;
+    if (c.type == ContactType::crushing) {
+      // A crushing row carries a half of a contact of the body pair, whose part pairs may come and go and whose
+      // centroid may slide: its predecessor is the cached row of the same pair and half whose crushed normal is
+      // in the same direction (kSameContactCos), the nearest.
+      double bd = std::numeric_limits<double>::infinity();
+      for (auto it = std::lower_bound(cache.begin(), cache.end(), c, body_pair_less);
+           it != cache.end() && it->body_a == c.body_a && it->body_b == c.body_b; ++it) {
+        if (it->type != ContactType::crushing || it->row != c.row ||
+            it->crush_normal_a.dot(c.crush_normal_a) < kSameContactCos)
+          continue;
+        const double d = (it->local_a - c.local_a).squaredNorm();
+        if (d < bd) bd = d, best = &*it;
       }
-      const double d = (it->local_a - c.local_a).squaredNorm();
-      if (d < bd) bd = d, best = &*it;
+    } else {
+      // Rigid points: the nearest cached point of the same part pair within match_tol.
+      double bd = match_tol2;
+      for (auto it = std::lower_bound(cache.begin(), cache.end(), c, key_less); it != cache.end() && same_key(*it, c);
+           ++it) {
+        const double d = (it->local_a - c.local_a).squaredNorm();
+        if (d < bd) bd = d, best = &*it;
+      }
     }
     if (!best) continue;
     c.pn = std::clamp(best->impulse.dot(c.normal), 0.0, c.max_normal_impulse);

@@ -23,7 +23,7 @@ enum class ContactType : uint8_t { rigid, crushing };
 struct Contact {
   int body_a = -1, body_b = -1;
   int part_a = -1, part_b = -1;
-  int row = 0;                 // crushing pairs: which half of the contact surface this row carries (0, 1)
+  int row = 0;                 // crushing contacts: which half of the contact surface this row carries (0, 1)
   Vec3 point = Vec3::Zero();   // world, midway between the surfaces
   Vec3 normal = Vec3::UnitZ(); // world, unit, from a to b
   double gap = 0;              // signed distance along the normal: < 0 overlap, > 0 speculative
@@ -67,8 +67,14 @@ struct Contact {
   bool fixed_a = false, fixed_b = false;              // a body the impulses cannot move (a wall)
 };
 
+// The part pairs of a body pair whose vector areas point within this cosine (26 deg) of each other press in one
+// direction and make one crushing contact (collide); the warm start takes a crushing row's predecessor from the
+// cached rows of the same body pair and half whose crushed normals are that close (solve).
+constexpr double kSameContactCos = 0.9;
+
 // The impulses of one contact kept for warm starting the next step, keyed by body/part pair and local point (rigid)
-// or row (crushing), and the pair's crushed state (crushing rows; the same in every row of the pair).
+// or by body pair, row and crushed normal (crushing: the key's part pair, its first, may change as parts come and
+// go), and the crushed state of a crushing contact (the same in both its rows).
 struct CachedContact {
   int body_a, part_a, body_b, part_b;
   int row;
@@ -92,7 +98,7 @@ struct State {
   std::vector<double> still_time_s;     // time spent below the sleep thresholds without contacts
   std::vector<double> heave_lowpass_mps;  // forces: heave velocity through the radiation filter's low pass
                                           // (heave_radiation_force); 0 while asleep, a piece takes its parent's
-  std::vector<CachedContact> contact_cache;  // sorted by (body_a, part_a, body_b, part_b)
+  std::vector<CachedContact> contact_cache;  // sorted by (body_a, body_b, part_a, part_b)
   // Vessel controllers.
   double speed_error_integral = 0;      // m, integral of the speed error (PI thrust controller)
   double heading_ref_rad = 0;           // course held by the autopilot

@@ -572,6 +572,97 @@ TEST(SimCrushing, PressureAreaLawActsOnTheWholeContactOfABodyPair) {
   }
 }
 
+// One crushing contact per body pair and direction, however the bodies are cut into convex parts. A flat floe edge
+// (width w, centred on y = 0) pressed into a wall of one, two or three parts (seams 0.3 m and 0.8 m off the edge's
+// centre): in every step one contact, two rows, each at the centroid of its half of the edge (y = -w/4 and +w/4:
+// the halves of the whole edge, not of each part's piece of it). Cut per part pair, the three-part wall gave six
+// rows at the centroids of the pieces.
+TEST(SimCrushing, OneContactPerBodyPairWhateverTheSeams) {
+  const double h = 0.7, width = 3.0, v = 0.4;
+  const Floe f = testing::rect_floe(1, 52.002, -width / 2, 5.0, width, h);
+  const std::vector<std::vector<double>> seams = {{}, {0.3}, {-0.8, 0.3}};
+  for (const std::vector<double>& cuts : seams) {
+    HullModel wall;
+    std::vector<double> ys = {-15};
+    ys.insert(ys.end(), cuts.begin(), cuts.end());
+    ys.push_back(15);
+    for (size_t k = 0; k + 1 < ys.size(); ++k)
+      wall.parts.push_back(
+          extrude_polygon({Vec2(-2, ys[k]), Vec2(2, ys[k]), Vec2(2, ys[k + 1]), Vec2(-2, ys[k + 1])}, -3, 6));
+    wall.surface = box_hull(4, 30, -3, 6).surface;
+    WallRig rig = wall_rig(f, 1e7, v, 0.0, 0.0, &wall);
+    World w(rig.model);
+    int steps = 0;
+    double worst = 0;
+    for (int i = 0; i < 50; ++i) {
+      w.step();
+      if (w.contacts().empty()) continue;
+      ++steps;
+      ASSERT_EQ(w.contacts().size(), 2u) << wall.parts.size() << " parts, step " << i;
+      for (const Contact& c : w.contacts()) {
+        EXPECT_EQ(c.type, ContactType::crushing);
+        EXPECT_NEAR(c.normal.x(), 1.0, 1e-12);
+        // Row 1 is the half on the side of z x n = +y of the edge's centre line (the floe's, y = 0 at the start).
+        const double y0 = w.state().position[1].y();
+        worst = std::max(worst, std::abs(c.point.y() - y0 - (c.row == 0 ? -width / 4 : width / 4)));
+      }
+      EXPECT_NE(w.contacts()[0].row, w.contacts()[1].row);
+    }
+    std::printf("[measured] flat edge on a wall of %zu part(s): %d crushing steps, rows' largest distance from the "
+                "halves' centroids %.2e m\n",
+                wall.parts.size(), steps, worst);
+    EXPECT_GT(steps, 40);
+    EXPECT_LT(worst, 1e-6);
+  }
+}
+
+// ... and one per direction: a floe wedge of half-angle 45 deg (1.5 m long) pushed into a V notch of the same
+// angle (its flanks 2 m deep) meets the two flanks at 90 deg to each other: two contacts (four rows) with the flanks'
+// normals (1, -+1)/sqrt(2), not one contact along x (merged, the two normal forces would come out as their x-projected
+// sum, and so would the friction they allow). The notch's flank faces inside the floe reach from its apex to the
+// floe's back corner, y = 0 .. 1.502 m - delta each (delta: how far the notch has moved into the floe since the
+// apexes were 2 mm apart): each flank crushes with N = sigma_c h sqrt(2) (1.502 m - delta) and, the notch sliding
+// along it at v sin 45 deg, rubs with mu N, so F_x = 2 N (cos 45 + mu sin 45) = sigma_c h 2 (1.502 m - delta)
+// (1 + mu). Tolerance 1 %: the area shrinks with the penetration, and the law then crushes at the step's starting
+// area (delta changes by 2 mm a step: 0.15 %). Normals to 1e-8: the clipping's 1 nm tolerance over 1 m faces.
+TEST(SimCrushing, APieceInANotchGetsOneContactPerFlank) {
+  const double h = 0.8, v = 0.2, phi = kPi / 4, L = 1.5;
+  HullModel notch;
+  notch.parts = {extrude_polygon({Vec2(-2, 0), Vec2(0, 0), Vec2(2, 2), Vec2(2, 15), Vec2(-2, 15)}, -3, 6),
+                 extrude_polygon({Vec2(-2, -15), Vec2(2, -15), Vec2(2, -2), Vec2(0, 0), Vec2(-2, 0)}, -3, 6)};
+  notch.surface = box_hull(4, 30, -3, 6).surface;
+  // The floe's apex 2 mm in front of the notch's (the wall's origin, the notch's apex, is at x = 50 m).
+  WallRig rig = wall_rig(wedge_floe(1, 50.002, 0.0, phi, L, h), 1e9, v, 0.0, 0.0, &notch);
+  World w(rig.model);
+  const double sigma = rig.model.options.ice.crushing_strength_pa, mu = rig.model.options.ice.mu_ice_structure;
+  const double wall0 = w.state().position[0].x(), floe0 = w.state().position[1].x();
+  int steps = 0;
+  double worst_normal = 0, worst_force = 0;
+  for (int i = 0; i < 60; ++i) {
+    const double delta = (w.state().position[0].x() - wall0) - (w.state().position[1].x() - floe0) - 0.002;
+    w.step();
+    if (w.contacts().empty()) continue;
+    ++steps;
+    ASSERT_EQ(w.contacts().size(), 4u) << "step " << i;
+    int upper = 0, lower = 0;
+    for (const Contact& c : w.contacts()) {
+      const Vec3 flank = c.normal.y() < 0 ? Vec3(1, -1, 0) / std::sqrt(2.0) : Vec3(1, 1, 0) / std::sqrt(2.0);
+      (c.normal.y() < 0 ? upper : lower)++;
+      worst_normal = std::max(worst_normal, (c.normal - flank).norm());
+    }
+    EXPECT_EQ(upper, 2);
+    EXPECT_EQ(lower, 2);
+    const double theory = sigma * h * 2 * (L + 0.002 - std::max(delta, 0.0)) * (1 + mu);
+    worst_force = std::max(worst_force, std::abs(contact_force_on(w, 1).x() / theory - 1));
+  }
+  std::printf("[measured] wedge in a notch: %d crushing steps, normals within %.2e of the flanks', largest "
+              "|F_x / (sigma_c h 2 (1.502 m - delta) (1 + mu)) - 1| = %.2e\n",
+              steps, worst_normal, worst_force);
+  EXPECT_GT(steps, 40);
+  EXPECT_LT(worst_normal, 1e-8);
+  EXPECT_LT(worst_force, 0.01);
+}
+
 // Crushing work = sigma_c x crushed volume (e_x = 0): the wall driven at 0.2 m/s into a heavy floe whose nose is an
 // irregular convex polygon. The crushed volume is h times the area of the outline beyond the wall's final face,
 // computed in 2-D by clipping the outline (geometry2d, independent of the 3-D clipping of the contact). The work
