@@ -308,8 +308,10 @@ Vec3 reclip_member(PatchMember& m, const Vec3& shift_b, const Vec3& origin, Clip
   sa.surface = sb.surface = &surface;
   sb.side = 1;
   m.poly_first = static_cast<int>(surface.end.size());
-  if (m.side_weight[0] != 0 || m.point_side[0]) clip_faces(*m.A, *m.wa, zero, *m.B, *m.wb, shift_b, origin, false, cs, sa);
-  if (m.side_weight[1] != 0 || m.point_side[1]) clip_faces(*m.B, *m.wb, shift_b, *m.A, *m.wa, zero, origin, true, cs, sb);
+  if (m.side_weight[0] != 0 || m.point_side[0])
+    clip_faces(*m.A, *m.wa, zero, *m.B, *m.wb, shift_b, origin, false, cs, sa);
+  if (m.side_weight[1] != 0 || m.point_side[1])
+    clip_faces(*m.B, *m.wb, shift_b, *m.A, *m.wa, zero, origin, true, cs, sb);
   m.poly_end = static_cast<int>(surface.end.size());
   return m.side_weight[0] * sa.vec_area + m.side_weight[1] * sb.vec_area;
 }
@@ -405,10 +407,10 @@ void complete_patch(ContactPatch& r, const Vec3& centre, PatchMember* ms, int n,
   }
 }
 
-// The local origin of the overlaps of two placed parts (b translated by shift_b): the centre of the intersection of
-// their boxes, so that the sums do not cancel large world offsets.
-Vec3 overlap_origin(const PartWorld& wa, const PartWorld& wb, const Vec3& shift_b) {
-  return 0.5 * (wa.lo.cwiseMax(wb.lo + shift_b) + wa.hi.cwiseMin(wb.hi + shift_b));
+// The local origin of the overlaps of two placed parts: the centre of the intersection of their boxes, so that the
+// sums do not cancel large world offsets.
+Vec3 overlap_origin(const PartWorld& wa, const PartWorld& wb) {
+  return 0.5 * (wa.lo.cwiseMax(wb.lo) + wa.hi.cwiseMin(wb.hi));
 }
 
 // A candidate part pair, ordered by body pair first: a body pair's part pairs are adjacent (one crushing contact
@@ -510,8 +512,7 @@ struct CollisionWorld::Impl {
   // hull sections and floe parts) make one contact: one normal, one point, two rows over their surfaces together,
   // one crushed state. A floe wedged in a notch, pressed on two faces at an angle, gets one contact per face. Per
   // part pair, a light piece pressed into its parent floe or the hull had 4-12 nearly dependent rows across part
-  // seams, on which Gauss-Seidel crept at 1-2 % a sweep to the sweep cap (issue #7's stall); the force is the same
-  // sum (p A per member: their vector areas add up).
+  // seams; the force is the same sum (p A per member: their vector areas add up), on two rows.
   //
   // Crushed state: the ice crushed so far is gone. A contact remembers where it crushed last: its point as a
   // material point of a and of b (where the crushed face of b met a) and its normal, in a's frame. How far b's
@@ -530,7 +531,7 @@ struct CollisionWorld::Impl {
     PatchScratch& ps = sc.patch;
     // 1. Each part pair's overlap as it is, about one local origin for the body pair. The vessel is body 0, so in
     // a vessel-floe pair it is always a (the structure side of the patch).
-    const Vec3 origin = overlap_origin(world[pc0.part_a], world[pc0.part_b], Vec3::Zero());
+    const Vec3 origin = overlap_origin(world[pc0.part_a], world[pc0.part_b]);
     ps.surface.clear();
     ps.members.clear();
     for (int i = first; i < last; ++i) {
@@ -1119,7 +1120,7 @@ ContactPatch convex_overlap(const ConvexPart& pa, const Vec3& xa, const Quat& qa
   PatchScratch ps;
   PatchMember m;
   m.A = &pa, m.wa = &wa, m.B = &pb, m.wb = &wb;
-  const Vec3 origin = overlap_origin(wa, wb, Vec3::Zero());
+  const Vec3 origin = overlap_origin(wa, wb);
   if (!clip_member(m, Vec3::Zero(), origin, side, ps.clip, ps.surface)) return ContactPatch{};
   Vec3 centre;
   ContactPatch r = patch_sums(&m, 1, origin, centre);
