@@ -324,6 +324,7 @@ struct PatchScratch {
   SurfacePolygons surface, shifted, secant;
   std::vector<PatchMember> members, contact;
   std::vector<Vec3> contact_dir;  // per contact of a body pair: the sum of its members' vector areas
+  std::vector<Vec3> contact_lo, contact_hi;  // ... and the box of their contact surfaces (local origin)
   std::vector<int> contact_of;    // per member: its contact
 };
 
@@ -546,16 +547,39 @@ struct CollisionWorld::Impl {
     }
     const int n = static_cast<int>(ps.members.size());
     touching += n;
-    // 2. The members into contacts by direction (in pair order: deterministic).
+    // 2. The members into contacts by direction and place (in pair order: deterministic). A member joins a contact
+    // whose direction is within kSameContactCos of its own and whose surface's box comes within the join distance
+    // of its surface's box: max(2 h, 1 m), the distance at which the fracture stage takes two contacts of a level
+    // ice tile as one load. So a contact never bridges a gap along the waterline (two hull sections metres apart
+    // pressing in one direction stay two loads, each with its own width).
+    double h = 1e300;  // the thinner ice body's thickness
+    for (int body : {a, b})
+      if (model.bodies[body].kind == BodyKind::floe) h = std::min(h, model.bodies[body].thickness_m);
+    const double join = h < 1e300 ? std::max(2 * h, 1.0) : 1.0;
     ps.contact_dir.clear();
+    ps.contact_lo.clear();
+    ps.contact_hi.clear();
     ps.contact_of.resize(n);
     for (int k = 0; k < n; ++k) {
-      const Vec3 dir = ps.members[k].vec_area.normalized();
+      const PatchMember& m = ps.members[k];
+      Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+      const int v0 = m.poly_first > 0 ? ps.surface.end[m.poly_first - 1] : 0;
+      const int v1 = m.poly_end > 0 ? ps.surface.end[m.poly_end - 1] : 0;
+      for (int v = v0; v < v1; ++v) lo = lo.cwiseMin(ps.surface.v[v]), hi = hi.cwiseMax(ps.surface.v[v]);
+      const Vec3 dir = m.vec_area.normalized();
       int c = 0;
-      while (c < static_cast<int>(ps.contact_dir.size()) && ps.contact_dir[c].normalized().dot(dir) < kSameContactCos)
-        ++c;
-      if (c == static_cast<int>(ps.contact_dir.size())) ps.contact_dir.push_back(Vec3::Zero());
-      ps.contact_dir[c] += ps.members[k].vec_area;
+      for (; c < static_cast<int>(ps.contact_dir.size()); ++c) {
+        const Vec3 gap = (lo - ps.contact_hi[c]).cwiseMax(ps.contact_lo[c] - hi).cwiseMax(0.0);
+        if (ps.contact_dir[c].normalized().dot(dir) >= kSameContactCos && gap.norm() <= join) break;
+      }
+      if (c == static_cast<int>(ps.contact_dir.size())) {
+        ps.contact_dir.push_back(Vec3::Zero());
+        ps.contact_lo.push_back(lo);
+        ps.contact_hi.push_back(hi);
+      }
+      ps.contact_dir[c] += m.vec_area;
+      ps.contact_lo[c] = ps.contact_lo[c].cwiseMin(lo);
+      ps.contact_hi[c] = ps.contact_hi[c].cwiseMax(hi);
       ps.contact_of[k] = c;
     }
     // 3. Each contact.
