@@ -222,10 +222,13 @@ struct RowSums {
   }
 };
 
+// Where polygon k's vertices begin in s.v (they end where polygon k + 1's begin).
+inline int vertex_begin(const SurfacePolygons& s, int k) { return k > 0 ? s.end[k - 1] : 0; }
+
 // Adds the polygons [first, last) of s to `out`.
 void row_sums(const SurfacePolygons& s, int first, int last, const Vec3& c, const Vec3& u, const double side_weight[2],
               const bool point_side[2], std::vector<Vec3>& half, RowSums& out) {
-  int begin = first > 0 ? s.end[first - 1] : 0;
+  int begin = vertex_begin(s, first);
   for (int k = first; k < last; ++k) {
     const Vec3* p = s.v.data() + begin;
     const int n = s.end[k] - begin;
@@ -268,16 +271,23 @@ struct PatchMember {
 // Clips the member's parts, b translated by shift_b, about `origin`: both sides, their contact-surface faces appended
 // to `surface`. Sets which sides carry the contact (PatchSide), the vector area, the point's sums and the volume.
 // Returns whether the parts press on each other (a vector area of at least kMinPatchArea).
-bool clip_member(PatchMember& m, const Vec3& shift_b, const Vec3& origin, PatchSide side, ClipScratch& cs,
-                 SurfacePolygons& surface) {
+// a's faces clipped by b (if side_a) and b's by a (if side_b), b translated by shift_b, about `origin`, into sa and
+// sb; their contact-surface faces are appended to `surface` and become the member's.
+void clip_sides(PatchMember& m, const Vec3& shift_b, const Vec3& origin, bool side_a, bool side_b, ClipScratch& cs,
+                SurfacePolygons& surface, SideSums& sa, SideSums& sb) {
   const Vec3 zero = Vec3::Zero();
-  SideSums sa, sb;
   sa.surface = sb.surface = &surface;
   sb.side = 1;
   m.poly_first = static_cast<int>(surface.end.size());
-  clip_faces(*m.A, *m.wa, zero, *m.B, *m.wb, shift_b, origin, false, cs, sa);
-  clip_faces(*m.B, *m.wb, shift_b, *m.A, *m.wa, zero, origin, true, cs, sb);
+  if (side_a) clip_faces(*m.A, *m.wa, zero, *m.B, *m.wb, shift_b, origin, false, cs, sa);
+  if (side_b) clip_faces(*m.B, *m.wb, shift_b, *m.A, *m.wa, zero, origin, true, cs, sb);
   m.poly_end = static_cast<int>(surface.end.size());
+}
+
+bool clip_member(PatchMember& m, const Vec3& shift_b, const Vec3& origin, PatchSide side, ClipScratch& cs,
+                 SurfacePolygons& surface) {
+  SideSums sa, sb;
+  clip_sides(m, shift_b, origin, true, true, cs, surface, sa, sb);
   m.volume = sa.volume + sb.volume;
   // The boundary of the overlap is closed, so sa.vec_area = -sb.vec_area up to the internal faces left out: the
   // vector area of one side is the overlap projected on the plane normal to it, which is the nominal contact area
@@ -303,16 +313,9 @@ bool clip_member(PatchMember& m, const Vec3& shift_b, const Vec3& origin, PatchS
 // The sides the member uses, b translated by shift_b, their faces appended to `surface` (the secant's re-clip).
 // Returns their weighted vector area.
 Vec3 reclip_member(PatchMember& m, const Vec3& shift_b, const Vec3& origin, ClipScratch& cs, SurfacePolygons& surface) {
-  const Vec3 zero = Vec3::Zero();
   SideSums sa, sb;
-  sa.surface = sb.surface = &surface;
-  sb.side = 1;
-  m.poly_first = static_cast<int>(surface.end.size());
-  if (m.side_weight[0] != 0 || m.point_side[0])
-    clip_faces(*m.A, *m.wa, zero, *m.B, *m.wb, shift_b, origin, false, cs, sa);
-  if (m.side_weight[1] != 0 || m.point_side[1])
-    clip_faces(*m.B, *m.wb, shift_b, *m.A, *m.wa, zero, origin, true, cs, sb);
-  m.poly_end = static_cast<int>(surface.end.size());
+  clip_sides(m, shift_b, origin, m.side_weight[0] != 0 || m.point_side[0], m.side_weight[1] != 0 || m.point_side[1],
+             cs, surface, sa, sb);
   return m.side_weight[0] * sa.vec_area + m.side_weight[1] * sb.vec_area;
 }
 
@@ -323,9 +326,11 @@ struct PatchScratch {
   std::vector<Vec3> half;
   SurfacePolygons surface, shifted, secant;
   std::vector<PatchMember> members, contact;
-  std::vector<Vec3> contact_dir;  // per contact of a body pair: the sum of its members' vector areas
-  std::vector<Vec3> contact_lo, contact_hi;  // ... and the box of their contact surfaces (local origin)
-  std::vector<int> contact_of;    // per member: its contact
+  struct Group {
+    Vec3 dir, lo, hi;  // the sum of its members' vector areas; the box of their contact surfaces (local origin)
+  };
+  std::vector<Group> groups;    // per contact of a body pair
+  std::vector<int> contact_of;  // per member: its contact
 };
 
 // The area, normal, point and volume of the contact of members ms[0, n), sums over them; `centre` gets the point
@@ -363,9 +368,7 @@ void complete_patch(ContactPatch& r, const Vec3& centre, PatchMember* ms, int n,
   double lo = 1e300, hi = -1e300;
   r.span_lo = r.span_hi = r.point;
   for (int k = 0; k < n; ++k) {
-    const int first = ms[k].poly_first > 0 ? surface.end[ms[k].poly_first - 1] : 0;
-    const int last = ms[k].poly_end > 0 ? surface.end[ms[k].poly_end - 1] : 0;
-    for (int i = first; i < last; ++i) {
+    for (int i = vertex_begin(surface, ms[k].poly_first); i < vertex_begin(surface, ms[k].poly_end); ++i) {
       const Vec3& p = surface.v[i];
       const double s = u1.dot(p);
       if (s < lo) lo = s, r.span_lo = p + origin;
@@ -496,11 +499,11 @@ struct CollisionWorld::Impl {
                                });
     const Quat& qa = s.orientation[a];
     const CachedContact* best = nullptr;
-    double best_d = kSameSpot;
+    double best_d = 0;
     for (; it != cache.end() && it->body_a == a && it->body_b == b; ++it) {
       if (it->type != ContactType::crushing || (qa * it->crush_normal_a).dot(normal) < kSameDirection) continue;
       const double d = (qa * it->crush_point_a + s.position[a] - point).norm();
-      if (d < best_d || (!best && d <= best_d)) best_d = d, best = &*it;
+      if (d <= kSameSpot && (!best || d < best_d)) best_d = d, best = &*it;
     }
     return best;
   }
@@ -508,9 +511,10 @@ struct CollisionWorld::Impl {
   // The crushing contacts of a compliant body pair, whose candidate part pairs are pairs[first, last), into out;
   // returns how many. `touching` counts the part pairs that press.
   //
-  // One contact per direction, not per part pair. The part pairs of a body pair that press in about one direction
-  // (their normals within kSameContactCos of the contact's: a floe against one flank of the bow, across however many
-  // hull sections and floe parts) make one contact: one normal, one point, two rows over their surfaces together,
+  // One contact per direction and place, not per part pair. The part pairs of a body pair that press in about one
+  // direction at one place (their normals within kSameContactCos of the contact's and their surfaces within
+  // load_join_distance_m of it: a floe against one flank of the bow, across however many hull sections and floe
+  // parts) make one contact: one normal, one point, two rows over their surfaces together,
   // one crushed state. A floe wedged in a notch, pressed on two faces at an angle, gets one contact per face. Per
   // part pair, a light piece pressed into its parent floe or the hull had 4-12 nearly dependent rows across part
   // seams; the force is the same sum (p A per member: their vector areas add up), on two rows.
@@ -550,41 +554,36 @@ struct CollisionWorld::Impl {
     // 2. The members into contacts by direction and place (in pair order: deterministic). A member joins a contact
     // whose direction is within kSameContactCos of its own and whose surface's box comes within the join distance
     // of its surface's box: max(2 h, 1 m), the distance at which the fracture stage takes two contacts of a level
-    // ice tile as one load. So a contact never bridges a gap along the waterline (two hull sections metres apart
-    // pressing in one direction stay two loads, each with its own width).
-    double h = 1e300;  // the thinner ice body's thickness
-    for (int body : {a, b})
-      if (model.bodies[body].kind == BodyKind::floe) h = std::min(h, model.bodies[body].thickness_m);
-    const double join = h < 1e300 ? std::max(2 * h, 1.0) : 1.0;
-    ps.contact_dir.clear();
-    ps.contact_lo.clear();
-    ps.contact_hi.clear();
+    // ice tile as one load (load_join_distance_m). So a contact never bridges a gap along the waterline (two hull
+    // sections metres apart pressing in one direction stay two loads, each with its own width).
+    // The ice's thickness: b's against the vessel (body 0, always a), the thinner floe's between two floes.
+    const double h = structure ? model.bodies[b].thickness_m
+                               : std::min(model.bodies[a].thickness_m, model.bodies[b].thickness_m);
+    const double join = load_join_distance_m(h);
+    ps.groups.clear();
     ps.contact_of.resize(n);
     for (int k = 0; k < n; ++k) {
       const PatchMember& m = ps.members[k];
       Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-      const int v0 = m.poly_first > 0 ? ps.surface.end[m.poly_first - 1] : 0;
-      const int v1 = m.poly_end > 0 ? ps.surface.end[m.poly_end - 1] : 0;
-      for (int v = v0; v < v1; ++v) lo = lo.cwiseMin(ps.surface.v[v]), hi = hi.cwiseMax(ps.surface.v[v]);
+      for (int v = vertex_begin(ps.surface, m.poly_first); v < vertex_begin(ps.surface, m.poly_end); ++v)
+        lo = lo.cwiseMin(ps.surface.v[v]), hi = hi.cwiseMax(ps.surface.v[v]);
       const Vec3 dir = m.vec_area.normalized();
       int c = 0;
-      for (; c < static_cast<int>(ps.contact_dir.size()); ++c) {
-        const Vec3 gap = (lo - ps.contact_hi[c]).cwiseMax(ps.contact_lo[c] - hi).cwiseMax(0.0);
-        if (ps.contact_dir[c].normalized().dot(dir) >= kSameContactCos && gap.norm() <= join) break;
+      for (; c < static_cast<int>(ps.groups.size()); ++c) {
+        const PatchScratch::Group& g = ps.groups[c];
+        const Vec3 gap = (lo - g.hi).cwiseMax(g.lo - hi).cwiseMax(0.0);
+        if (g.dir.normalized().dot(dir) >= kSameContactCos && gap.norm() <= join) break;
       }
-      if (c == static_cast<int>(ps.contact_dir.size())) {
-        ps.contact_dir.push_back(Vec3::Zero());
-        ps.contact_lo.push_back(lo);
-        ps.contact_hi.push_back(hi);
-      }
-      ps.contact_dir[c] += m.vec_area;
-      ps.contact_lo[c] = ps.contact_lo[c].cwiseMin(lo);
-      ps.contact_hi[c] = ps.contact_hi[c].cwiseMax(hi);
+      if (c == static_cast<int>(ps.groups.size())) ps.groups.push_back({Vec3::Zero(), lo, hi});
+      PatchScratch::Group& g = ps.groups[c];
+      g.dir += m.vec_area;
+      g.lo = g.lo.cwiseMin(lo);
+      g.hi = g.hi.cwiseMax(hi);
       ps.contact_of[k] = c;
     }
     // 3. Each contact.
     int made = 0;
-    for (int c = 0; c < static_cast<int>(ps.contact_dir.size()); ++c) {
+    for (int c = 0; c < static_cast<int>(ps.groups.size()); ++c) {
       ps.contact.clear();
       for (int k = 0; k < n; ++k)
         if (ps.contact_of[k] == c) ps.contact.push_back(ps.members[k]);

@@ -310,7 +310,7 @@ std::vector<FractureCut> find_fractures(const Model& model, const State& state, 
       // width would span the hull).
       const Body& fb = model.bodies[floe];
       const std::vector<std::vector<size_t>> groups =
-          fb.fixed ? contact_patches(contacts, shares, pair, std::max(2 * fb.thickness_m, 1.0))
+          fb.fixed ? contact_patches(contacts, shares, pair, load_join_distance_m(fb.thickness_m))
                    : std::vector<std::vector<size_t>>{pair};
       for (const std::vector<size_t>& group : groups) {
         PairLoad pl;

@@ -4,6 +4,7 @@
 // grow: when ice breaks, the world appends the pieces as new bodies (sim/fracture.h); an entry, once made, never
 // changes (a broken floe stays in the table, marked dead in State::alive), so indices stay valid for a whole run.
 #pragma once
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -42,6 +43,11 @@ struct DragFace {
   Vec3 centroid = Vec3::Zero();  // body frame (used as is when the whole face is under water)
   int side = -1;                 // side wall between ring vertices side and side + 1 (-1: top or bottom)
 };
+
+// Contacts of one body pair whose surfaces come within this of each other press on the ice as one load: one crushing
+// contact (collide) and one fracture load of a level ice tile (fracture). Twice the ice thickness h, at least 1 m:
+// closer than that, thin-plate theory does not tell two loads apart.
+inline double load_join_distance_m(double thickness_m) { return std::max(2 * thickness_m, 1.0); }
 
 struct Body {
   BodyKind kind = BodyKind::floe;

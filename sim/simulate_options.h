@@ -357,8 +357,8 @@ struct SolverOptions {
 };
 
 // Contact laws per pair of body classes (PHYSICS.md §1.7-1.8). Rigid: non-penetration with ERP push-out and a
-// manifold of up to 4 points. Compliant: crushing (§1.8(c)), one row per pair of convex parts at the centroid of the
-// overlap's contact surface, normal force capped by p_c(A) A of the overlap's nominal contact area A, hardening with
+// manifold of up to 4 points. Compliant: crushing (§1.8(c)), one contact (two rows) per body pair, direction and
+// place over the overlaps' contact surfaces, normal force capped by p_c(A) A of the overlap's nominal contact area A, hardening with
 // K_t = dF/d(delta) inside the implicit step, no push-out and no spring-back. Both compliant by default, as in SAMS
 // (PHYSICS.md §1.7: compliant ice-structure and ice-ice contacts, "large rubble accumulation and ice-ice
 // contact-induced failure"): with fracture, broken pieces are squeezed between floes, and rigid ice-ice rows there

@@ -174,10 +174,9 @@ bool same_state(const State& a, const State& b) {
 
 // The paired reference solve (solver.reference) is the step solved again from the same state with twice the sweep
 // caps, the other sweep order or no settled contact left out. Checked against a second algorithm: a second world
-// run with those settings. While
-// the two trajectories are bit-identical, the difference recorded in the first must equal the difference of the two
-// worlds' surge ice loads; they part at the first step the setting changes, which is the step that is checked. The
-// jam's caps are cut to 4 and 2 sweeps so that they bite.
+// run with those settings. While the two trajectories are bit-identical, the difference recorded in the first must
+// equal the difference of the two worlds' surge ice loads; they part at the first step the setting changes, which
+// is the step that is checked. The jam's caps are cut to 4 and 2 sweeps so that they bite.
 TEST(SolverReference, PairedSolveEqualsASecondRunWithTheReferenceSettings) {
   const Jam jam = ten_floe_jam(2e5, 1);  // the vessel under way: it strikes the row
   const FloeField& field = jam.field;
