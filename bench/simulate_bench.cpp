@@ -6,7 +6,8 @@
 // vessel covers the same ~400 m in every field, so the cost must stay with the floes it sets in motion, not grow
 // with the field. Fracture (PHYSICS.md §2) is on as in the cases; the Oden-size field runs first without it, in the
 // same process, so that its cost is a ratio of one run: events per simulated second, floe bodies at the start and
-// the end, the fracture stage's time, and `fracture_speed_ratio <with / without>`. The last line is
+// the end, the fracture stage's time, who presses on the hull (input floes, pieces), and
+// `fracture_speed_ratio <with / without>`. The last line is
 // `realtime_factor <simulated s per wall s on the Oden-size field, fracture on>`.
 //
 //   floesim-bench [--duration 200] [--threads 2] [--scales 1,4,9] [--seed 1] [--keep DIR] [--no-compare]
@@ -192,6 +193,40 @@ double peak_memory_mb() {
   return u.ru_maxrss / 1024.0;  // ru_maxrss is in kB on Linux
 }
 
+// Who presses on the hull, from the results' in_contact flags (every stored frame): the input floes and the pieces
+// broken from them, per frame on average, and the longest time one piece stayed against the hull (frames in a row).
+// With fracture on, the pieces that ride the bow are where the extra contacts of a step come from.
+struct HullPressers {
+  double input_floes = 0, pieces = 0, longest_piece_s = 0;
+};
+
+HullPressers hull_pressers(const Results& r) {
+  HullPressers h;
+  if (r.frames() == 0) return h;
+  FrameReplay replay(r, "the bench's results");
+  std::vector<int> run(r.floe_id.size(), 0);  // per floe: frames in a row it has pressed on the hull
+  int longest = 0;
+  for (size_t f = 0; f < r.frames(); ++f) {
+    replay.seek(f);
+    std::vector<uint8_t> pressing(r.floe_id.size(), 0);
+    for (size_t k = 0; k < replay.rows().size(); ++k) {
+      const int32_t floe = replay.floes()[k];
+      if (floe < 0 || !r.state_in_contact[replay.rows()[k]]) continue;
+      pressing[floe] = 1;
+      (r.floe_generation[floe] > 0 ? h.pieces : h.input_floes) += 1;
+    }
+    for (size_t g = 0; g < run.size(); ++g) {
+      run[g] = pressing[g] ? run[g] + 1 : 0;
+      if (r.floe_generation[g] > 0) longest = std::max(longest, run[g]);
+    }
+  }
+  h.input_floes /= static_cast<double>(r.frames());
+  h.pieces /= static_cast<double>(r.frames());
+  const double interval = r.frames() > 1 ? r.frame_time_s[1] - r.frame_time_s[0] : 0;
+  h.longest_piece_s = longest * interval;
+  return h;
+}
+
 struct BenchOptions {
   double duration_s = 200;
   int threads = 2;
@@ -284,6 +319,9 @@ double run_field(int scale, const BenchOptions& bo, const HullModel& hull, bool 
                 r.fracture_mode.size(), mode[1], mode[2], mode[3], r.fracture_mode.size() / bo.duration_s,
                 model.floe_count(), bodies.empty() ? 0.0 : bodies.back(), 1e3 * st.stage_s[kFracture] / st.steps);
   }
+  const HullPressers hp = hull_pressers(r);
+  std::printf("  pressing on the hull (mean per frame): input floes %.1f, pieces %.1f; longest a piece stayed "
+              "pressed %.1f s\n", hp.input_floes, hp.pieces, hp.longest_piece_s);
   std::printf("  peak memory (ru_maxrss, whole process so far) %.0f MB\n", peak_memory_mb());
   std::fflush(stdout);
   return rtf;
