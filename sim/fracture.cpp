@@ -159,11 +159,54 @@ Candidate evaluate(const Model& model, const State& state, const PairLoad& pl, l
   return split;
 }
 
-// The pieces of a decided failure, in the floe's body frame; empty when the cut leaves the floe whole or cannot be
+bool any_brash(const std::vector<Polygon>& pieces, double thickness_m, double min_area_m2) {
+  for (const Polygon& p : pieces)
+    if (is_brash(p, thickness_m, min_area_m2)) return true;
+  return false;
+}
+
+// fracture.small_wedge "enlarge": the wedge of the smallest R_b >= rb whose pieces are none of them brash (to 1e-6
+// of R_b), by doubling and then bisection (the wedge only grows with R_b), its R_b in `rb_out`; `wedge` (at rb) if
+// even a wedge reaching across the whole floe is brash. wedge_of(R_b) cuts the floe.
+template <class WedgeOf>
+PolygonCut smallest_kept_wedge(WedgeOf wedge_of, double rb, double thickness_m, double min_area_m2,
+                               const PolygonCut& wedge, double& rb_out) {
+  rb_out = rb;
+  auto kept = [&](const PolygonCut& w) {
+    return !w.inside.empty() && !w.outside.empty() && !any_brash(w.inside, thickness_m, min_area_m2);
+  };
+  double lo = rb, hi = rb;
+  PolygonCut best;
+  for (int k = 0; k < 20; ++k) {  // up to 2^20 R_b: beyond any floe the contact can break
+    hi *= 2;
+    best = wedge_of(hi);
+    if (kept(best)) break;
+    if (best.outside.empty()) return wedge;  // the wedge took the whole floe and is still brash
+    lo = hi;
+  }
+  if (!kept(best)) return wedge;
+  rb_out = hi;
+  while (hi - lo > 1e-6 * rb) {
+    const double mid = 0.5 * (lo + hi);
+    PolygonCut w = wedge_of(mid);
+    if (kept(w)) {
+      hi = rb_out = mid;
+      best = std::move(w);
+    } else {
+      lo = mid;
+    }
+  }
+  return best;
+}
+
+// The pieces of a decided failure, in the floe's body frame, and the R_b of a wedge as cut (`rb_cut`: c.rb, or
+// larger with fracture.small_wedge "enlarge"); empty when the cut leaves the floe whole or cannot be
 // made (a piece below the minimum size of a split, a degenerate boolean result).
-std::vector<Polygon> cut(const Body& body, const Candidate& c, const FractureOptions& fo, int* wedge_pieces) {
+std::vector<Polygon> cut(const Body& body, const Candidate& c, const FractureOptions& fo, int* wedge_pieces,
+                         double* rb_cut) {
   std::vector<Polygon> pieces;
   *wedge_pieces = 0;
+  *rb_cut = c.rb;
   try {
     if (c.mode == kFractureSplitting) {
       const LineSplit s = split_by_line(body.outline, c.point, c.direction);
@@ -185,8 +228,12 @@ std::vector<Polygon> cut(const Body& body, const Candidate& c, const FractureOpt
       // fracture (floesim-bench: fracture_speed_ratio 0.26, with the kite 0.45). The crack's shape is not
       // resolved finer than that by the closed-form laws anyway.
       const Vec2 apex = c.point - c.apex_distance * c.direction;
-      const Polygon sector = equal_area_wedge(apex, c.direction, 0.5 * c.theta, c.apex_distance + c.rb);
-      const PolygonCut wedge = cut_polygon(body.outline, sector);
+      auto wedge_of = [&](double rb) {
+        return cut_polygon(body.outline, equal_area_wedge(apex, c.direction, 0.5 * c.theta, c.apex_distance + rb));
+      };
+      PolygonCut wedge = wedge_of(c.rb);
+      if (fo.small_wedge == "enlarge" && any_brash(wedge.inside, body.thickness_m, fo.min_piece_area_m2))
+        wedge = smallest_kept_wedge(wedge_of, c.rb, body.thickness_m, fo.min_piece_area_m2, wedge, *rb_cut);
       if (wedge.inside.empty() || wedge.outside.empty()) return {};
       pieces = wedge.inside;
       *wedge_pieces = static_cast<int>(wedge.inside.size());
@@ -338,7 +385,8 @@ std::vector<FractureCut> find_fractures(const Model& model, const State& state, 
     if (best.ratio < 1) continue;
     FractureCut fc;
     fc.body = floe;
-    fc.pieces = cut(model.bodies[floe], best, fo, &fc.wedge_pieces);
+    double rb_cut = best.rb;
+    fc.pieces = cut(model.bodies[floe], best, fo, &fc.wedge_pieces, &rb_cut);
     if (fc.pieces.empty()) continue;
     FractureEvent& e = fc.event;
     e.time_s = step * dt;
@@ -351,7 +399,7 @@ std::vector<FractureCut> find_fractures(const Model& model, const State& state, 
     e.width_m = best.width;
     e.theta_rad = best.mode == kFractureSplitting ? 0.0 : best.theta;
     e.lc_m = best.lc;
-    e.rb_m = best.mode == kFractureSplitting ? 0.0 : best.rb;
+    e.rb_m = best.mode == kFractureSplitting ? 0.0 : rb_cut;
     cuts.push_back(std::move(fc));
   }
   return cuts;

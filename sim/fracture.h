@@ -39,7 +39,7 @@ struct FractureEvent {
   double width_m = 0;              // contact width used (>= h)
   double theta_rad = 0;            // wedge angle (0 for splitting)
   double lc_m = 0;                 // characteristic length of the floe's plate
-  double rb_m = 0;                 // R_b: load -> circumferential crack (wedges; 0 for splitting)
+  double rb_m = 0;                 // R_b as cut: load -> circumferential crack (wedges; 0 for splitting)
   double brash_mass_kg = 0;        // pieces below fracture.min_piece_area_m2, removed
   std::vector<int> child_ids;      // the pieces that became bodies
 };

@@ -452,6 +452,9 @@ struct FractureOptions {
   bool speed_correction = false;             // R_b x (1 + C_v v_n) (§2.1, velocity effects), either piece size
   double speed_coefficient_spm = -0.1;       // C_v, s/m
   double min_piece_area_m2 = 1.0;            // smaller pieces become brash: removed, their mass counted
+  // A bending wedge that would be brash: "brash" (removed, its mass counted) or "enlarge" (its R_b grown until it
+  // is the smallest piece the simulation keeps: no ice is deleted, and the ice it stands for is still pushed under).
+  std::string small_wedge = "brash";
   template <class V>
   void visit(V& v) {
     v.field("enabled", enabled, "-", "floes break (bending, radial cracking, splitting); false: they only crush");
@@ -490,6 +493,11 @@ struct FractureOptions {
     v.field("min_piece_area_m2", min_piece_area_m2, "m^2",
             "pieces smaller than this are brash: removed from the simulation, their mass counted in the summary",
             non_negative());
+    v.field("small_wedge", small_wedge, "-",
+            "a bending wedge that would be brash (below min_piece_area_m2 or narrower than the ice is thick): "
+            "\"brash\" (removed, its mass counted) or \"enlarge\" (R_b grown to the smallest wedge that is not brash, "
+            "so that no broken ice is deleted)",
+            one_of({"brash", "enlarge"}));
   }
 };
 

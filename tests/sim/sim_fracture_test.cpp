@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <string>
 
 #include "pipeline/error.h"
 #include "pipeline/options.h"
@@ -143,6 +144,43 @@ TEST(Fracture, EmpiricalPieceReachesClLcTimesTheSpeedFactorBeyondTheLoad) {
     // behind the load point, is outside the floe).
     const double sector = 0.5 * theta * ((a + rb) * (a + rb) - a * a);
     EXPECT_NEAR(signed_area(wedge), sector, 0.06 * sector) << speed;
+  }
+}
+
+TEST(Fracture, ASmallWedgeIsBrashOrEnlargedToTheSmallestPieceKept) {
+  // Thin ice (h = 0.3 m, l_c = 5.92 m) and the empirical piece R_b = l_c / 6 = 0.99 m: loaded over w = h at the
+  // west edge of a 200 m floe through a 30 deg face, theta = 60 deg, the wedge is the kite between the apex
+  // a = w / theta = 0.286 m behind the load point and a + R_b, less the triangle behind the ice edge (0.05 m behind
+  // the load point, d = a - 0.05 from the apex): A(R) = (a + R)^2 theta / 2 - d^2 tan(theta / 2) = 0.81 m^2, under
+  // min_piece_area_m2 = 1. With small_wedge "brash" that wedge is cut (and removed as brash when the world applies
+  // the cut); with "enlarge" R_b grows until A(R) = 1 m^2: R = sqrt(2 (1 + d^2 tan(theta / 2)) / theta) - a.
+  const double h = 0.3, lc = lc_by_hand(h), w = h, theta = kPi / 3, a = w / theta, d = a - 0.05;
+  auto kite_area = [&](double rb) { return 0.5 * theta * (a + rb) * (a + rb) - d * d * std::tan(0.5 * theta); };
+  const double rb_law = lc / 6, rb_kept = std::sqrt(2 * (1.0 + d * d * std::tan(0.5 * theta)) / theta) - a;
+  ASSERT_LT(kite_area(rb_law), 0.9);
+  for (const char* mode : {"brash", "enlarge"}) {
+    SimulateOptions o = testing::floe_options();
+    o.fracture.piece_size = "empirical";
+    o.fracture.piece_c_l = 1.0 / 6;
+    o.fracture.min_piece_area_m2 = 1.0;
+    o.fracture.small_wedge = mode;
+    Rig rig({rect_floe(1, 0, -100, 200, 200, h)}, 60, o);
+    World world(rig.model);
+    const double dt = rig.model.options.time_step_s;
+    // 50 kN through the 30 deg face: F_V = 43 kN, above the wedge's ~10 kN; F_H = 25 kN, far below splitting the
+    // 200 m floe (2 K_IC h sqrt(200 m) = 1.3 MN).
+    const auto cuts = find_fractures(world.model(), world.state(),
+                                     {pushing_contact(Vec3(0.05, 0, 0), sloped_normal(30), 5e4, w, dt)}, dt);
+    ASSERT_EQ(cuts.size(), 1u) << mode;
+    ASSERT_EQ(cuts[0].wedge_pieces, 1) << mode;
+    ASSERT_EQ(cuts[0].pieces.size(), 2u) << mode;
+    const double wedge = signed_area(cuts[0].pieces[0]);
+    const double expected_rb = std::string(mode) == "brash" ? rb_law : rb_kept;
+    EXPECT_NEAR(cuts[0].event.rb_m, expected_rb, 1e-5 * expected_rb) << mode;
+    EXPECT_NEAR(wedge, kite_area(expected_rb), 1e-5) << mode;
+    EXPECT_EQ(is_brash(cuts[0].pieces[0], h, 1.0), std::string(mode) == "brash") << mode;
+    // The pieces still tile the floe.
+    EXPECT_NEAR(wedge + signed_area(cuts[0].pieces[1]), 200.0 * 200.0, 1e-8 * 200 * 200) << mode;
   }
 }
 
