@@ -268,9 +268,6 @@ struct PatchMember {
   int poly_first = 0, poly_end = 0;  // its contact-surface faces in the SurfacePolygons it was clipped into
 };
 
-// Clips the member's parts, b translated by shift_b, about `origin`: both sides, their contact-surface faces appended
-// to `surface`. Sets which sides carry the contact (PatchSide), the vector area, the point's sums and the volume.
-// Returns whether the parts press on each other (a vector area of at least kMinPatchArea).
 // a's faces clipped by b (if side_a) and b's by a (if side_b), b translated by shift_b, about `origin`, into sa and
 // sb; their contact-surface faces are appended to `surface` and become the member's.
 void clip_sides(PatchMember& m, const Vec3& shift_b, const Vec3& origin, bool side_a, bool side_b, ClipScratch& cs,
@@ -284,6 +281,9 @@ void clip_sides(PatchMember& m, const Vec3& shift_b, const Vec3& origin, bool si
   m.poly_end = static_cast<int>(surface.end.size());
 }
 
+// Clips the member's parts, b translated by shift_b, about `origin`: both sides, their contact-surface faces appended
+// to `surface`. Sets which sides carry the contact (PatchSide), the vector area, the point's sums and the volume.
+// Returns whether the parts press on each other (a vector area of at least kMinPatchArea).
 bool clip_member(PatchMember& m, const Vec3& shift_b, const Vec3& origin, PatchSide side, ClipScratch& cs,
                  SurfacePolygons& surface) {
   SideSums sa, sb;

@@ -214,8 +214,7 @@ std::vector<Polygon> cut(const Body& body, const Candidate& c, const FractureOpt
       pieces = s.left;
       pieces.insert(pieces.end(), s.right.begin(), s.right.end());
       // A split that leaves a sliver is no split (Metrikin's rule, PHYSICS.md §2.2): the floe crushes instead.
-      for (const Polygon& p : pieces)
-        if (is_brash(p, body.thickness_m, fo.min_piece_area_m2)) return {};
+      if (any_brash(pieces, body.thickness_m, fo.min_piece_area_m2)) return {};
     } else {
       // The wedge: apex a = alpha l_c behind the contact point (outside the ice), radial cracks at +-theta/2 about
       // the inward normal, the circumferential crack R_b beyond the load point, so its radius about the apex is
