@@ -685,12 +685,35 @@ nlohmann::json summarize(const Model& model, const Results& r, const SeriesSourc
       ea += std::abs(err[i]);
       emax = std::max(emax, std::abs(err[i]));
     }
-    s["solver"]["surge_load_error"] = {{"reference", o.solver.reference},
-                                       {"reference_sweeps", o.solver.reference_sweeps},
-                                       {"mean_N", e / n},
-                                       {"mean_abs_N", ea / n},
-                                       {"max_abs_N", emax},
-                                       {"mean_over_mean_load", mean != 0 ? (e / n) / mean : 0.0}};
+    nlohmann::json& j = s["solver"]["surge_load_error"];
+    j = {{"reference", o.solver.reference},
+         {"reference_sweeps", o.solver.reference_sweeps},
+         {"horizon_s", o.solver.reference_horizon_s},
+         {"mean_N", e / n},
+         {"mean_abs_N", ea / n},
+         {"max_abs_N", emax},
+         {"mean_over_mean_load", mean != 0 ? (e / n) / mean : 0.0}};
+    // With a branch: each whole window inside the steady part gives one mean difference. The windows start from
+    // the run's own trajectory on fresh copies, so their differences scatter about the setting's effect nearly
+    // independently: their standard error says how well the run pins the effect.
+    const size_t h = static_cast<size_t>(o.reference_horizon_steps());
+    if (h > 0) {
+      std::vector<double> wm;
+      for (size_t k = (first + h - 1) / h; (k + 1) * h <= steps; ++k) {
+        double sum = 0;
+        for (size_t i = k * h; i < (k + 1) * h; ++i) sum += err[i];
+        wm.push_back(sum / static_cast<double>(h));
+      }
+      double m = 0, v2 = 0;
+      for (double x : wm) m += x;
+      if (!wm.empty()) m /= static_cast<double>(wm.size());
+      for (double x : wm) v2 += (x - m) * (x - m);
+      const double se = wm.size() > 1 ? std::sqrt(v2 / static_cast<double>(wm.size() - 1) / wm.size()) : 0.0;
+      j["windows"] = wm.size();
+      j["window_mean_N"] = m;
+      j["window_se_N"] = wm.size() > 1 ? nlohmann::json(se) : nlohmann::json(nullptr);
+      j["window_mean_over_mean_load"] = mean != 0 ? m / mean : 0.0;
+    }
   }
   s["steps"] = steps;
   s["frames"] = r.frames();

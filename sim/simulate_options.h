@@ -303,6 +303,12 @@ struct SolverOptions {
   // by far more (5-15 % between starts).
   std::string reference = "off";
   int reference_sweeps = 2000;     // sweeps of the "converged_relax" reference
+  // 0: the reference is the step's solve again (paired on one step). > 0 (double_cap, reverse_order,
+  // every_contact): the reference is a branch, a copy of the world that runs on by itself with the reference's
+  // settings for this long and is then replaced by a fresh copy; each step records the difference of the two
+  // worlds' loads. The paired solve sees what a setting changes in one step; the branch also sees what it carries
+  // into the next steps (other velocities, positions, crushed depths), until the transit's chaos parts the two.
+  double reference_horizon_s = 0;
   bool reverse_order = false;      // sweep the rows last to first (to check that results do not hang on the order)
   // A sweep leaves out a contact that has settled: its last update changed its row velocities by less than this
   // fraction of tolerance_mps, and its relative velocity has moved by less than that since (see solve_island).
@@ -335,6 +341,12 @@ struct SolverOptions {
             one_of({"off", "converged_relax", "double_cap", "reverse_order", "every_contact"}));
     v.field("reference_sweeps", reference_sweeps, "-",
             "sweeps of the converged_relax reference (tolerance 1e-3 of tolerance_mps)", int_in_range(1, 1000000));
+    v.field("reference_horizon_s", reference_horizon_s, "s",
+            "0: the reference is each step solved again; > 0 (double_cap, reverse_order, every_contact): a copy of "
+            "the world runs on with the reference's settings for this long (a whole number of time steps), then a "
+            "fresh copy is taken, and each step records the two worlds' difference (what the setting carries from "
+            "step to step)",
+            non_negative());
     v.field("reverse_order", reverse_order, "-", "sweep the contact rows in reverse order (an order-dependence check)");
     v.field("skip_settled", skip_settled, "-",
             "a sweep leaves out a contact whose last update and whose relative velocity since then both changed by "
@@ -678,9 +690,20 @@ struct SimulateOptions {
       else if (std::abs(n - std::round(n)) > 1e-6 * std::max(1.0, n))
         v.problem("checkpoint_interval_s", "must be a whole number of time steps");
     }
+    if (time_step_s > 0 && solver.reference_horizon_s > 0) {
+      const double n = solver.reference_horizon_s / time_step_s;
+      if (solver.reference != "double_cap" && solver.reference != "reverse_order" &&
+          solver.reference != "every_contact")
+        v.problem("solver.reference_horizon_s", "a branch runs only for solver.reference double_cap, reverse_order "
+                  "or every_contact (it is \"" + solver.reference + "\"): set the reference or a horizon of 0");
+      else if (n < 1 - 1e-9 || std::abs(n - std::round(n)) > 1e-6 * std::max(1.0, n))
+        v.problem("solver.reference_horizon_s", "must be 0 or a whole number of time steps (time_step_s = " +
+                  Json(time_step_s).dump() + ")");
+    }
   }
 
   long steps() const { return std::lround(duration_s / time_step_s); }
+  long reference_horizon_steps() const { return std::lround(solver.reference_horizon_s / time_step_s); }  // 0: none
   long output_every() const { return std::lround(output_interval_s / time_step_s); }
   long checkpoint_every() const { return std::lround(checkpoint_interval_s / time_step_s); }  // 0: none
 };

@@ -28,6 +28,27 @@ class StageTimer {
 
 bool finite(const Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
 
+// The solver settings of the reference solver.reference names (double_cap, reverse_order or every_contact), with no
+// reference of their own.
+SolverOptions reference_settings(const SolverOptions& o) {
+  SolverOptions v = o;
+  if (o.reference == "double_cap") v.iterations *= 2, v.relax_iterations *= 2;
+  else if (o.reference == "every_contact") v.skip_settled = 0;
+  else v.reverse_order = !o.reverse_order;
+  v.reference = "off";
+  v.reference_horizon_s = 0;
+  return v;
+}
+
+// What a branch of a world built on `model` is restored on (solver.reference_horizon_s): the same model with the
+// reference's solver settings; null when the world has no branch.
+std::shared_ptr<const Model> branch_base(const Model& model) {
+  if (model.vessel < 0 || model.options.reference_horizon_steps() <= 0) return nullptr;
+  Model b = model;
+  b.options.solver = reference_settings(model.options.solver);
+  return std::make_shared<const Model>(std::move(b));
+}
+
 }  // namespace
 
 World::World(const Model& model) : model_(model), pool_(model.options.threads) {
@@ -50,6 +71,8 @@ World::World(const Model& model) : model_(model), pool_(model.options.threads) {
   ended_s_.assign(n, std::numeric_limits<double>::infinity());
   for (const Body& b : model.bodies) next_floe_id_ = std::max(next_floe_id_, b.id + 1);
   floes_alive_ = model.floe_count();
+  branch_base_ = branch_base(model);
+  if (branch_base_) branch_every_ = o.reference_horizon_steps();
   for (size_t b = 0; b < n; ++b) {
     state_.position[b] = model.bodies[b].initial_position;
     state_.orientation[b] = model.bodies[b].initial_orientation;
@@ -111,6 +134,7 @@ void World::fail(int body, const std::string& what) const {
 }
 
 void World::step() {
+  if (branch_every_ > 0 && state_.step % branch_every_ == 0) start_branch();
   report_ = StepReport{};
   { StageTimer t(stage_seconds_[kCollide]); stage_collide(); }
   { StageTimer t(stage_seconds_[kForces]); stage_forces(); }
@@ -121,6 +145,32 @@ void World::step() {
   { StageTimer t(stage_seconds_[kSleep]); stage_sleep(); }
   state_.time_s = (state_.step + 1) * model_.options.time_step_s;  // no drift from repeated addition
   ++state_.step;
+  if (branch_) step_branch();
+}
+
+void World::start_branch() {
+  // Through the checkpoint's bytes: the restored world steps on bit for bit as this one would (tested), here on
+  // the reference's settings. The old branch goes first, so that it is not copied into the new one.
+  branch_.reset();
+  ByteWriter w;
+  save(w);
+  ByteReader r(w.bytes(), "the solver.reference branch");
+  branch_ = restore(*branch_base_, r);
+}
+
+void World::step_branch() {
+  try {
+    branch_->step();
+  } catch (const Error& e) {
+    throw Error(std::string("solver.reference branch (") + model_.options.solver.reference + ", started at t = " +
+                std::to_string((state_.step - 1) / branch_every_ * branch_every_ * model_.options.time_step_s) +
+                " s): " + e.what());
+  }
+  const int v = model_.vessel;
+  const Vec3 surge = state_.orientation[v] * Vec3::UnitX();
+  const Vec3 surge_branch = branch_->state_.orientation[v] * Vec3::UnitX();
+  report_.surge_load_error_n =
+      surge.dot(report_.ice_load.force) - surge_branch.dot(branch_->report_.ice_load.force);
 }
 
 void World::stage_collide() {
@@ -224,7 +274,8 @@ void World::stage_solve() {
   const double dt = model_.options.time_step_s;
   islands_ = prepare_contacts(model_, solver_bodies_, state_, contacts_, dt);
   // A paired reference solve of the whole step starts where this one does: after the warm start.
-  if (o.reference == "double_cap" || o.reference == "reverse_order" || o.reference == "every_contact") {
+  if (branch_every_ == 0 &&
+      (o.reference == "double_cap" || o.reference == "reverse_order" || o.reference == "every_contact")) {
     reference_state_ = state_;
     reference_contacts_ = contacts_;
   }
@@ -259,7 +310,7 @@ void World::stage_relax() {
   report_.ice_load += report_.ice_load_compliant;
   // What the solver's settings change in the recorded load (solver.reference, a diagnostic).
   report_.surge_load_error_n = std::numeric_limits<double>::quiet_NaN();
-  if (o.reference != "off" && model_.vessel >= 0) {
+  if (o.reference != "off" && branch_every_ == 0 && model_.vessel >= 0) {
     const Vec3 surge = state_.orientation[model_.vessel] * Vec3::UnitX();
     report_.surge_load_error_n = surge.dot(report_.ice_load.force) - reference_surge_load(surge);
   }
@@ -280,15 +331,13 @@ double World::reference_surge_load(const Vec3& surge) {
     // The step's solve and relax passes again, from the state the solve started from, with twice the caps, the
     // other sweep order or every contact in every sweep. The relax pass does not read positions, so the copy taken
     // before integration serves it.
-    SolverOptions v = o;
-    int cap = o.iterations, relax = o.relax_iterations;
-    if (o.reference == "double_cap") cap *= 2, relax *= 2;
-    else if (o.reference == "every_contact") v.skip_settled = 0;
-    else v.reverse_order = !o.reverse_order;
+    const SolverOptions v = reference_settings(o);
     s = std::move(reference_state_);
     c = std::move(reference_contacts_);
-    solve_contacts(model_, solver_bodies_, s, c, islands_, dt, true, cap, o.tolerance_mps, &pool_, &v);
-    if (relax > 0) solve_contacts(model_, solver_bodies_, s, c, islands_, dt, false, relax, o.tolerance_mps, &pool_, &v);
+    solve_contacts(model_, solver_bodies_, s, c, islands_, dt, true, v.iterations, o.tolerance_mps, &pool_, &v);
+    if (v.relax_iterations > 0)
+      solve_contacts(model_, solver_bodies_, s, c, islands_, dt, false, v.relax_iterations, o.tolerance_mps, &pool_,
+                     &v);
   }
   Wrench rigid, compliant;
   vessel_ice_load(c, &rigid, &compliant);
@@ -614,6 +663,9 @@ void World::save(ByteWriter& w) const {
   std::vector<int32_t> moved(moved_.begin(), moved_.end());
   w.vec(moved);
   for (double t : stage_seconds_) w.pod(t);
+  // 4. The branch of solver.reference_horizon_s, if one runs (a world of its own, saved the same way).
+  w.pod<uint8_t>(branch_ ? 1 : 0);
+  if (branch_) branch_->save(w);
 }
 
 std::unique_ptr<World> World::restore(const Model& base, ByteReader& r) {
@@ -755,7 +807,13 @@ std::unique_ptr<World> World::restore(const Model& base, ByteReader& r) {
     FLOESIM_REQUIRE(b >= 0 && static_cast<size_t>(b) < n, r.what(), ": damaged (a moved body does not exist)");
   w->moved_.assign(moved.begin(), moved.end());
   for (double& t : w->stage_seconds_) t = r.pod<double>();
-  // 4. The broad phase from the restored poses and awake flags, without the bodies that have left the world.
+  // 4. The branch: restored on the model as built (the constructor made its base of the grown table).
+  w->branch_base_ = branch_base(base);
+  if (r.pod<uint8_t>()) {
+    FLOESIM_REQUIRE(w->branch_base_, r.what(), ": damaged (a solver.reference branch for a run that has none)");
+    w->branch_ = restore(*w->branch_base_, r);
+  }
+  // 5. The broad phase from the restored poses and awake flags, without the bodies that have left the world.
   w->collision_ = std::make_unique<CollisionWorld>(w->model_, w->state_, w->pool_);
   for (size_t b = 0; b < n; ++b)
     if (!s.alive[b]) w->collision_->remove_body(static_cast<int>(b));

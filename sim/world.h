@@ -45,8 +45,9 @@ struct StepReport {
   int fracture_events = 0;   // floes broken in this step
   int floe_bodies = 0;       // floe bodies alive at the end of the step
   SolverReport solve, relax;
-  // Vessel surge ice load minus the same from the reference solve of solver.reference (the relax pass converged,
-  // twice the sweep caps, or the other sweep order), N; NaN when not measured.
+  // Vessel surge ice load minus the same from the reference of solver.reference (the relax pass converged, twice
+  // the sweep caps, the other sweep order or every contact in every sweep: the step solved again, or with
+  // solver.reference_horizon_s the branch world's step), N; NaN when not measured.
   double surge_load_error_n = 0;
   Wrench ice_load, ice_load_rigid, ice_load_compliant;
   Wrench ice_load_level_ice;  // part of ice_load from contacts with level ice tiles (breaking the sheet's edge)
@@ -122,6 +123,10 @@ class World {
   [[noreturn]] void fail(int body, const std::string& what) const;
   // The vessel's surge ice load (along `surge`) from the reference solve of solver.reference, on copies.
   double reference_surge_load(const Vec3& surge);
+  // solver.reference_horizon_s: replaces the branch by a copy of this world (as it is between two steps) that
+  // steps with the reference's settings; and steps it with this world, recording the difference of the loads.
+  void start_branch();
+  void step_branch();
   std::string body_name(int body) const;
 
   Model model_;
@@ -149,6 +154,11 @@ class World {
   int floes_alive_ = 0;             // floe bodies alive (changes only in the fracture stage)
   std::array<double, kStageCount> stage_seconds_{};
   size_t base_bodies_ = 0;          // bodies of the model as built; pieces come after them
+  // solver.reference_horizon_s: the model as built with the reference's solver settings (what a branch is restored
+  // on), the branch of the current window, and the window's length in steps (0: no branch).
+  std::shared_ptr<const Model> branch_base_;
+  std::unique_ptr<World> branch_;
+  long branch_every_ = 0;
 };
 
 // What makes a piece of a broken floe: its outline in its own body frame (centred on its centroid), thickness, id,

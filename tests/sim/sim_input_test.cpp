@@ -38,6 +38,14 @@ TEST(SimInput, OptionErrorsNameTheKey) {
   expect_error([] { options_from({{"solver", {{"skip_settled", 1.5}}}}); }, {"solver.skip_settled"});
   expect_error([] { options_from({{"solver", {{"reference", "converged"}}}}); },
                {"solver.reference", "converged_relax", "double_cap", "reverse_order", "every_contact"});
+  expect_error([] { options_from({{"solver", {{"reference_horizon_s", 5}}}}); },
+               {"solver.reference_horizon_s", "double_cap", "\"off\""});
+  expect_error([] { options_from({{"solver", {{"reference", "converged_relax"}, {"reference_horizon_s", 5}}}}); },
+               {"solver.reference_horizon_s", "converged_relax"});
+  expect_error([] { options_from({{"solver", {{"reference", "double_cap"}, {"reference_horizon_s", 0.015}}}}); },
+               {"solver.reference_horizon_s", "whole number of time steps"});
+  expect_error([] { options_from({{"solver", {{"reference", "double_cap"}, {"reference_horizon_s", -1}}}}); },
+               {"solver.reference_horizon_s"});
   // The added-mass factors and the propellers (a list: errors name the item).
   expect_error([] { options_from({{"water", {{"floe_added_mass_scale", -1}}}}); }, {"water.floe_added_mass_scale"});
   expect_error([] { options_from({{"water", {{"floe_heave_added_mass_ratio", 1}}}}); },
