@@ -20,7 +20,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kCheckpointMagic = "floesim-checkpoint/3\n";
+constexpr const char* kCheckpointMagic = "floesim-checkpoint/4\n";
 constexpr const char* kRecordsMagic = "floesim-checkpoint-records/1\n";
 constexpr size_t kHashChars = 64;  // SHA-256, hex
 
@@ -325,7 +325,7 @@ void Checkpointer::save(const World& world, Results& r, const RecorderSums& sums
       r.series_first_step = static_cast<size_t>(step);
     }
     // 3. For people and the runner's messages.
-    const nlohmann::json info = {{"format", "floesim-checkpoint/3"},
+    const nlohmann::json info = {{"format", "floesim-checkpoint/4"},
                                  {"time_s", world.state().time_s},
                                  {"step", step},
                                  {"chunks", chunks_.size()},
