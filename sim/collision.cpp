@@ -227,7 +227,7 @@ inline int vertex_begin(const SurfacePolygons& s, int k) { return k > 0 ? s.end[
 
 // Adds the polygons [first, last) of s to `out`.
 void row_sums(const SurfacePolygons& s, int first, int last, const Vec3& c, const Vec3& u, const double side_weight[2],
-              const bool point_side[2], std::vector<Vec3>& half, RowSums& out) {
+              const bool point_side[2], std::array<std::vector<Vec3>, kRows>& half, RowSums& out) {
   int begin = vertex_begin(s, first);
   for (int k = first; k < last; ++k) {
     const Vec3* p = s.v.data() + begin;
@@ -235,10 +235,9 @@ void row_sums(const SurfacePolygons& s, int first, int last, const Vec3& c, cons
     begin = s.end[k];
     if (side_weight[s.side[k]] == 0 && !point_side[s.side[k]]) continue;  // a side the patch does not use
     const Vec3& nf = s.n[k];
+    split_polygon_plane(p, n, u, u.dot(c), half[0], half[1]);  // half 1: u.(x - c) >= 0
     for (int h = 0; h < kRows; ++h) {
-      const double sg = h ? 1.0 : -1.0;  // h = 1: u.(x - c) >= 0
-      clip_polygon_plane(p, n, -sg * u, -sg * u.dot(c), half);
-      const AreaCentroid ac = polygon_area_centroid(half.data(), static_cast<int>(half.size()));
+      const AreaCentroid ac = polygon_area_centroid(half[h].data(), static_cast<int>(half[h].size()));
       if (!(ac.area > 0)) continue;
       out.vec_area[h] += side_weight[s.side[k]] * ac.area * nf;
       if (point_side[s.side[k]]) {
@@ -323,7 +322,7 @@ Vec3 reclip_member(PatchMember& m, const Vec3& shift_b, const Vec3& origin, Clip
 // depth (shifted), after the secant's step (secant), and the members of the contact being built.
 struct PatchScratch {
   ClipScratch clip;
-  std::vector<Vec3> half;
+  std::array<std::vector<Vec3>, kRows> half;  // a surface polygon's two row halves
   SurfacePolygons surface, shifted, secant;
   std::vector<PatchMember> members, contact;
   struct Group {

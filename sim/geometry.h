@@ -70,20 +70,34 @@ inline int clip_polygon_z(const Vec3* p, int n, double z0, bool below, Vec3* out
   return k;
 }
 
-// Part of the polygon p[0..n) in the half-space u.x <= d, written to out (any plane; clip_polygon_z is z alone).
-// Each edge gives at most two points, so out is sized once and written by index (no push_back in the loop: this
-// runs for every face of every crushing contact, every step).
-inline void clip_polygon_plane(const Vec3* p, int n, const Vec3& u, double d, std::vector<Vec3>& out) {
-  out.resize(2 * static_cast<size_t>(n));
-  int k = 0;
+// The parts of the polygon p[0..n) in the half-spaces u.x <= d (below) and u.x >= d (above), in one pass: each
+// vertex's signed distance is computed once (any plane; clip_polygon_z is z alone). A point on the plane is in
+// both. `above` is bit for bit what clipping by the flipped plane (-u, -d) gives: that plane's distances are the
+// exact negations of these, and an edge's crossing point a + (s_a / (s_a - s_b)) (b - a) is the same with both
+// distances negated. Each edge gives at most two points, so the outputs are sized once and written by index (no
+// push_back in the loop: this runs for every face of every crushing contact, twice per step).
+inline void split_polygon_plane(const Vec3* p, int n, const Vec3& u, double d, std::vector<Vec3>& below,
+                                std::vector<Vec3>& above) {
+  below.resize(2 * static_cast<size_t>(n));
+  above.resize(2 * static_cast<size_t>(n));
+  int kb = 0, ka = 0;
+  double sb = n > 0 ? u.dot(p[0]) - d : 0;  // the distance of the edge's end, carried to the next edge's start
   for (int i = 0; i < n; ++i) {
     const Vec3& a = p[i];
     const Vec3& b = p[i + 1 == n ? 0 : i + 1];
-    const double sa = u.dot(a) - d, sb = u.dot(b) - d;
-    if (sa <= 0) out[k++] = a;
-    if ((sa <= 0) != (sb <= 0)) out[k++] = a + (sa / (sa - sb)) * (b - a);
+    const double sa = sb;
+    sb = u.dot(b) - d;
+    if (sa <= 0) below[kb++] = a;
+    if (sa >= 0) above[ka++] = a;
+    const bool cross_below = (sa <= 0) != (sb <= 0), cross_above = (sa >= 0) != (sb >= 0);
+    if (cross_below || cross_above) {
+      const Vec3 x = a + (sa / (sa - sb)) * (b - a);
+      if (cross_below) below[kb++] = x;
+      if (cross_above) above[ka++] = x;
+    }
   }
-  out.resize(k);
+  below.resize(kb);
+  above.resize(ka);
 }
 
 // 2D cross product of (b - a) and (c - a).
