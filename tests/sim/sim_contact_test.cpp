@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "pipeline/geometry2d.h"
+#include "sim/geometry.h"
 #include "sim/world.h"
 #include "sim_fixtures.h"
 
@@ -209,6 +210,46 @@ TEST(BroadPhase, CandidatePairsAreEveryPartPairWhoseBoxesOverlap) {
   EXPECT_GT(awake_awake, 100);
   EXPECT_GT(with_sleeper, 50);
   EXPECT_EQ(w.collision_stats().broadphase_pairs, expected);
+}
+
+// The two row halves of a crushing contact's surface (split_polygon_plane): a 2 m x 1 m rectangle, tilted out of
+// the horizontal, cut by a plane across it. The halves' areas and centroids are the closed-form rectangles', they
+// add up to the whole, and a cut through a vertex puts that vertex in both halves.
+TEST(SplitPolygonPlane, HalvesOfATiltedRectangleAreTheClosedFormRectangles) {
+  // Rectangle [0, 2] x [0, 1] in its own frame, placed by a rotation about x by 30 degrees and a shift.
+  const double c30 = std::cos(M_PI / 6), s30 = std::sin(M_PI / 6);
+  auto place = [&](double x, double y) { return Vec3(3.0 + x, -1.0 + c30 * y, 0.5 + s30 * y); };
+  const std::vector<Vec3> rect = {place(0, 0), place(2, 0), place(2, 1), place(0, 1)};
+  std::vector<Vec3> below, above;
+  // The plane x = 3.5 (0.5 m into the rectangle): halves of 0.5 and 1.5 m^2.
+  split_polygon_plane(rect.data(), 4, Vec3::UnitX(), 3.5, below, above);
+  const AreaCentroid b = polygon_area_centroid(below.data(), static_cast<int>(below.size()));
+  const AreaCentroid a = polygon_area_centroid(above.data(), static_cast<int>(above.size()));
+  EXPECT_NEAR(b.area, 0.5, 1e-12);
+  EXPECT_NEAR(a.area, 1.5, 1e-12);
+  EXPECT_NEAR((b.centroid - place(0.25, 0.5)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((a.centroid - place(1.25, 0.5)).norm(), 0.0, 1e-12);
+  // The plane through the diagonal from (0, 0) to (2, 1) (normal in the rectangle's plane): two triangles of 1 m^2
+  // with centroids at the mean of their corners; both corners on the plane are in both halves.
+  const Vec3 d = rect[2] - rect[0];
+  const Vec3 face_normal = (rect[1] - rect[0]).cross(rect[3] - rect[0]).normalized();
+  const Vec3 u = face_normal.cross(d).normalized();
+  split_polygon_plane(rect.data(), 4, u, u.dot(rect[0]), below, above);
+  const AreaCentroid tb = polygon_area_centroid(below.data(), static_cast<int>(below.size()));
+  const AreaCentroid ta = polygon_area_centroid(above.data(), static_cast<int>(above.size()));
+  EXPECT_NEAR(tb.area, 1.0, 1e-12);
+  EXPECT_NEAR(ta.area, 1.0, 1e-12);
+  const Vec3 t1 = (rect[0] + rect[1] + rect[2]) / 3.0, t2 = (rect[0] + rect[2] + rect[3]) / 3.0;
+  // Which triangle is below depends on the sign of u; each half is one of the two.
+  const double e1 = std::min((tb.centroid - t1).norm(), (tb.centroid - t2).norm());
+  const double e2 = std::min((ta.centroid - t1).norm(), (ta.centroid - t2).norm());
+  EXPECT_LT(e1, 1e-9);
+  EXPECT_LT(e2, 1e-9);
+  EXPECT_GT((tb.centroid - ta.centroid).norm(), 0.1);
+  // A plane that misses the polygon leaves it whole on one side and nothing on the other.
+  split_polygon_plane(rect.data(), 4, Vec3::UnitX(), 10.0, below, above);
+  EXPECT_EQ(below.size(), 4u);
+  EXPECT_TRUE(above.empty());
 }
 
 }  // namespace
