@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "pipeline/error.h"
+#include "pipeline/geometry2d.h"
 #include "pipeline/ice_resistance.h"
 #include "tests/error_of.h"
 
@@ -86,7 +87,7 @@ TEST(Lindqvist, BracketingOfTheEntranceTermGivesThePublishedSubmersion) {
   blunt.entrance_angle_deg = 90;
   const LindqvistResistance rb = lindqvist(blunt, example_ice(), 0.0);
   EXPECT_TRUE(std::isfinite(rb.submersion_n));
-  const double phi = 30.0 * M_PI / 180.0;
+  const double phi = 30.0 * kPi / 180.0;
   const double length = 0.7 * 100 - 7 / std::tan(phi) + 7 * std::cos(phi) * std::cos(phi) / std::sin(phi);
   const double expected = 125.0 * 9.81 * 1.0 * 20.0 * (7.0 * 27.0 / 34.0 + 0.1 * length);
   EXPECT_NEAR(rb.submersion_n, expected, 1e-9 * expected);

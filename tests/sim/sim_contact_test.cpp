@@ -217,7 +217,7 @@ TEST(BroadPhase, CandidatePairsAreEveryPartPairWhoseBoxesOverlap) {
 // add up to the whole, and a cut through a vertex puts that vertex in both halves.
 TEST(SplitPolygonPlane, HalvesOfATiltedRectangleAreTheClosedFormRectangles) {
   // Rectangle [0, 2] x [0, 1] in its own frame, placed by a rotation about x by 30 degrees and a shift.
-  const double c30 = std::cos(M_PI / 6), s30 = std::sin(M_PI / 6);
+  const double c30 = std::cos(kPi / 6), s30 = std::sin(kPi / 6);
   auto place = [&](double x, double y) { return Vec3(3.0 + x, -1.0 + c30 * y, 0.5 + s30 * y); };
   const std::vector<Vec3> rect = {place(0, 0), place(2, 0), place(2, 1), place(0, 1)};
   std::vector<Vec3> below, above;
