@@ -717,8 +717,8 @@ struct CollisionWorld::Impl {
   // one to fill the cells, and the pairs within each cell) takes that step from 4.34 to 3.9-4.05 ms. A pair sharing
   // several cells is taken in one of them, the cell holding the corner (max lo.x, max lo.y) of the two boxes'
   // overlap, which both boxes cover. The cells' pairs are found on the pool's threads, rows of cells shared out in
-  // chunks, each thread's pairs into its own list: the lists together hold each pair once, and find_contacts sorts
-  // them, so neither the thread count nor the schedule shows in the result.
+  // chunks, each thread's pairs into its own list, the lists then appended to `pairs`: they hold each pair once,
+  // and find_contacts sorts them, so neither the thread count nor the schedule shows in the result.
   struct GridItem {
     int part, body, i0, j0;  // the part, its body, and the cell of its box's low corner
     Vec3 lo, hi;             // the part's exact box (a copy: the pairs loop reads nothing else)
@@ -767,6 +767,7 @@ struct CollisionWorld::Impl {
     }
     // The cell of the overlap's corner is (max of the two i0, max of the two j0): ix and iy never decrease.
     constexpr int kRowsPerChunk = 4;
+    for (auto& sc : scratch) sc.candidates.clear();
     pool.parallel_chunks(ny, kRowsPerChunk, [&](int row_begin, int row_end, int w, int) {
       std::vector<PairCandidate>& found = scratch[w].candidates;
       for (int j = row_begin; j < row_end; ++j)
@@ -777,33 +778,30 @@ struct CollisionWorld::Impl {
               const GridItem& g1 = grid_items[a];
               const GridItem& g2 = grid_items[b];
               if (std::max(g1.i0, g2.i0) != i || std::max(g1.j0, g2.j0) != j) continue;
-              if (g1.body == g2.body || (!state->awake[g1.body] && !state->awake[g2.body]) ||
-                  !boxes_overlap(g1.lo, g1.hi, g2.lo, g2.hi))
-                continue;
-              found.push_back(candidate(g1.part, g2.part));
+              if (keeps(g1.body, g1.lo, g1.hi, g2.body, g2.lo, g2.hi))
+                found.push_back(ordered(g1.body, g1.part, g2.body, g2.part));
             }
         }
     });
+    for (const auto& sc : scratch) pairs.insert(pairs.end(), sc.candidates.begin(), sc.candidates.end());
   }
 
-  static bool boxes_overlap(const Vec3& lo1, const Vec3& hi1, const Vec3& lo2, const Vec3& hi2) {
+  // A part pair of the broad phase is kept if the parts are of two bodies, one of them awake, with overlapping exact
+  // boxes (the tree's boxes are enlarged and depend on the history of the leaf; the exact boxes make the candidate
+  // set a function of the current poses only).
+  bool keeps(int b1, const Vec3& lo1, const Vec3& hi1, int b2, const Vec3& lo2, const Vec3& hi2) const {
+    if (b1 == b2 || (!state->awake[b1] && !state->awake[b2])) return false;
     return !((lo1.array() > hi2.array()).any() || (lo2.array() > hi1.array()).any());
   }
-  // Parts p1 and p2 of two bodies as a candidate, the lower body first.
-  PairCandidate candidate(int p1, int p2) const {
-    const int b1 = model.parts[p1].body, b2 = model.parts[p2].body;
+  // Part p1 of body b1 and part p2 of body b2 as a candidate, the lower body first.
+  static PairCandidate ordered(int b1, int p1, int b2, int p2) {
     return b1 < b2 ? PairCandidate{b1, p1, b2, p2} : PairCandidate{b2, p2, b1, p1};
   }
 
-  // A part pair of the tree of awake parts against the tree of sleeping ones: kept if the parts are of two bodies,
-  // one of them awake, with overlapping exact boxes (the tree's boxes are enlarged and depend on the history of the
-  // leaf; the exact boxes make the candidate set a function of the current poses only).
+  // A pair of the tree of awake parts against the tree of sleeping ones.
   void add_candidate(int p1, int p2) {
     const int b1 = model.parts[p1].body, b2 = model.parts[p2].body;
-    if (b1 == b2) return;
-    if (!state->awake[b1] && !state->awake[b2]) return;
-    if (!boxes_overlap(world[p1].lo, world[p1].hi, world[p2].lo, world[p2].hi)) return;
-    pairs.push_back(candidate(p1, p2));
+    if (keeps(b1, world[p1].lo, world[p1].hi, b2, world[p2].lo, world[p2].hi)) pairs.push_back(ordered(b1, p1, b2, p2));
   }
 
   static bool broadphase_callback(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) {
@@ -1093,9 +1091,7 @@ void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out
   // Broad phase: candidate part pairs, then a fixed order so that runs are deterministic.
   m.pairs.clear();
   m.state = &state;
-  for (auto& sc : m.scratch) sc.candidates.clear();
   m.awake_pairs_in_grid();
-  for (const auto& sc : m.scratch) m.pairs.insert(m.pairs.end(), sc.candidates.begin(), sc.candidates.end());
   m.awake_tree.collide(&m.sleeping_tree, &m, &Impl::broadphase_callback);
   std::sort(m.pairs.begin(), m.pairs.end());
   stats_ = CollisionStats{};
