@@ -53,7 +53,7 @@ TEST(FloesIo, ClockwiseRingsAreStoredCounterClockwise) {
 TEST(FloesIo, RejectsSelfIntersectionNamingTheFloe) {
   Json bow = square_feature(7, 0);
   // Json::array around the ring: a one-element brace list `{ring}` is the ring itself under clang, a list of it
-  // under gcc (nlohmann's initializer-list rule; the clang build of bench/sanitize found it).
+  // under gcc (nlohmann's initializer-list rule; the clang build of tests/sanitize/sanitize found it).
   bow["geometry"]["coordinates"] = Json::array({Json::array({{0, 0}, {10, 10}, {10, 0}, {0, 10}, {0, 0}})});
   const std::string e = error_of(collection({bow}));
   EXPECT_NE(e.find("floe id 7"), std::string::npos) << e;

@@ -9,7 +9,7 @@
 //   kill_test [--kills N] [--seed S] [--case DIR] [--work DIR] [--bin DIR]
 //
 // N kills (default 50) round-robin over the stages and the three ways to kill; prints the figures; exit status 0
-// only if nothing was found half-written, every recovery finished and matched. bench/kill-test runs it with 50
+// only if nothing was found half-written, every recovery finished and matched. tests/e2e/kill-test runs it with 50
 // kills, ctest (kill_test_short) with 6.
 #include <fcntl.h>
 #include <signal.h>

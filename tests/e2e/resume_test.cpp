@@ -122,7 +122,7 @@ class Resume : public ::testing::Test {
     const fs::path log = out.string() + ".log";
     const pid_t pid = start(simulate_args(config, out, resume), log);
     const fs::path info = out / "checkpoint" / "checkpoint.json";
-    // At most ten minutes: an instrumented build (bench/sanitize) on a loaded machine takes several to reach a
+    // At most ten minutes: an instrumented build (tests/sanitize/sanitize) on a loaded machine takes several to reach a
     // late checkpoint, and signalling before it would stop the run too early for the test's assertions.
     for (int i = 0; i < 60000; ++i) {
       if (fs::exists(info)) {
@@ -192,7 +192,7 @@ TEST_F(Resume, TheCaseBreaksFloes) {
   // At least one before the second SIGINT stop below (step 3400): the world restored there carries pieces. Which
   // floes break when depends on the compiler: fracture is a threshold on chaotic contact loads, and round-off
   // differs between builds (gcc, Release: 9.45, 17.69, 39.09 and 39.95 s; clang with the sanitizers,
-  // bench/sanitize: 26.92 and 38.70 s). Each build is compared with its own uninterrupted run.
+  // tests/sanitize/sanitize: 26.92 and 38.70 s). Each build is compared with its own uninterrupted run.
   ASSERT_GE(r.fracture_time_s.size(), 1u);
   EXPECT_LT(r.fracture_time_s[0], 34.0);
 }

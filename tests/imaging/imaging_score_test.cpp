@@ -224,7 +224,7 @@ TEST(Score, DigitiseWritesScoreAgainstAMask) {
 
 TEST(Score, CloseRangeSettingsOnOneLabelledImage) {
   // The settings file of the benchmark on the quickest labelled image (sparse floes, 0.05 m/px). The benchmark
-  // (bench/digitise_bench) runs all 12; this guards the file and the method against regressions:
+  // (imaging/bench/digitise_bench) runs all 12; this guards the file and the method against regressions:
   // measured F1 0.96, |concentration error| 0.05, KS 0.13.
   const auto image = test::shared_data("passerotti/images/2022-07-24_111713_ortho.png");
   const auto mask = test::shared_data("passerotti/masks/2022-07-24_111713_mask.png");

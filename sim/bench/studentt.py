@@ -1,6 +1,6 @@
 """Student t quantiles for the bench scripts, standard library only (no scipy): the t distribution's CDF from the
 regularised incomplete beta function (Numerical Recipes' continued fraction, Lentz's method), inverted by bisection.
-bench/ensemble-difference --self-test checks them against the table."""
+sim/bench/ensemble-difference --self-test checks them against the table."""
 import math
 
 
