@@ -69,7 +69,7 @@ Polygon circular_sector(const Vec2& apex, const Vec2& axis, double half_angle_ra
 // lies on the axis at `radius_m` and whose two sides of half-angle `half_angle_rad` (0, pi/2] are long enough,
 // r' = r half / sin(half), that its area is the sector's, r^2 half. A fracture's wedge cut as this kite reaches
 // as far and weighs as much as the sector; the floe it leaves has a notch of 3 reflex corners instead of an arc's
-// many, hence few convex parts (sim/fracture.cpp).
+// many, hence few convex parts (sim/engine/fracture.cpp).
 Polygon equal_area_wedge(const Vec2& apex, const Vec2& axis, double half_angle_rad, double radius_m);
 
 }  // namespace floesim

@@ -49,14 +49,14 @@ std::vector<std::string> lindqvist_problems(const IceHull& hull, const LevelIce&
   need(p, hull.entrance_angle_deg > 0 && hull.entrance_angle_deg <= 90, hull.entrance_angle_deg,
        "hull.entrance_angle_deg", "in (0, 90] deg");
   need(p, ice.thickness_m > 0, ice.thickness_m, "ice.thickness_m", "> 0");
-  need(p, ice.flexural_strength_pa > 0, ice.flexural_strength_pa, "ice.flexural_strength_pa", "> 0");
-  need(p, ice.youngs_modulus_pa > 0, ice.youngs_modulus_pa, "ice.youngs_modulus_pa", "> 0");
-  need(p, ice.poisson_ratio >= 0 && ice.poisson_ratio < 0.5, ice.poisson_ratio, "ice.poisson_ratio", "in [0, 0.5)");
+  need(p, ice.flexural_strength_pa > 0, ice.flexural_strength_pa, "fracture.flexural_strength_pa", "> 0");
+  need(p, ice.youngs_modulus_pa > 0, ice.youngs_modulus_pa, "fracture.youngs_modulus_pa", "> 0");
+  need(p, ice.poisson_ratio >= 0 && ice.poisson_ratio < 0.5, ice.poisson_ratio, "fracture.poisson_ratio", "in [0, 0.5)");
   need(p, ice.ice_density_kg_m3 > 0, ice.ice_density_kg_m3, "ice.density_kg_m3", "> 0");
   need(p, ice.water_density_kg_m3 > ice.ice_density_kg_m3, ice.water_density_kg_m3, "water.density_kg_m3",
        ("> the ice density " + num(ice.ice_density_kg_m3) + " kg/m^3 (ice floats)").c_str());
   need(p, ice.gravity_mps2 > 0, ice.gravity_mps2, "water.gravity_mps2", "> 0");
-  need(p, ice.friction >= 0, ice.friction, "ice.mu_ice_hull", ">= 0");
+  need(p, ice.friction >= 0, ice.friction, "ice.mu_ice_structure", ">= 0");
   need(p, v >= 0, v, "speed_mps", ">= 0");
   if (p.empty()) {
     // The crushing term divides by 1 - mu sin(phi)/cos(psi): friction that large makes the wedge self-locking and
@@ -65,7 +65,7 @@ std::vector<std::string> lindqvist_problems(const IceHull& hull, const LevelIce&
     const double psi = std::atan2(std::tan(phi), std::sin(alpha));
     const double d = 1.0 - ice.friction * std::sin(phi) / std::cos(psi);
     if (!(d > 0))
-      p.push_back("ice.mu_ice_hull = " + num(ice.friction) + " with hull.stem_angle_deg = " +
+      p.push_back("ice.mu_ice_structure = " + num(ice.friction) + " with hull.stem_angle_deg = " +
                   num(hull.stem_angle_deg) + " makes 1 - mu sin(phi)/cos(psi) = " + num(d) +
                   " <= 0 (Lindqvist's crushing term is undefined): lower the friction");
   }

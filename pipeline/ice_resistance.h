@@ -14,7 +14,7 @@
 namespace floesim {
 
 // The hull particulars both formulas take. floesim-hull measures them from the mesh and writes them to hull.json
-// ("particulars"; definitions in sim/hull_particulars.h and the README); read_ice_hull() reads them back.
+// ("particulars"; definitions in sim/vessel/particulars.h and the README); read_ice_hull() reads them back.
 struct IceHull {
   double length_m = 0;            // L: waterline length
   double beam_m = 0;              // B: waterline beam (over the reamers, if any)

@@ -165,7 +165,7 @@ class FrameReplay {
 };
 
 // The per-step series of a run, one at a time. A long simulation keeps only the rows since its last checkpoint in
-// Results::series and leaves the earlier ones on disk in the checkpoint's chunks (sim/checkpoint.h): all the series
+// Results::series and leaves the earlier ones on disk in the checkpoint's chunks (sim/simulate/checkpoint.h): all the series
 // together are 72 values, 0.58 kB, per step (207 MB per simulated hour at 0.01 s), one of them at most 6 values.
 // The results writer and the summary read them through this, one series at a time, so that a run's memory does not
 // hold them all.

@@ -34,9 +34,9 @@
 #include "pipeline/floes_io.h"
 #include "pipeline/results_io.h"
 #include "pipeline/stage_main.h"
-#include "sim/hull.h"
-#include "sim/simulate.h"
-#include "sim/world.h"
+#include "sim/vessel/hull.h"
+#include "sim/simulate/simulate.h"
+#include "sim/engine/world.h"
 #include "pipeline/geometry2d.h"
 
 using namespace floesim;
@@ -277,7 +277,7 @@ double run_field(int scale, const BenchOptions& bo, const HullModel& hull, bool 
     write_floes(fs::path(bo.keep_dir) / ("floes_" + std::to_string(scale) + "x.geojson"), field);
   }
   RunStats st;
-  Results r = simulate(model, st);
+  Results r = simulate(o, model, st);
   const double record_s = st.stage_s[kStageCount];
   const fs::path dir = bo.keep_dir.empty() ? fs::temp_directory_path() / "floesim_bench" : fs::path(bo.keep_dir);
   ensure_directory(dir);

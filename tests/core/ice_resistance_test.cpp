@@ -135,10 +135,10 @@ TEST(IceResistance, BadInputIsRefusedNamingTheField) {
       {[](IceHull& h, LevelIce&, double&) { h.entrance_angle_deg = 0; }, "hull.entrance_angle_deg"},
       {[](IceHull& h, LevelIce&, double&) { h.beam_m = 0; }, "hull.beam_m"},
       {[](IceHull&, LevelIce& i, double&) { i.ice_density_kg_m3 = 1100; }, "water.density_kg_m3"},
-      {[](IceHull&, LevelIce& i, double&) { i.poisson_ratio = 0.5; }, "ice.poisson_ratio"},
-      {[](IceHull&, LevelIce& i, double&) { i.youngs_modulus_pa = nan; }, "ice.youngs_modulus_pa"},
+      {[](IceHull&, LevelIce& i, double&) { i.poisson_ratio = 0.5; }, "fracture.poisson_ratio"},
+      {[](IceHull&, LevelIce& i, double&) { i.youngs_modulus_pa = nan; }, "fracture.youngs_modulus_pa"},
       {[](IceHull&, LevelIce&, double& v) { v = -1; }, "speed_mps"},
-      {[](IceHull&, LevelIce& i, double&) { i.friction = 3; }, "ice.mu_ice_hull"},
+      {[](IceHull&, LevelIce& i, double&) { i.friction = 3; }, "ice.mu_ice_structure"},
   };
   for (const Case& c : cases) {
     IceHull h = example_hull();

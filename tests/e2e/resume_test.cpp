@@ -238,7 +238,7 @@ TEST_F(Resume, SigkillThenResumeFromTheLastRegularCheckpoint) {
 }
 
 // Writing checkpoints does not touch the physics: the datasets equal those of a run without checkpoints. With
-// checkpoints the series before the last one are read back from its chunks (sim/checkpoint.h CheckpointSeries),
+// checkpoints the series before the last one are read back from its chunks (sim/simulate/checkpoint.h CheckpointSeries),
 // without them they are all in memory: the results and the summary are the same either way.
 TEST_F(Resume, CheckpointsDoNotChangeTheResults) {
   Json c = base_config();

@@ -1,4 +1,4 @@
-// The simulate stage's checkpoint reader (sim/checkpoint.h Checkpointer::resume, and World::restore behind it):
+// The simulate stage's checkpoint reader (sim/simulate/checkpoint.h Checkpointer::resume, and World::restore behind it):
 // checkpoint.bin and its records-NNNNNN.bin chunks, each file a magic line, a payload and the payload's SHA-256.
 //
 // A mutated file almost never matches its SHA-256, so feeding raw bytes only fuzzes the hash check. The input is
@@ -29,10 +29,10 @@
 #include "fuzz_util.h"
 #include "pipeline/provenance.h"
 #include "pipeline/results_io.h"
-#include "sim/checkpoint.h"
-#include "sim/hull.h"
-#include "sim/model.h"
-#include "sim/simulate.h"
+#include "sim/simulate/checkpoint.h"
+#include "sim/vessel/hull.h"
+#include "sim/engine/model.h"
+#include "sim/simulate/simulate.h"
 #include "tests/sim/small_breaking_run.h"
 
 namespace fs = std::filesystem;

@@ -1,10 +1,10 @@
 // The CSV readers, one harness per reader (FUZZ_CSV_READER selects it at compile time): the thrust series
-// (sim/model.h read_thrust_series), the measured ship data (sim/identify.h read_measured_csv) and the generic
+// (sim/engine/model.h read_thrust_series), the measured ship data (sim/analysis/identify.h read_measured_csv) and the generic
 // numeric CSV (pipeline/csv.h read_numeric_csv).
 #include "fuzz_util.h"
 #include "pipeline/csv.h"
-#include "sim/identify.h"
-#include "sim/model.h"
+#include "sim/analysis/identify.h"
+#include "sim/engine/model.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const auto file = floesim::fuzz::temp_file(".csv");

@@ -1,9 +1,9 @@
-// Hull meshes through the loader (sim/hull.h load_hull: assimp, welding, orientation, convexity, slicing) and the
-// measurement of their particulars for the ice-resistance formulas (sim/hull_particulars.h). The
+// Hull meshes through the loader (sim/vessel/hull.h load_hull: assimp, welding, orientation, convexity, slicing) and the
+// measurement of their particulars for the ice-resistance formulas (sim/vessel/particulars.h). The
 // input is written to a file with the extension FUZZ_HULL_EXT (".obj", ".stl", ".ply"), as a user's mesh would be.
 #include "fuzz_util.h"
-#include "sim/hull.h"
-#include "sim/hull_particulars.h"
+#include "sim/vessel/hull.h"
+#include "sim/vessel/particulars.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const auto file = floesim::fuzz::temp_file(FUZZ_HULL_EXT);

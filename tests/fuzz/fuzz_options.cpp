@@ -10,11 +10,11 @@
 #include "render/plot.h"
 #include "render/render_options.h"
 #include "render/report.h"
-#include "sim/hull.h"
-#include "sim/identify.h"
-#include "sim/resistance.h"
-#include "sim/shipdata.h"
-#include "sim/simulate_options.h"
+#include "sim/vessel/hull.h"
+#include "sim/analysis/identify.h"
+#include "sim/analysis/resistance.h"
+#include "sim/analysis/shipdata.h"
+#include "sim/simulate/options.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// Hull angles and lengths for the ice-resistance formulas (issue #10 item 2; sim/hull_particulars.h), measured from
+// Hull angles and lengths for the ice-resistance formulas (issue #10 item 2; sim/vessel/particulars.h), measured from
 // meshes whose answers are known independently of the measuring code: a box barge; the parametric icebreaker, whose
 // stem angle is an option and whose entrance angle is 90 deg (its spoon bow is square across at B/4) or, with the
 // wedge bow, the option entrance_angle_deg; and the two real hulls of ../shared/data/hulls against their published
@@ -14,8 +14,8 @@
 
 #include "pipeline/error.h"
 #include "pipeline/geometry2d.h"
-#include "sim/hull.h"
-#include "sim/hull_particulars.h"
+#include "sim/vessel/hull.h"
+#include "sim/vessel/particulars.h"
 #include "tests/sim/obj_faces.h"
 #include "tests/sim/sim_fixtures.h"
 

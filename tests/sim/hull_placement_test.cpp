@@ -15,7 +15,7 @@
 
 #include "pipeline/error.h"
 #include "pipeline/options.h"
-#include "sim/hull.h"
+#include "sim/vessel/hull.h"
 #include "tests/sim/obj_faces.h"
 #include "tests/sim/sim_fixtures.h"
 

@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pipeline/error.h"
-#include "sim/hull.h"
+#include "sim/vessel/hull.h"
 #include "tests/sim/obj_faces.h"
 #include "tests/sim/sim_fixtures.h"
 

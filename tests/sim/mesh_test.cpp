@@ -8,7 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "pipeline/error.h"
-#include "sim/mesh.h"
+#include "sim/geometry/mesh.h"
 #include "pipeline/geometry2d.h"
 
 namespace floesim::sim {

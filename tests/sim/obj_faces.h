@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "sim/mesh.h"
+#include "sim/geometry/mesh.h"
 
 namespace floesim::sim::testing {
 

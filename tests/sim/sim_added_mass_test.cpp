@@ -6,9 +6,9 @@
 #include <cmath>
 
 #include "pipeline/error.h"
-#include "sim/forces.h"
-#include "sim/mesh.h"
-#include "sim/world.h"
+#include "sim/engine/forces.h"
+#include "sim/geometry/mesh.h"
+#include "sim/engine/world.h"
 #include "sim_fixtures.h"
 #include "pipeline/geometry2d.h"
 

@@ -15,9 +15,9 @@
 #include <vector>
 
 #include "pipeline/floes_io.h"
-#include "sim/hull.h"
-#include "sim/simulate.h"
-#include "sim/world.h"
+#include "sim/vessel/hull.h"
+#include "sim/simulate/simulate.h"
+#include "sim/engine/world.h"
 
 namespace floesim::sim {
 namespace {
@@ -173,7 +173,7 @@ TEST(SimCases, SingleFloeStruckOffCentreSplitsGloballyThenBendsLocally) {
   const HullModel hull = hull_model_from_parts(generate_hull(HullGeneratorOptions{}));
   const Model m = build_model(field, &hull, o);
   ASSERT_EQ(m.floe_count(), 1);  // not removed: the vessel starts clear of it
-  ASSERT_TRUE(m.options.fracture.enabled);
+  ASSERT_TRUE(m.settings.fracture.enabled);
   World w(m);
   for (long i = 0; i < o.steps(); ++i) w.step();
 

@@ -1,4 +1,4 @@
-// The checkpoint reader (sim/checkpoint.h) against files whose SHA-256 is right but whose content is not what a run
+// The checkpoint reader (sim/simulate/checkpoint.h) against files whose SHA-256 is right but whose content is not what a run
 // writes (what fuzz_checkpoint feeds it, re-sealed): refused with a message naming the file, never accepted into a
 // world and results that disagree. The run: tests/sim/small_breaking_run.h (checkpoints at steps 10, 20 and 30).
 #include <gtest/gtest.h>
@@ -10,8 +10,8 @@
 #include <sstream>
 
 #include "pipeline/provenance.h"
-#include "sim/checkpoint.h"
-#include "sim/simulate.h"
+#include "sim/simulate/checkpoint.h"
+#include "sim/simulate/simulate.h"
 #include "tests/sim/sim_fixtures.h"
 #include "tests/sim/small_breaking_run.h"
 
@@ -71,7 +71,7 @@ class Checkpoint : public ::testing::Test {
                              ::testing::UnitTest::GetInstance()->current_test_info()->name()) / "checkpoint";
     CheckpointPlan plan{dir_, provenance_, false};
     RunStats stats;
-    full_ = simulate(model_, stats, nullptr, &plan);
+    full_ = simulate(options_, model_, stats, nullptr, &plan);
     ASSERT_EQ(stats.checkpoints, 3);  // at 0.1, 0.2 and 0.3 s; none after the last step
     ASSERT_GT(full_.fracture_time_s.size(), 0u) << "the run must break ice before its last checkpoint";
   }
@@ -79,13 +79,14 @@ class Checkpoint : public ::testing::Test {
   std::unique_ptr<World> resume(Results& r) {
     Checkpointer cp(dir_, provenance_);
     RecorderSums sums;
-    return cp.resume(model_, r, sums, nullptr);
+    return cp.resume(options_, model_, r, sums, nullptr);
   }
   void expect_refused(std::initializer_list<const char*> pieces) {
     Results r = fresh_results();
     testing::expect_error([&] { resume(r); }, pieces);
   }
 
+  const SimulateOptions options_ = testing::small_breaking_run_options();
   const Model model_ = small_breaking_run();
   const nlohmann::json provenance_ = {{"program", "sim_checkpoint_test"}};
   fs::path dir_;
@@ -231,7 +232,7 @@ TEST_F(Checkpoint, SpilledSeriesReadBackEqualTheSeriesHeldInMemory) {
   const fs::path dir = dir_.parent_path() / "spilled";
   CheckpointPlan plan{dir, provenance_, false, true};
   RunStats stats;
-  const Results tail = simulate(model_, stats, nullptr, &plan);
+  const Results tail = simulate(options_, model_, stats, nullptr, &plan);
   EXPECT_EQ(tail.series_first_step, 30u);  // the last checkpoint
   EXPECT_EQ(tail.steps(), 10u);            // steps 31 to 40
   EXPECT_LE(tail.series.at("ice_load").capacity(), 10u * 6) << "reserved for the whole run, not one interval";
@@ -242,12 +243,12 @@ TEST_F(Checkpoint, SpilledSeriesReadBackEqualTheSeriesHeldInMemory) {
     ASSERT_EQ(a.size(), b.size()) << f.name;
     EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(double)), 0) << f.name;
   }
-  EXPECT_EQ(summarize(model_, tail, series).dump(), summarize(model_, full_).dump());
+  EXPECT_EQ(summarize(options_, model_, tail, series).dump(), summarize(options_, model_, full_).dump());
   write_results(dir_.parent_path() / "spilled.h5", tail, series);
   write_results(dir_.parent_path() / "held.h5", full_);
   EXPECT_TRUE(read_text(dir_.parent_path() / "spilled.h5") == read_text(dir_.parent_path() / "held.h5"));
   // Without the rows on disk, the results cannot stand for the run: the functions that take them whole refuse.
-  testing::expect_error([&] { summarize(model_, tail); }, {"internal: these results hold the series from step 30"});
+  testing::expect_error([&] { summarize(options_, model_, tail); }, {"internal: these results hold the series from step 30"});
   testing::expect_error([&] { CheckpointSeries(dir, provenance_, 20, tail); },
                         {"internal: the series in memory start at step 30"});
   testing::expect_error([&] { CheckpointSeries(dir, {{"program", "another"}}, 30, tail); },
@@ -260,7 +261,7 @@ TEST_F(Checkpoint, ResumedWithSpilledSeriesItReadsOnlyTheFrames) {
   Results r = fresh_results();
   Checkpointer cp(dir_, provenance_, true);
   RecorderSums sums;
-  const auto w = cp.resume(model_, r, sums, nullptr);
+  const auto w = cp.resume(options_, model_, r, sums, nullptr);
   ASSERT_TRUE(w);
   EXPECT_EQ(cp.series_steps_on_disk(), 30);
   EXPECT_TRUE(r.series.at("time_s").empty());

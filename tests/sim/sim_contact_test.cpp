@@ -6,8 +6,8 @@
 #include <cmath>
 
 #include "pipeline/geometry2d.h"
-#include "sim/geometry.h"
-#include "sim/world.h"
+#include "sim/geometry/polygon3d.h"
+#include "sim/engine/world.h"
 #include "sim_fixtures.h"
 
 namespace floesim::sim {

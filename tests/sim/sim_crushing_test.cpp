@@ -9,10 +9,10 @@
 #include <map>
 #include <random>
 
-#include "sim/collision.h"
-#include "sim/geometry.h"
-#include "sim/simulate.h"
-#include "sim/world.h"
+#include "sim/engine/collision.h"
+#include "sim/geometry/polygon3d.h"
+#include "sim/simulate/simulate.h"
+#include "sim/engine/world.h"
 #include "sim_fixtures.h"
 #include "pipeline/geometry2d.h"
 
@@ -339,7 +339,7 @@ TEST(SimCrushing, WedgeCornerForceGrowsWithPenetration) {
     const double c_n = 2 * zeta * std::sqrt(rig.model.bodies[1].mass_kg * 2 * 2e6 * h * std::tan(phi));
     World w(rig.model);
     // Move the wall (vessel at x = 50 m: its face is at 52 m) to 3 mm behind the apex.
-    const double sigma = rig.model.options.ice.crushing_strength_pa;
+    const double sigma = rig.model.settings.ice.crushing_strength_pa;
     const double apex0 = w.state().position[1].x() - 2 * L / 3;
     w.mutable_state().position[0].x() = apex0 - 2.0 - 0.003;
     w.sync();
@@ -393,7 +393,7 @@ TEST(SimCrushing, FlatEdgeCrushesAtSigmaTimesArea) {
     Floe f = testing::rect_floe(1, 52.002, -width / 2, 5.0, width, h);
     WallRig rig = wall_rig(f, 1e7, v, ex);
     World w(rig.model);
-    const double sigma = rig.model.options.ice.crushing_strength_pa;
+    const double sigma = rig.model.settings.ice.crushing_strength_pa;
     const double theory = sigma * std::pow(h * width, 1 + ex);
     int steps = 0;
     const double worst = worst_surge_force_error(w, theory, steps);
@@ -419,8 +419,8 @@ TEST(SimCrushing, FloeStoppedByCrushingKeepsItsOverlap) {
   WallRig rig = wall_rig(wedge_floe(1, 52.001, 0.0, phi, L, h), 900, 0.0);
   World w(rig.model);
   w.mutable_state().velocity[1] = Vec3(-v0, 0, 0);
-  const double m = rig.model.bodies[1].mass_kg, dt = rig.model.options.time_step_s;
-  const double sigma = rig.model.options.ice.crushing_strength_pa;
+  const double m = rig.model.bodies[1].mass_kg, dt = rig.model.settings.time_step_s;
+  const double sigma = rig.model.settings.ice.crushing_strength_pa;
   const double kt = 2 * sigma * h * std::tan(phi);
   const double theory = v0 * std::sqrt(m / kt);
   const double omega_dt = std::sqrt(kt / m) * dt;
@@ -460,7 +460,7 @@ TEST(SimCrushing, ReloadingStartsAtTheCrushedDepth) {
   const double phi = 45 * kPi / 180, L = 10, h = 1.0, v = 0.1;
   WallRig rig = wall_rig(wedge_floe(1, 2.0 + 0.003 + 50.0, 0.0, phi, L, h), 1e9, v);
   World w(rig.model);
-  const double sigma = rig.model.options.ice.crushing_strength_pa, kt = 2 * sigma * h * std::tan(phi);
+  const double sigma = rig.model.settings.ice.crushing_strength_pa, kt = 2 * sigma * h * std::tan(phi);
   auto penetration = [&] { return w.state().position[0].x() + 2.0 - (w.state().position[1].x() - 2 * L / 3); };
   double delta_max = 0, work = 0, worst = 0, max_step = 0, max_unloaded = 0;
   int crushing_steps = 0, gap_steps = 0;
@@ -516,7 +516,7 @@ TEST(SimCrushing, FaceTurningIntoTheWallIsResistedByAMoment) {
   const Floe f = testing::rect_floe(1, 52.001, -width / 2, length, width, h);
   WallRig rig = wall_rig(f, 1e10, 0.1);
   World w(rig.model);
-  const double sigma = rig.model.options.ice.crushing_strength_pa, dt = rig.model.options.time_step_s;
+  const double sigma = rig.model.settings.ice.crushing_strength_pa, dt = rig.model.settings.time_step_s;
   for (int i = 0; i < 21; ++i) w.step();
   w.mutable_state().velocity[0].setZero();
   const double face_x = w.state().position[0].x() + 2.0;
@@ -560,7 +560,7 @@ TEST(SimCrushing, PressureAreaLawActsOnTheWholeContactOfABodyPair) {
   const double theory = 2e6 * std::pow(h * width, 1 + ex);
   for (int parts = 1; parts <= 2; ++parts) {
     WallRig rig = parts == 1 ? wall_rig(f, 1e7, v, ex) : wall_rig(f, 1e7, v, ex, 0.0, &cut);
-    ASSERT_EQ(rig.model.options.ice.crushing_strength_pa, 2e6);
+    ASSERT_EQ(rig.model.settings.ice.crushing_strength_pa, 2e6);
     World w(rig.model);
     int steps = 0;
     const double worst = worst_surge_force_error(w, theory, steps);
@@ -634,7 +634,7 @@ TEST(SimCrushing, APieceInANotchGetsOneContactPerFlank) {
   // The floe's apex 2 mm in front of the notch's (the wall's origin, the notch's apex, is at x = 50 m).
   WallRig rig = wall_rig(wedge_floe(1, 50.002, 0.0, phi, L, h), 1e9, v, 0.0, 0.0, &notch);
   World w(rig.model);
-  const double sigma = rig.model.options.ice.crushing_strength_pa, mu = rig.model.options.ice.mu_ice_structure;
+  const double sigma = rig.model.settings.ice.crushing_strength_pa, mu = rig.model.settings.ice.mu_ice_structure;
   const double wall0 = w.state().position[0].x(), floe0 = w.state().position[1].x();
   int steps = 0;
   double worst_normal = 0, worst_force = 0;
@@ -679,7 +679,7 @@ TEST(SimCrushing, CrushingWorkIsStrengthTimesCrushedVolume) {
   f.thickness_m = h;
   WallRig rig = wall_rig(f, 1e11, v);  // ~3e12 kg: turns by ~1e-6 rad under the off-centre load
   World w(rig.model);
-  const double sigma = rig.model.options.ice.crushing_strength_pa;
+  const double sigma = rig.model.settings.ice.crushing_strength_pa;
   const Vec3 x0 = w.state().position[1];
   double work = 0, max_step = 0;
   double prev_face = w.state().position[0].x() + 2.0, prev_floe = w.state().position[1].x();
@@ -788,8 +788,8 @@ double mean_surge_ice_load(double dt) {
   o.output_interval_s = 1.0;
   const Model m = build_model(floe_grid(6, 6, 10, 0.8, 56, 1.0), &hull, o);
   RunStats stats;
-  const Results r = simulate(m, stats);
-  return summarize(m, r)["mean_surge_ice_load_N"].get<double>();
+  const Results r = simulate(o, m, stats);
+  return summarize(o, m, r)["mean_surge_ice_load_N"].get<double>();
 }
 
 // Halving the time step changes the mean surge ice load of a short transit by less than 2 % (PHYSICS.md §1.8(g)

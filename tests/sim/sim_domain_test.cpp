@@ -7,8 +7,8 @@
 #include <cmath>
 
 #include "pipeline/error.h"
-#include "sim/simulate.h"
-#include "sim/world.h"
+#include "sim/simulate/simulate.h"
+#include "sim/engine/world.h"
 #include "sim_fixtures.h"
 #include "tests/error_of.h"
 
@@ -98,7 +98,7 @@ TEST(SimDomain, FloesPackIntoTheDownstreamCornerAndWallsAreNotInTheResults) {
   const Model m = build_model(field, &hull, o);
   ASSERT_EQ(m.floe_count(), 9);
   RunStats stats;
-  const Results r = simulate(m, stats);
+  const Results r = simulate(o, m, stats);
   // Last frame: every floe is inside the domain corner region, stopped; the spread of the field shrank.
   FrameReplay replay(r, "results");
   replay.seek(r.frames() - 1);

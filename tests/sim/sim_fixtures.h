@@ -10,10 +10,10 @@
 
 #include "pipeline/error.h"
 #include "pipeline/floes_io.h"
-#include "sim/hull.h"
-#include "sim/model.h"
-#include "sim/simulate_options.h"
-#include "sim/world.h"
+#include "sim/vessel/hull.h"
+#include "sim/engine/model.h"
+#include "sim/simulate/options.h"
+#include "sim/engine/world.h"
 
 namespace floesim::sim::testing {
 
@@ -150,7 +150,7 @@ inline std::filesystem::path temp_dir(const std::string& name) {
 // Net contact force on body b this step (impulse / dt), world frame.
 inline Vec3 contact_force_on(const World& w, int b) {
   Vec3 f = Vec3::Zero();
-  const double dt = w.model().options.time_step_s;
+  const double dt = w.model().settings.time_step_s;
   for (const Contact& c : w.contacts()) {
     const Vec3 p = c.pn * c.normal + c.pt1 * c.t1 + c.pt2 * c.t2;
     if (c.body_b == b) f += p / dt;

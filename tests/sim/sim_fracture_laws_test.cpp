@@ -8,7 +8,7 @@
 #include <limits>
 
 #include "pipeline/error.h"
-#include "sim/fracture_laws.h"
+#include "sim/engine/fracture_laws.h"
 #include "pipeline/geometry2d.h"
 
 namespace floesim::sim {

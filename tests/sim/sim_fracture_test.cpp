@@ -11,8 +11,8 @@
 #include "pipeline/error.h"
 #include "pipeline/options.h"
 #include "pipeline/results_io.h"
-#include "sim/fracture.h"
-#include "sim/simulate.h"
+#include "sim/engine/fracture.h"
+#include "sim/simulate/simulate.h"
 #include "sim_fixtures.h"
 #include "tests/sim/small_breaking_run.h"
 #include "pipeline/geometry2d.h"
@@ -70,7 +70,7 @@ TEST(Fracture, WedgeBreaksAtTheTableLoadAndExtendsRbIntoTheIce) {
   const double h = 1.0, lc = lc_by_hand(h), w = 0.2 * lc, theta = kPi / 3;
   Rig rig({rect_floe(1, 0, -100, 200, 200, h)});
   World world(rig.model);
-  const double dt = rig.model.options.time_step_s;
+  const double dt = rig.model.settings.time_step_s;
   const double alpha = w / (theta * lc);
   // Table numbers: P_r = 0.226 sigma_f h^2 at w/l_c = 0.2 (printed), P_f by linear interpolation in alpha.
   const double pr = 0.226 * 5e5 * h * h, pf = table_pf(alpha) * theta * 5e5 * h * h;
@@ -117,7 +117,7 @@ TEST(Fracture, EmpiricalPieceReachesClLcTimesTheSpeedFactorBeyondTheLoad) {
   o.fracture.speed_correction = true;
   o.fracture.speed_coefficient_spm = -0.1;
   Rig rig({rect_floe(1, 0, -100, 200, 200, h)}, 60, o);
-  const double dt = rig.model.options.time_step_s;
+  const double dt = rig.model.settings.time_step_s;
   const double alpha = w / (theta * lc), a = alpha * lc;
   const double fail = std::max(0.226 * 5e5 * h * h, table_pf(alpha) * theta * 5e5 * h * h);
   const Vec3 p(0.05, 0, 0);
@@ -166,7 +166,7 @@ TEST(Fracture, ASmallWedgeIsBrashOrEnlargedToTheSmallestPieceKept) {
     o.fracture.small_wedge = mode;
     Rig rig({rect_floe(1, 0, -100, 200, 200, h)}, 60, o);
     World world(rig.model);
-    const double dt = rig.model.options.time_step_s;
+    const double dt = rig.model.settings.time_step_s;
     // 50 kN through the 30 deg face: F_V = 43 kN, above the wedge's ~10 kN; F_H = 25 kN, far below splitting the
     // 200 m floe (2 K_IC h sqrt(200 m) = 1.3 MN).
     const auto cuts = find_fractures(world.model(), world.state(),
@@ -191,7 +191,7 @@ TEST(Fracture, SplittingLoadScalesAsKicHSqrtL) {
     for (double L : {10.0, 40.0, 160.0}) {
       Rig rig({rect_floe(1, 0, -L / 2, L, L, h)});
       World world(rig.model);
-      const double dt = rig.model.options.time_step_s;
+      const double dt = rig.model.settings.time_step_s;
       const double expected = 2.0 * 1.5e5 * h * std::sqrt(L);
       const Vec3 p(0.01, 0, 0);
       const auto none = find_fractures(world.model(), world.state(),
@@ -212,7 +212,7 @@ TEST(Fracture, VerticalFaceNeverBendsASlopedFaceBendsBeforeSplitting) {
   const double h = 1.0;
   Rig rig({rect_floe(1, 0, -100, 200, 200, h)});
   World world(rig.model);
-  const double dt = rig.model.options.time_step_s;
+  const double dt = rig.model.settings.time_step_s;
   const Vec3 p(0.05, 0, 0);
   // §2.4: F_V/F_H = (cos b - mu sin b) / (sin b + mu cos b) on the ice; at 90 deg with mu = 0.1 it is -0.10: the
   // face lifts the ice, never bends it down. Built from its normal and a friction force mu F_n upward on the ice.
@@ -396,7 +396,7 @@ TEST(Fracture, ResultsAreByteIdenticalOnRerunAndAcrossThreads) {
     o.threads = threads;
     const Model model = build_model(f, &hull, o);
     RunStats stats;
-    const Results r = simulate(model, stats);
+    const Results r = simulate(o, model, stats);
     EXPECT_GT(r.fracture_time_s.size(), 0u);
     const auto file = dir / ("r" + std::to_string(bytes.size()) + ".h5");
     write_results(file, r);
@@ -449,7 +449,7 @@ TEST(FracturePieces, InheritTheParentsHeaveFilterState) {
   World w(model);
   int pieces = 0;
   double largest = 0;
-  while (w.state().time_s < model.options.duration_s - 1e-9) {
+  while (w.state().time_s < testing::small_breaking_run_options().duration_s - 1e-9) {
     const size_t before = w.model().bodies.size();
     w.step();
     for (size_t k = before; k < w.model().bodies.size(); ++k) {

@@ -5,9 +5,9 @@
 #include <cmath>
 #include <random>
 
-#include "sim/forces.h"
-#include "sim/geometry.h"
-#include "sim/world.h"
+#include "sim/engine/forces.h"
+#include "sim/geometry/polygon3d.h"
+#include "sim/engine/world.h"
 #include "sim_fixtures.h"
 #include "pipeline/geometry2d.h"
 

@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pipeline/error.h"
-#include "sim/identify.h"
+#include "sim/analysis/identify.h"
 #include "pipeline/geometry2d.h"
 #include "sim_fixtures.h"
 

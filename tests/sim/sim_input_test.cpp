@@ -4,8 +4,8 @@
 #include <fstream>
 
 #include "pipeline/error.h"
-#include "sim/simulate.h"
-#include "sim/world.h"
+#include "sim/simulate/simulate.h"
+#include "sim/engine/world.h"
 #include "sim_fixtures.h"
 
 namespace floesim::sim {

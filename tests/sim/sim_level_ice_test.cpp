@@ -11,7 +11,7 @@
 #include "pipeline/geometry2d.h"
 #include "pipeline/options.h"
 #include "pipeline/results_io.h"
-#include "sim/simulate.h"
+#include "sim/simulate/simulate.h"
 #include "sim_fixtures.h"
 
 namespace floesim::sim {
@@ -162,7 +162,7 @@ TEST(LevelIce, TransitIsByteIdenticalOnRerunAndAcrossThreads) {
     o.threads = threads;
     const Model model = build_model(FloeField{}, &hull, o);
     RunStats stats;
-    const Results r = simulate(model, stats);
+    const Results r = simulate(o, model, stats);
     EXPECT_GT(r.fracture_time_s.size(), 0u);
     const auto file = dir / ("r" + std::to_string(bytes.size()) + ".h5");
     write_results(file, r);
@@ -207,7 +207,7 @@ TEST(LevelIce, ChannelWidthIsTheSheetAreaLostBehindMidshipOverItsLength) {
     r.floe_vertices_m.insert(r.floe_vertices_m.end(), {p.x(), p.y()});
   for (const Vec2& p : left) r.floe_vertices_m.insert(r.floe_vertices_m.end(), {p.x() - c.x(), p.y() - c.y()});
   r.floe_vertex_offset.push_back(static_cast<int64_t>(r.floe_vertices_m.size() / 2));
-  const Json j = level_ice_summary(m, r);
+  const Json j = level_ice_summary(o, m, r);
   EXPECT_EQ(j["tiles_start"], 1);
   EXPECT_NEAR(j["sheet_area_start_m2"].get<double>(), 1e4, 1e-6);
   const Json& ch = j["channel"];

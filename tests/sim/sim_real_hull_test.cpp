@@ -9,7 +9,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "sim/world.h"
+#include "sim/engine/world.h"
+#include "sim/simulate/options.h"
 #include "tests/sim/obj_faces.h"
 #include "pipeline/geometry2d.h"
 

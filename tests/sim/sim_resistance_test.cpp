@@ -15,8 +15,8 @@
 #include "pipeline/csv.h"
 #include "pipeline/error.h"
 #include "pipeline/geometry2d.h"
-#include "sim/hull.h"
-#include "sim/resistance.h"
+#include "sim/vessel/hull.h"
+#include "sim/analysis/resistance.h"
 #include "tests/sim/sim_fixtures.h"
 
 namespace floesim::sim {
@@ -40,11 +40,11 @@ IceResistanceOptions example_options() {
   IceResistanceOptions o;
   o.thicknesses_m = {1.0};
   o.speeds_mps = {0.0, 1.0, 2.0};
-  o.ice.flexural_strength_pa = 0.5e6;
-  o.ice.youngs_modulus_pa = 2e9;
-  o.ice.poisson_ratio = 0.3;
+  o.fracture.flexural_strength_pa = 0.5e6;
+  o.fracture.youngs_modulus_pa = 2e9;
+  o.fracture.poisson_ratio = 0.3;
   o.ice.density_kg_m3 = 900;
-  o.ice.mu_ice_hull = 0.1;
+  o.ice.mu_ice_structure = 0.1;
   o.water.density_kg_m3 = 1025;
   o.water.gravity_mps2 = 9.81;
   o.hull = {100, 20, 7, 30, 30, 50, 25};
@@ -56,18 +56,18 @@ TEST(Resistance, DefaultIceIsTheSimulationsSamsTable1) {
   // mu_is = 0.15; and the values simulate itself runs with.
   const IceResistanceOptions o;
   EXPECT_EQ(o.thicknesses_m, std::vector<double>{1.0});
-  EXPECT_EQ(o.ice.flexural_strength_pa, 500e3);
-  EXPECT_EQ(o.ice.youngs_modulus_pa, 5e9);
-  EXPECT_EQ(o.ice.poisson_ratio, 0.3);
+  EXPECT_EQ(o.fracture.flexural_strength_pa, 500e3);
+  EXPECT_EQ(o.fracture.youngs_modulus_pa, 5e9);
+  EXPECT_EQ(o.fracture.poisson_ratio, 0.3);
   EXPECT_EQ(o.ice.density_kg_m3, 900.0);
   EXPECT_EQ(o.water.density_kg_m3, 1025.0);
-  EXPECT_EQ(o.ice.mu_ice_hull, 0.15);
+  EXPECT_EQ(o.ice.mu_ice_structure, 0.15);
   const SimulateOptions s;
-  EXPECT_EQ(o.ice.flexural_strength_pa, s.fracture.flexural_strength_pa);
-  EXPECT_EQ(o.ice.youngs_modulus_pa, s.fracture.youngs_modulus_pa);
-  EXPECT_EQ(o.ice.poisson_ratio, s.fracture.poisson_ratio);
+  EXPECT_EQ(o.fracture.flexural_strength_pa, s.fracture.flexural_strength_pa);
+  EXPECT_EQ(o.fracture.youngs_modulus_pa, s.fracture.youngs_modulus_pa);
+  EXPECT_EQ(o.fracture.poisson_ratio, s.fracture.poisson_ratio);
   EXPECT_EQ(o.ice.density_kg_m3, s.ice.density_kg_m3);
-  EXPECT_EQ(o.ice.mu_ice_hull, s.ice.mu_ice_structure);
+  EXPECT_EQ(o.ice.mu_ice_structure, s.ice.mu_ice_structure);
   EXPECT_EQ(o.water.density_kg_m3, s.water.density_kg_m3);
   EXPECT_EQ(o.water.gravity_mps2, s.water.gravity_mps2);
 }
@@ -175,7 +175,7 @@ TEST(Resistance, BadOptionsAndInputsAreErrorsNamingTheKey) {
   EXPECT_NE(problem(R"({"thicknesses_m": []})").find("thicknesses_m"), std::string::npos);
   EXPECT_NE(problem(R"({"thicknesses_m": [1, -0.5]})").find("thicknesses_m"), std::string::npos);
   EXPECT_NE(problem(R"({"speeds_mps": [-1]})").find("speeds_mps"), std::string::npos);
-  EXPECT_NE(problem(R"({"ice": {"poisson_ratio": 0.7}})").find("ice.poisson_ratio"), std::string::npos);
+  EXPECT_NE(problem(R"({"fracture": {"poisson_ratio": 0.7}})").find("fracture.poisson_ratio"), std::string::npos);
   EXPECT_NE(problem(R"({"hull": {"stem_angle_deg": 120}})").find("hull.stem_angle_deg"), std::string::npos);
   EXPECT_NE(problem(R"({"ice": {"flexural_strength": 5e5}})").find("ice.flexural_strength"), std::string::npos);
   // No hull.json and not all particulars: every missing key named.
@@ -212,7 +212,7 @@ TEST(Resistance, ExecutableEndToEnd) {
   EXPECT_NE(slurp(dir / "out.txt").find("| 1.5 | 3 |"), std::string::npos) << slurp(dir / "out.txt");
   // --help-config lists the keys; --check-config refuses a typo, naming it, and writes nothing.
   ASSERT_EQ(std::system((res + " --help-config > " + (dir / "help.txt").string()).c_str()), 0);
-  EXPECT_NE(slurp(dir / "help.txt").find("ice.mu_ice_hull"), std::string::npos);
+  EXPECT_NE(slurp(dir / "help.txt").find("ice.mu_ice_structure"), std::string::npos);
   std::ofstream(dir / "bad.json") << R"({"ice": {"mu": 0.1}})";
   const int rc = std::system((base + " --config " + (dir / "bad.json").string() + " --check-config 2> " +
                               (dir / "err.txt").string())

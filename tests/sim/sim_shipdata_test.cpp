@@ -13,8 +13,8 @@
 
 #include "pipeline/error.h"
 #include "pipeline/options.h"
-#include "sim/shipdata.h"
-#include "sim/simulate.h"
+#include "sim/analysis/shipdata.h"
+#include "sim/simulate/simulate.h"
 #include "sim_fixtures.h"
 
 namespace fs = std::filesystem;
@@ -39,6 +39,7 @@ FloeField floe_field() {
 // One 40 s transit at 2 m/s (the speed controller), shared by the tests: the model, the results, the summary (with
 // the settings, as floesim-simulate writes it).
 struct Transit {
+  SimulateOptions options;
   Model model;
   Results results;
   nlohmann::json summary;
@@ -50,11 +51,11 @@ const Transit& transit() {
     o.duration_s = 40;
     o.steady_start_s = 10;
     o.output_interval_s = 1;
-    Transit tr{build_model(floe_field(), &hull, o), {}, {}};
+    Transit tr{o, build_model(floe_field(), &hull, o), {}, {}};
     RunStats stats;
-    tr.results = simulate(tr.model, stats);
-    tr.summary = summarize(tr.model, tr.results);
-    tr.summary["settings"] = options_to_json(tr.model.options);
+    tr.results = simulate(o, tr.model, stats);
+    tr.summary = summarize(o, tr.model, tr.results);
+    tr.summary["settings"] = options_to_json(o);
     return tr;
   }();
   return t;
@@ -123,7 +124,7 @@ TEST(ShipData, SidecarIsTheSimulatedShip) {
   EXPECT_EQ(d.identify.resistance.model, "ittc57");
   // Same curve as the simulator's at 2 m/s.
   EXPECT_NEAR(open_water_resistance(2.0, d.identify.resistance),
-              ittc57_resistance(2.0, tr.model.vessel_info, tr.model.options), 1e-9);
+              ittc57_resistance(2.0, ittc57_of(tr.model.vessel_info, tr.options)), 1e-9);
   EXPECT_EQ(d.measured.time_s.size(), tr.results.steps());
   EXPECT_FALSE(d.wind);
 }
@@ -204,9 +205,9 @@ TEST(ShipData, RoundTripWithWindAndCurrent) {
   o.water.current_direction_deg = 200;
   const Model model = build_model(floe_field(), &hull, o);
   RunStats stats;
-  const Results r = simulate(model, stats);
-  nlohmann::json summary = summarize(model, r);
-  summary["settings"] = options_to_json(model.options);
+  const Results r = simulate(o, model, stats);
+  nlohmann::json summary = summarize(o, model, r);
+  summary["settings"] = options_to_json(o);
   const ShipData d = make_ship_data(r, summary, {});
   ASSERT_TRUE(d.wind);
   // The wind load identify computes from the CSV equals the simulator's (up to the end-of-step axes).
@@ -296,7 +297,7 @@ TEST(ShipData, RemainderIsTheTrim) {
   const auto& hyd = tr.results.get("hydro_load");
   const auto& q = tr.results.get("vessel_quaternion_wxyz");
   const double M11 = d.identify.mass.surge_kg, m = tr.model.bodies[tr.model.vessel].mass_kg;
-  const double g = tr.model.options.water.gravity_mps2;
+  const double g = tr.model.settings.water.gravity_mps2;
   double rv = 0, hx = 0, gx = 0, sim = 0, n = 0;
   for (size_t i = 0; i < d.measured.time_s.size(); ++i) {
     if (d.measured.time_s[i] < d.mean_t0_s) continue;

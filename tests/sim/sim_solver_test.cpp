@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <memory>
 
-#include "sim/solver.h"
+#include "sim/engine/solver.h"
 #include "sim_fixtures.h"
 
 namespace floesim::sim {
@@ -25,7 +25,7 @@ struct Chain {
 
 Chain make_chain(const std::vector<double>& mass, double v0, ContactType type, const std::string& method) {
   Chain ch;
-  ch.model.options.solver.method = method;
+  ch.model.settings.solver.method = method;
   const int n = static_cast<int>(mass.size());
   ch.state.position.resize(n);
   ch.state.orientation.assign(n, Quat::Identity());
@@ -71,9 +71,9 @@ TEST_P(SolverChain, HeavyOnLightChainGetsTheInelasticImpulse) {
   double reached[2] = {0, 0};
   for (const char* method : {"pgs", "pgs_subspace"}) {
     Chain ch = make_chain(mass, v0, GetParam(), method);
-    const double dt = ch.model.options.time_step_s;
+    const double dt = ch.model.settings.time_step_s;
     const ContactIslands islands = prepare_contacts(ch.model, ch.bodies, ch.state, ch.contacts, dt);
-    const SolverOptions& o = ch.model.options.solver;
+    const SolverOptions& o = ch.model.settings.solver;
     const SolverReport rep = solve_contacts(ch.model, ch.bodies, ch.state, ch.contacts, islands, dt, true,
                                             o.iterations, o.tolerance_mps);
     const bool sm = std::string(method) == "pgs_subspace";

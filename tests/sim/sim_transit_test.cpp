@@ -11,8 +11,8 @@
 #include <map>
 
 #include "pipeline/provenance.h"
-#include "sim/simulate.h"
-#include "sim/world.h"
+#include "sim/simulate/simulate.h"
+#include "sim/engine/world.h"
 #include "sim_fixtures.h"
 
 namespace floesim::sim {
@@ -43,7 +43,7 @@ TEST(SimTransit, LayoutIsExact) {
   const Model m = build_model(floe_block(), &hull, o);
   ASSERT_EQ(m.floe_count(), 20);
   RunStats stats;
-  const Results r = simulate(m, stats);
+  const Results r = simulate(o, m, stats);
   // Exactly duration / dt rows and duration / output_interval frames, at t = k * output_interval, k = 1..N.
   ASSERT_EQ(r.steps(), 2000u);
   ASSERT_EQ(r.frames(), 100u);
@@ -61,7 +61,7 @@ TEST(SimTransit, LayoutIsExact) {
     EXPECT_EQ(r.state_body_id[replay.vessel_row()], 0);
   }
 
-  const nlohmann::json s = summarize(m, r);
+  const nlohmann::json s = summarize(o, m, r);
   std::printf("[measured] mean surge ice load %.1f kN, mean speed %.3f m/s, mean vessel contacts %.2f, "
               "mean sweeps %.1f, %.3f ms/step\n",
               s["mean_surge_ice_load_N"].get<double>() / 1e3, s["mean_vessel_speed_mps"].get<double>(), s["mean_vessel_contacts"].get<double>(),
@@ -74,15 +74,16 @@ TEST(SimTransit, LayoutIsExact) {
 // body that a second run, stepping the world by hand and reading its whole state at each output time, sees: the
 // same bodies and bit-identical poses at every frame. Checked on a transit with floes far off that fall asleep
 // (they must stop costing rows) and on level ice, where wedges break off (parents must leave, pieces appear).
-void expect_frames_replay_to_world_states(const Model& m, size_t* stored_rows, size_t* dense_rows) {
+void expect_frames_replay_to_world_states(const SimulateOptions& o, const Model& m, size_t* stored_rows,
+                                          size_t* dense_rows) {
   RunStats stats;
-  const Results r = simulate(m, stats);
+  const Results r = simulate(o, m, stats);
   FrameReplay replay(r, "results");
   World w(m);
-  const long every = m.options.output_every();
+  const long every = o.output_every();
   size_t frame = 0;
   *dense_rows = 0;
-  for (long k = 1; k <= m.options.steps(); ++k) {
+  for (long k = 1; k <= o.steps(); ++k) {
     w.step();
     if (k % every) continue;
     ASSERT_LT(frame, r.frames());
@@ -123,7 +124,7 @@ TEST(SimTransit, StoredFramesReplayToEveryBodysStateAndSleepingFloesCostNoRows) 
   for (int i = 0; i < 10; ++i) field.floes.push_back(rect_floe(100 + i, 60 + 10 * i, 150, 7, 7, 1.0));  // far off
   const Model m = build_model(field, &hull, o);
   size_t stored = 0, dense = 0;
-  expect_frames_replay_to_world_states(m, &stored, &dense);
+  expect_frames_replay_to_world_states(o, m, &stored, &dense);
   std::printf("[measured] %zu state rows stored against %zu with every body in every frame\n", stored, dense);
   // The ten far floes settle and sleep within seconds: of their 1,000 frame-rows, most are not stored.
   EXPECT_LT(stored + 800, dense);
@@ -134,7 +135,7 @@ TEST(SimTransit, StoredFramesReplayThroughFractureOfLevelIce) {
   const HullModel hull = coarse_hull();
   const Model m = build_model(FloeField{}, &hull, o);
   size_t stored = 0, dense = 0;
-  expect_frames_replay_to_world_states(m, &stored, &dense);
+  expect_frames_replay_to_world_states(o, m, &stored, &dense);
   std::printf("[measured] level ice: %zu state rows stored against %zu dense\n", stored, dense);
   EXPECT_LT(stored, dense);  // the fixed tiles are stored once
 }
@@ -160,7 +161,7 @@ TEST(SimTransit, FloesMarkedInContactAreTheOnesTheHullPressesOn) {
   field.floes.push_back(rect_floe(99, 80, 80, 7, 7, 1.0));  // far to port: never reached
   const Model m = build_model(field, &hull, o);
   RunStats stats;
-  const Results r = simulate(m, stats);
+  const Results r = simulate(o, m, stats);
   ASSERT_EQ(r.state_in_contact.size(), r.state_body_id.size());
   double hx = 0, hy = 0;  // hull half-extents (body frame)
   for (size_t i = 0; i < r.hull_vertices_m.size() / 3; ++i) {
@@ -220,8 +221,8 @@ TEST(SimTransit, MeanLoadIsTheMomentumGivenToTheIce) {
   const HullModel hull = box_hull(4, 30, -3, 6);
   const Model m = build_model(field, &hull, o);
   RunStats stats;
-  const Results r = simulate(m, stats);
-  const double mean = summarize(m, r)["mean_surge_ice_load_N"].get<double>();
+  const Results r = simulate(o, m, stats);
+  const double mean = summarize(o, m, r)["mean_surge_ice_load_N"].get<double>();
   const double M = o.ice.density_kg_m3 * 3 * 6 * 6 * 1.0, U = 2.0, T = o.duration_s;
   // Every floe's final speed: its advance over the last second (frames 1 s apart, bodies in the same order).
   const size_t last = r.frames() - 1;

@@ -7,9 +7,9 @@
 #include <fstream>
 
 #include "pipeline/error.h"
-#include "sim/forces.h"
-#include "sim/simulate.h"
-#include "sim/world.h"
+#include "sim/engine/forces.h"
+#include "sim/simulate/simulate.h"
+#include "sim/engine/world.h"
 #include "sim_fixtures.h"
 #include "pipeline/geometry2d.h"
 
@@ -77,7 +77,7 @@ TEST(SimVessel, IttcFrictionLineMatchesWorkedNumbers) {
   o.vessel.roughness_ca = 0;
   ASSERT_EQ(o.water.kinematic_viscosity_m2ps, 1.83e-6);  // the brief's value is the default
   for (const auto& [u, cf] : {std::pair{2.0, 0.00206}, std::pair{6.0, 0.00177}}) {
-    const double c = 2 * ittc57_resistance(u, vp, o) / (o.water.density_kg_m3 * u * u);
+    const double c = 2 * ittc57_resistance(u, ittc57_of(vp, o)) / (o.water.density_kg_m3 * u * u);
     std::printf("[measured] C_F(L = 100 m, %.0f m/s) = %.6f (PHYSICS.md: %.5f)\n", u, c, cf);
     EXPECT_NEAR(c, cf, 0.5e-5);
   }
@@ -95,11 +95,11 @@ TEST(SimVessel, TerminalSpeedUnderConstantThrust) {
   o.vessel.heading_deg = 30;
   o.vessel.propulsion.mode = "constant_thrust";
   Model m = build_model(FloeField{}, &hull, o);
-  m.options.water.kinematic_viscosity_m2ps = 1.83e-6 * m.vessel_info.length_wl_m / 100;
+  m.settings.water.kinematic_viscosity_m2ps = 1.83e-6 * m.vessel_info.length_wl_m / 100;
   const double u = 2.0, cf = 0.00206;
   const double thrust = 0.5 * o.water.density_kg_m3 * m.vessel_info.wetted_surface_m2 * u * u *
                         ((1 + o.vessel.form_factor_k) * cf + o.vessel.roughness_ca);
-  m.options.vessel.propulsion.thrust_n = thrust;
+  m.settings.vessel.propulsion.thrust_n = thrust;
   World w(m);
   for (int i = 0; i < 3000; ++i) w.step();
   const double speed = surge_speed(w);
@@ -118,7 +118,7 @@ TEST(SimVessel, TerminalSpeedUnderConstantThrust) {
   os.vessel.propulsion.mode = "thrust_series";
   os.vessel.propulsion.thrust_file = (dir / "thrust.csv").string();
   Model ms = build_model(FloeField{}, &hull, os);
-  ms.options.water.kinematic_viscosity_m2ps = m.options.water.kinematic_viscosity_m2ps;
+  ms.settings.water.kinematic_viscosity_m2ps = m.settings.water.kinematic_viscosity_m2ps;
   World ws(ms);
   for (int i = 0; i < 500; ++i) ws.step();
   EXPECT_NEAR(ws.report().thrust_n, 0.5 * thrust + 0.5 * thrust * (4.99 / 10), 1e-6 * thrust);  // at t = 4.99 s
@@ -136,7 +136,7 @@ TEST(SimVessel, SpeedControllerHoldsTarget) {
   const Model m = build_model(FloeField{}, &hull, o);
   World w(m);
   for (int i = 0; i < 15000; ++i) w.step();
-  const double r2 = ittc57_resistance(2.0, m.vessel_info, o);
+  const double r2 = ittc57_resistance(2.0, ittc57_of(m.vessel_info, o));
   std::printf("[measured] speed after 150 s %.5f m/s, thrust %.1f kN (R_ow(2) %.1f kN)\n", surge_speed(w),
               w.report().thrust_n / 1e3, r2 / 1e3);
   EXPECT_NEAR(surge_speed(w), 2.0, 0.002);

@@ -9,8 +9,8 @@
 
 #include "pipeline/geometry2d.h"
 #include "pipeline/options.h"
-#include "sim/forces.h"
-#include "sim/world.h"
+#include "sim/engine/forces.h"
+#include "sim/engine/world.h"
 #include "sim_fixtures.h"
 
 namespace floesim::sim {

@@ -6,9 +6,9 @@
 #pragma once
 #include "pipeline/floes_io.h"
 #include "pipeline/results_io.h"
-#include "sim/hull.h"
-#include "sim/model.h"
-#include "sim/simulate_options.h"
+#include "sim/vessel/hull.h"
+#include "sim/engine/model.h"
+#include "sim/simulate/options.h"
 
 namespace floesim::sim::testing {
 

@@ -1,0 +1,175 @@
+// The model of a simulation (MuJoCo's mjModel idea): bodies addressed by integer index, their convex collision
+// parts, mass properties, hydrostatic data and the vessel's particulars. Everything that changes in time lives in
+// State (sim/engine/state.h). Built once from the floes artefact, the hull and the options. The body and part tables only
+// grow: when ice breaks, the world appends the pieces as new bodies (sim/engine/fracture.h); an entry, once made, never
+// changes (a broken floe stays in the table, marked dead in State::alive), so indices stay valid for a whole run.
+#pragma once
+#include <algorithm>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "pipeline/floes_io.h"
+#include "sim/vessel/hull.h"
+#include "sim/geometry/mesh.h"
+#include "sim/engine/settings.h"
+#include "sim/vessel/open_water.h"
+
+namespace floesim::sim {
+
+using Quat = Eigen::Quaterniond;
+
+// A convex polyhedron in its body's frame (origin = body centre of mass): the unit of collision.
+struct ConvexPart {
+  int body = -1;
+  std::vector<Vec3> vertices;
+  std::vector<std::vector<int>> faces;  // planar faces, counter-clockwise seen from outside (coplanar triangles merged)
+  std::vector<Vec3> face_normal;        // outward unit normals
+  std::vector<uint8_t> face_internal;   // 1: the face is shared with another part of the same body (not a surface
+                                        // of the body: never a contact reference face)
+  double bounding_radius = 0;           // about the body origin (for cheap rejection tests)
+};
+
+// wall: a fixed body (infinite mass, never awake, no forces) bounding the domain (options.domain).
+enum class BodyKind : uint8_t { vessel, floe, wall };
+
+// One planar face of a floe slab for the drag model: indices into Body::drag_vertices.
+struct DragFace {
+  int first = 0, count = 0;  // into Body::drag_face_index
+  Vec3 normal = Vec3::Zero();  // outward, body frame
+  double area = 0;             // m^2
+  Vec3 centroid = Vec3::Zero();  // body frame (used as is when the whole face is under water)
+  int side = -1;                 // side wall between ring vertices side and side + 1 (-1: top or bottom)
+};
+
+// Contacts of one body pair whose surfaces come within this of each other press on the ice as one load: one crushing
+// contact (collide) and one fracture load of a level ice tile (fracture). Twice the ice thickness h, at least 1 m:
+// closer than that, thin-plate theory does not tell two loads apart.
+inline double load_join_distance_m(double thickness_m) { return std::max(2 * thickness_m, 1.0); }
+
+struct Body {
+  BodyKind kind = BodyKind::floe;
+  int id = 0;              // 0 = vessel, else the floe id of the input file (pieces: new ids, never reused)
+  // Lineage (floes): the id of the floe this piece broke from (-1: input floe), its generation (0: input floe),
+  // how it was made (FractureMode of pipeline/results_io.h, 0: input) and when (s).
+  int parent_id = -1;
+  int generation = 0;
+  int origin_mode = 0;
+  double created_s = 0;
+  double mass_kg = 0, inv_mass = 0;
+  Mat3 inertia = Mat3::Zero();      // body frame, about the centre of mass, kg m^2
+  Mat3 inv_inertia = Mat3::Zero();
+  // Added mass (PHYSICS.md §3.3), body axes: translational (surge, sway, heave; kg) and rotational (roll, pitch,
+  // yaw; kg m^2). It enters the mass matrix only (inertia against every force, contacts included), never the
+  // weight. Inverses with it: inv_mass_added (translational, body axes) and inv_inertia_added (body frame).
+  Vec3 added_mass = Vec3::Zero();
+  Vec3 added_inertia = Vec3::Zero();
+  Vec3 inv_mass_added = Vec3::Zero();   // 1 / (m + A_ii), body axes (0 for walls)
+  Mat3 inv_inertia_added = Mat3::Zero();  // (I + diag(added_inertia))^-1, body frame
+  int first_part = 0, part_count = 0;  // into Model::parts
+  TriMesh buoyancy_mesh;               // closed surface in the body frame, clipped at z = 0 for buoyancy
+  // Drag model of floes: the slab's faces (top, bottom, sides) over a ring of vertices in the body frame.
+  std::vector<Vec3> drag_vertices;
+  std::vector<int> drag_face_index;
+  std::vector<DragFace> drag_faces;
+  int top_face = -1;                   // index into drag_faces of the top face (wind on floes)
+  double thickness_m = 0;              // floes
+  // Floes: plan-section properties about the centre of mass (exact prism buoyancy without clipping).
+  double section_area = 0;             // m^2
+  double section_sxx = 0, section_syy = 0, section_sxy = 0;  // integrals of x^2, y^2, xy over the section, m^4
+  double section_radius = 0;           // largest distance of an outline vertex from the centre, m
+  Polygon outline;                     // floes: CCW outline in the body frame (x, y)
+  // Linear damping coefficients from the hydrostatic stiffness at equilibrium and the damping ratios.
+  double heave_damping = 0;            // N s/m, along world z
+  double roll_damping = 0;             // N m s/rad, about body x
+  double pitch_damping = 0;            // N m s/rad, about body y
+  // Floes, water.floe_heave_damping "radiation" (heave_radiation_force): the gain G on the high-passed heave
+  // velocity (N s/m) and the filter's corner frequency w_c (rad/s); G = 0: none (then heave_damping acts).
+  double heave_radiation_gain = 0;
+  double heave_radiation_corner_radps = 0;
+  Vec3 initial_position = Vec3::Zero();
+  Quat initial_orientation = Quat::Identity();
+  // Level ice (issue #10): a tile of a sheet, held by the ice around it (hold_fixed). Like a wall it has infinite
+  // mass (inverse masses 0), is never awake and feels no force, so the sheet costs nothing per step until something
+  // moving touches it; unlike a wall it is ice: it keeps its mass for the ice balance, is recorded, and fracture
+  // breaks wedges off it (bending and radial cracking; a sheet does not split in-plane). What is left of a tile
+  // stays fixed; the wedges are free floes.
+  bool fixed = false;
+};
+
+// What the vessel model needs of the hull, computed from the mesh at the design waterline (z = 0).
+struct VesselParticulars {
+  double length_oa_m = 0, length_wl_m = 0, beam_wl_m = 0, draught_m = 0;
+  double displacement_m3 = 0, wetted_surface_m2 = 0, waterplane_area_m2 = 0;
+  double mass_kg = 0;
+  Vec3 centre_of_mass_hull = Vec3::Zero();  // in the hull (OBJ) frame
+  Vec3 radii_of_gyration_m = Vec3::Zero();
+  double gm_transverse_m = 0, gm_longitudinal_m = 0;  // metacentric heights from the clipped hull
+  std::vector<double> strip_x_m;      // stations of the cross-flow (sway/yaw) damping strips, body frame
+  std::vector<double> strip_beam_m;   // waterline beam at each station (heave/pitch added mass)
+  double strip_length_m = 0;          // length of one strip
+};
+
+// A propeller of the vessel (options.vessel.propellers) in the vessel's body frame.
+struct Propeller {
+  Vec3 position = Vec3::Zero();  // centre of the disc, body frame (about the centre of mass)
+  Vec3 axis = Vec3::UnitX();     // unit, the direction of the thrust it gives
+  double diameter_m = 0;
+  double thrust_share = 0;
+};
+
+struct Model {
+  EngineSettings settings;  // the physics settings it was built with (sim/engine/settings.h)
+  std::vector<Body> bodies;   // vessel first (if any), then the floes in input order
+  std::vector<ConvexPart> parts;
+  int vessel = -1;            // index of the vessel body, -1 if none (tests of floes alone)
+  VesselParticulars vessel_info;
+  std::vector<int> removed_floe_ids;  // floes that overlapped the vessel's initial footprint
+  int small_overlaps = 0;             // floe pairs overlapping below the error threshold (digitisation noise)
+  Vec3 gravity = Vec3::Zero();
+  Vec3 current = Vec3::Zero();        // water velocity, world
+  Vec3 wind = Vec3::Zero();           // air velocity, world
+  std::vector<double> thrust_time_s, thrust_n;  // thrust_series mode
+  std::vector<Propeller> propellers;            // their jets wash the floes (forces.h, PropellerJet)
+
+  int wall_count = 0;                 // domain walls, the last bodies
+  // Floe bodies in the table: the input floes of a built model; in a world's grown table, every piece too (dead or
+  // alive).
+  int floe_count() const { return static_cast<int>(bodies.size()) - (vessel >= 0 ? 1 : 0) - wall_count; }
+};
+
+// Builds the model. `hull` may be null (floes only). Checks the inputs (thickness, overlaps) and throws
+// floesim::Error naming the floe ids. Floes overlapping the vessel's initial footprint are removed. Domain walls
+// (options.domain) come last; a floe or the vessel overlapping one is an error.
+Model build_model(const FloeField& floes, const HullModel* hull, const EngineSettings& options);
+
+// Reads a thrust series CSV ("time_s,thrust_N" header, strictly increasing times); errors name the line.
+void read_thrust_series(const std::string& file, std::vector<double>& time_s, std::vector<double>& thrust_n);
+
+// The vessel's ITTC-57 open-water resistance line (sim/vessel/open_water.h) from its particulars and the settings'
+// water and form factor.
+Ittc57 ittc57_of(const VesselParticulars& v, const EngineSettings& o);
+
+// A floe body: a slab of thickness h over `outline` (CCW, body frame: centred on its area centroid, which is the
+// body origin), at hydrostatic equilibrium at plan position `centre`, with mass and inertia from polygon x h x
+// rho_i, added mass, damping and drag faces from the options. Its convex parts (convex decomposition of the
+// outline) are appended to `parts` with body index `body_index`; first_part/part_count point at them.
+Body make_floe_body(const Polygon& outline, double thickness_m, int id, int body_index, const Vec2& centre,
+                    const EngineSettings& o, std::vector<ConvexPart>& parts);
+
+// A body the solver and the integrator never move: a domain wall or a tile of level ice.
+inline bool is_fixed_body(const Body& b) { return b.kind == BodyKind::wall || b.fixed; }
+
+// Makes a floe body a fixed tile of level ice: inverse masses and inertias 0 (Body::fixed).
+void hold_fixed(Body& b);
+
+// Convex part from a closed convex triangle mesh (body frame): merges coplanar triangles into faces.
+ConvexPart make_convex_part(const TriMesh& mesh, int body);
+// Marks the faces that two parts of one body share (opposite normals in the same plane, overlapping): the cut
+// planes between hull sections and the diagonals of a floe's convex decomposition.
+void mark_shared_faces(std::vector<ConvexPart>& parts, int first, int count);
+
+}  // namespace floesim::sim

@@ -1,0 +1,56 @@
+// The recorder of the simulate stage: after each step of the world it appends the step's row to every series of
+// the results layout (pipeline/results_io.h), stores a frame of the bodies that changed at every output interval
+// and sums the run's statistics; at the end it adds the geometry of every floe that ever existed, the fracture
+// table and the run's attributes. It reads the world and writes the results: nothing of the world changes.
+#pragma once
+#include <map>
+#include <string>
+#include <vector>
+
+#include "pipeline/results_io.h"
+#include "sim/engine/world.h"
+#include "sim/simulate/options.h"
+
+namespace floesim::sim {
+
+// Sums over the steps for the run's statistics (RunStats), carried in checkpoints.
+struct RecorderSums {
+  double awake = 0, contacts = 0, iterations = 0, pairs = 0, touching = 0, edges = 0, crushing = 0;
+  double record_s = 0;  // wall time of the recording, s
+  double wall_s = 0;    // wall time of the steps before this process's first, s
+};
+
+class Recorder {
+ public:
+  // Reserves the series columns of `r` for `rows_held` steps and its frames for the whole run.
+  Recorder(const SimulateOptions& o, Results& r, long rows_held);
+
+  // Takes up the bodies' last stored states from the results (none for a fresh run; every row up to the checkpoint
+  // when resumed, so that a resumed run stores exactly what an uninterrupted one does).
+  void attach(const World& w);
+
+  // Records step k (1-based) that the world has just made: the series row, the sums, and a frame when k is a
+  // multiple of the output interval (the vessel and the bodies that are new or changed since they were stored).
+  void record_step(const World& w, long k);
+
+  // After the last step: the outline, thickness and lineage of every floe that ever existed, the fracture events,
+  // the hull surface and the run's attributes.
+  void finish(const World& w);
+
+  RecorderSums& sums() { return sums_; }
+
+ private:
+  class StoredStates;
+  const SimulateOptions& o_;
+  Results& r_;
+  long every_;
+  // Direct references to the series columns: no map look-up per step.
+  std::vector<double>*c_time_, *c_pos_, *c_quat_, *c_vel_, *c_omega_, *c_kinetic_;
+  std::vector<std::vector<double>*> c_loads_;   // the wrench series, in the order of kLoadSeries
+  std::vector<std::vector<double>*> c_scalar_;  // the scalar series, in the order of kScalarSeries
+  std::vector<int8_t> pressed_;                 // per body: pressed against the vessel in this step (frames only)
+  std::shared_ptr<StoredStates> stored_;
+  RecorderSums sums_;
+};
+
+}  // namespace floesim::sim

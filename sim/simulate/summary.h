@@ -1,0 +1,26 @@
+// summary.json of the simulate stage: the steady means of the loads and the vessel's motion, the moving averages
+// of PHYSICS.md §5, how the solver did, fracture and level ice, from the results alone (and the model as built, for
+// what the inputs were).
+#pragma once
+#include <nlohmann/json.hpp>
+
+#include "pipeline/results_io.h"
+#include "sim/engine/model.h"
+#include "sim/simulate/options.h"
+
+namespace floesim::sim {
+
+// Summary statistics of the results (steady part from o.steady_start_s); the series from `series` (one at a time)
+// or from results.series. `model` is the model as built (its input floes, vessel and sheet).
+nlohmann::json summarize(const SimulateOptions& o, const Model& model, const Results& results,
+                         const SeriesSource& series);
+nlohmann::json summarize(const SimulateOptions& o, const Model& model, const Results& results);
+
+// Level ice (summary.json "level_ice"): the sheet's tiles and area at the start and the channel the vessel broke:
+// from the sheet's edge on its path to its centre of mass in the last frame (behind midship the channel is formed),
+// the sheet area lost there over that length is the channel's mean width, against the waterline beam.
+nlohmann::json level_ice_summary(const SimulateOptions& o, const Model& model, const Results& results,
+                                 const SeriesSource& series);
+nlohmann::json level_ice_summary(const SimulateOptions& o, const Model& model, const Results& results);
+
+}  // namespace floesim::sim

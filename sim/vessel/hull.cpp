@@ -1,0 +1,1272 @@
+#include "sim/vessel/hull.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include <Eigen/Geometry>
+#include <assimp/Importer.hpp>
+#include <assimp/config.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include "pipeline/atomic_file.h"
+#include "pipeline/error.h"
+#include "pipeline/provenance.h"
+#include "pipeline/geometry2d.h"
+#include "sim/vessel/particulars.h"
+
+namespace floesim::sim {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+double deg(double d) { return d * kPi / 180.0; }
+
+std::string percent(double f) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%+.2f %%", 100.0 * f);
+  return buf;
+}
+
+// 0 -> 0, 1 -> 1 with zero slope at both ends (for blending hull parameters along x without kinks).
+double smooth(double s) {
+  s = std::clamp(s, 0.0, 1.0);
+  return 0.5 - 0.5 * std::cos(kPi * s);
+}
+double lerp(double a, double b, double s) { return a + (b - a) * s; }
+
+// Coordinates of the generated hull lie on a 2^-10 m (~1 mm) grid. Such numbers are printed exactly in decimal and
+// parsed exactly even by assimp's single-precision OBJ reader (integer part + a fraction of <= 10 binary digits fit
+// a float's 24-bit mantissa for |x| < 16 km), so the hull read back is bit-identical to the one generated.
+double grid(double v) { return std::round(v * 1024.0) / 1024.0; }
+
+std::string fmt_num(double v, int prec = 6) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", prec, v);
+  return buf;
+}
+
+// ---- the parametric icebreaker ---------------------------------------------------------------------------------
+//
+// Each cross-section x = const is a convex polygon: a flat bottom at z_b(x), a bilge arc of radius r(x), a lower side
+// flared outwards at beta_lo(x) from the vertical up to the waterline knuckle at half-breadth W(x), an upper side at
+// the smaller flare beta_up(x) up to the deck. The flare decreasing upwards keeps the section convex.
+// Along x:
+// - bow: a spoon: the bottom is a plane rising at the stem angle from the forefoot to the stem head at the deck;
+//   across, it is flat with large bilges, so the bow is broad and flat (Oden's signature);
+// - reamers: the waterline widens from beam_m to reamer_beam_m at the forefoot, just behind the bow, and the bow
+//   waterline closes from there as an ellipse onto a blunt stem;
+// - parallel body with a flat bottom, a small flare and a moderate bilge;
+// - stern: a run whose bottom rises quadratically to an immersed transom, with narrowing waterline and growing bilge.
+// The shape constants below were chosen (not fitted per call) so that the default particulars displace
+// ~13,000 t at rho_w = 1025 kg/m^3 (tests/sim/hull_test.cpp checks this within 5 %).
+struct HullShape {
+  // Fractions of the length.
+  static constexpr double run_length = 0.38;      // stern run (bottom rising to the transom)
+  static constexpr double stern_narrowing = 0.38;  // waterline narrowing aft, over this part of the length
+  static constexpr double shoulder_length = 0.12;  // beam_m -> reamer_beam_m transition ahead of the reamers
+  // Fractions of the draught / half-beam.
+  static constexpr double transom_immersion = 0.15;  // transom bottom below the waterline, in draughts
+  static constexpr double transom_half_beam = 0.78;  // waterline half-breadth at the transom, of beam_m / 2
+  static constexpr double stem_half_beam = 0.30;     // half-breadth of the stem head, of reamer_beam_m / 2
+  // Flare from the vertical (deg) below / above the waterline, midbody and bow. Above the waterline the sides are
+  // nearly upright, so the extreme beam (at the reamers, on deck) stays within ~1 m of reamer_beam_m.
+  static constexpr double flare_mid_lo_deg = 12.0, flare_mid_up_deg = 6.0;
+  static constexpr double flare_bow_lo_deg = 35.0, flare_bow_up_deg = 4.0;
+  // Bilge radii (m), midbody / bow / transom.
+  static constexpr double bilge_mid_m = 4.0, bilge_bow_m = 5.0, bilge_transom_m = 5.0;
+};
+
+struct Station {
+  double z_bottom, half_wl, flare_lo, flare_up, bilge;
+};
+
+class IcebreakerGeometry {
+ public:
+  explicit IcebreakerGeometry(const HullGeneratorOptions& o) : o_(o) {
+    x_aft_ = -0.5 * o.length_m;
+    x_fwd_ = 0.5 * o.length_m;
+    z_keel_ = -o.draught_m;
+    z_deck_ = o.depth_m - o.draught_m;
+    tan_stem_ = std::tan(deg(o.stem_angle_deg));
+    tan_entrance_ = std::tan(deg(o.entrance_angle_deg));
+    // Forefoot: where the spoon meets the keel. Kept in the forward half, so a very low stem angle still leaves a
+    // parallel body (the spoon then ends below the deck in a flat, vertical stem face).
+    x_forefoot_ = std::max(x_fwd_ - o.depth_m / tan_stem_, 0.0);
+    x_reamer_ = x_forefoot_;
+    x_run_ = x_aft_ + HullShape::run_length * o.length_m;
+    x_shoulder_ = std::max(x_reamer_ - HullShape::shoulder_length * o.length_m, x_run_);
+  }
+
+  double x_aft() const { return x_aft_; }
+  double x_fwd() const { return x_fwd_; }
+  double z_deck() const { return z_deck_; }
+  double x_reamer() const { return x_reamer_; }
+  bool wedge_bow() const { return o_.entrance_angle_deg < 90.0; }
+
+  Station at(double x) const {
+    const HullGeneratorOptions& o = o_;
+    Station s;
+    // Bottom: keel, the bow spoon plane, the stern run.
+    const double spoon = z_keel_ + (x - x_forefoot_) * tan_stem_;
+    double run = z_keel_;
+    if (x < x_run_) {
+      const double u = (x_run_ - x) / (x_run_ - x_aft_);
+      run = z_keel_ + (1.0 - HullShape::transom_immersion) * o.draught_m * u * u;
+    }
+    s.z_bottom = std::min(std::max({z_keel_, spoon, run}), z_deck_);
+    // Waterline half-breadth.
+    const double b = 0.5 * o.beam_m, r = 0.5 * o.reamer_beam_m;
+    if (x >= x_reamer_) {
+      const double u = std::clamp((x - x_reamer_) / (x_fwd_ - x_reamer_), 0.0, 1.0);
+      const double tip = HullShape::stem_half_beam * r;
+      s.half_wl = tip + (r - tip) * std::sqrt(std::max(0.0, 1.0 - u * u));
+    } else if (x >= x_shoulder_) {
+      s.half_wl = lerp(b, r, smooth((x - x_shoulder_) / (x_reamer_ - x_shoulder_)));
+    } else {
+      const double x_narrow = x_aft_ + HullShape::stern_narrowing * o.length_m;
+      const double u = x < x_narrow ? (x_narrow - x) / (x_narrow - x_aft_) : 0.0;
+      s.half_wl = lerp(b, HullShape::transom_half_beam * b, smooth(u));
+    }
+    // Flare and bilge: midbody values, blended to the bow over the shoulder and to the stern over the run.
+    const double to_bow = smooth((x - x_shoulder_) / (x_reamer_ - x_shoulder_));
+    const double to_stern = x < x_run_ ? smooth((x_run_ - x) / (x_run_ - x_aft_)) : 0.0;
+    s.flare_lo = deg(lerp(HullShape::flare_mid_lo_deg, HullShape::flare_bow_lo_deg, to_bow));
+    s.flare_up = deg(lerp(HullShape::flare_mid_up_deg, HullShape::flare_bow_up_deg, to_bow));
+    s.bilge = lerp(lerp(HullShape::bilge_mid_m, HullShape::bilge_bow_m, to_bow), HullShape::bilge_transom_m, to_stern);
+    return s;
+  }
+
+  // Starboard half of the section at x (y >= 0), bottom to deck; the port half is its mirror.
+  std::vector<Eigen::Vector2d> half_section(double x) const {
+    Station s = at(x);
+    std::vector<Eigen::Vector2d> pts;
+    const double zb = s.z_bottom, zd = z_deck_;
+    auto side_y = [&](double z) { return s.half_wl + z * std::tan(z <= 0 ? s.flare_lo : s.flare_up); };
+    if (zd - zb < 1e-3) {  // the stem head: the section has shrunk to the deck edge
+      pts.emplace_back(side_y(zd), zd);
+      return pts;
+    }
+    if (zb < 0)  // keep at least a quarter of the waterline half-breadth at the bottom for extreme particulars
+      s.flare_lo = std::min(s.flare_lo, std::atan(0.75 * s.half_wl / -zb));
+    const double yc = side_y(zb);  // bottom corner before rounding
+    const double beta = zb < 0 ? s.flare_lo : s.flare_up;
+    const Eigen::Vector2d dir(std::sin(beta), std::cos(beta));  // up the side from the corner
+    // Length of the straight side above the corner (to the knuckle at the waterline, or to the deck).
+    const double side_len = zb < 0 ? -zb / std::cos(beta) : (zd - zb) / std::cos(beta);
+    // Fillet tangent length for the corner angle 90 deg + beta, limited by the bottom and side available.
+    const double k = std::tan(0.5 * (0.5 * kPi + beta));
+    const double t = std::min({s.bilge / k, 0.95 * yc, 0.95 * side_len});
+    const double rad = t * k;
+    const Eigen::Vector2d corner(yc, zb);
+    const Eigen::Vector2d t1 = corner - Eigen::Vector2d(t, 0);
+    const Eigen::Vector2d centre = t1 + Eigen::Vector2d(0, rad);
+    pts.push_back(t1);
+    const int arc = 4;
+    const double a0 = -0.5 * kPi, a1 = -beta;  // from straight down to the side's outward normal
+    for (int i = 1; i < arc; ++i) {
+      const double a = lerp(a0, a1, double(i) / arc);
+      pts.push_back(centre + rad * Eigen::Vector2d(std::cos(a), std::sin(a)));
+    }
+    pts.push_back(corner + t * dir);
+    if (zb < 0) pts.emplace_back(s.half_wl, 0.0);  // waterline knuckle
+    pts.emplace_back(side_y(zd), zd);               // deck edge
+    return pts;
+  }
+
+  // The whole section at x (both sides, a ring) of the wedge bow: the section above cut by the two planes
+  //   |y| <= (x_s(z) - x) tan(alpha),  x_s(z) = x_forefoot + (z - z_keel) / tan(stem),
+  // which contain the stem line x_s(z) (the spoon's centreline) and meet the waterline at alpha to the centreline.
+  // A plane through a line rising at the stem angle phi whose waterline makes alpha with the centreline slopes at
+  // arctan(tan(phi) / sin(alpha)) across its waterline: Lindqvist's normal flare psi, exactly. Where the planes cut,
+  // the stem stays the spoon's line (they meet the centreline on it) and the sections become V-shaped.
+  std::vector<Eigen::Vector2d> wedge_section(double x) const {
+    const std::vector<Eigen::Vector2d> half = half_section(x);
+    std::vector<Eigen::Vector2d> ring(half.begin(), half.end());
+    for (auto it = half.rbegin(); it != half.rend(); ++it) ring.emplace_back(-it->x(), it->y());
+    for (const double side : {1.0, -1.0}) {
+      auto outside = [&](const Eigen::Vector2d& p) {  // > 0 beyond the plane on this side
+        return side * p.x() - (x_forefoot_ + (p.y() - z_keel_) / tan_stem_ - x) * tan_entrance_;
+      };
+      std::vector<Eigen::Vector2d> in;
+      in.swap(ring);
+      for (size_t i = 0; i < in.size(); ++i) {  // Sutherland-Hodgman against one plane
+        const Eigen::Vector2d &p = in[i], &q = in[(i + 1) % in.size()];
+        const double fp = outside(p), fq = outside(q);
+        if (fp <= 0) ring.push_back(p);
+        if ((fp < 0 && fq > 0) || (fp > 0 && fq < 0)) ring.push_back(p + (fp / (fp - fq)) * (q - p));
+      }
+    }
+    // Drop repeated and collinear points (a point on the centreline in the middle of the flat bottom or the deck
+    // edge), so that the convex parts are built from the section's corners only.
+    const double tol = 1e-9 * std::max(1.0, o_.length_m);
+    std::vector<Eigen::Vector2d> out;
+    for (const Eigen::Vector2d& p : ring)
+      if (out.empty() || (p - out.back()).norm() > tol) out.push_back(p);
+    while (out.size() > 1 && (out.front() - out.back()).norm() <= tol) out.pop_back();
+    for (bool again = out.size() >= 3; again && out.size() >= 3;) {
+      again = false;
+      for (size_t i = 0; i < out.size(); ++i) {
+        const Eigen::Vector2d &a = out[(i + out.size() - 1) % out.size()], &b = out[i], &c = out[(i + 1) % out.size()];
+        const Eigen::Vector2d u = b - a, w = c - b;
+        if (std::abs(u.x() * w.y() - u.y() * w.x()) <= tol * (u.norm() + w.norm())) {
+          out.erase(out.begin() + static_cast<long>(i));
+          again = true;
+          break;
+        }
+      }
+    }
+    if (out.empty()) out.emplace_back(0.0, z_deck_);  // the stem head, lost to round-off: keep its point
+    return out;
+  }
+
+ private:
+  HullGeneratorOptions o_;
+  double x_aft_, x_fwd_, z_keel_, z_deck_, tan_stem_, tan_entrance_, x_forefoot_, x_reamer_, x_shoulder_, x_run_;
+};
+
+// ---- mesh topology -----------------------------------------------------------------------------------------------
+
+struct Topology {
+  int unbalanced_edges = 0;   // edges not used equally often in both directions: holes or flipped triangles
+  int boundary_edges = 0;     // edges used once (holes)
+  int non_manifold_edges = 0;  // edges used more than twice
+  bool even = true;           // every edge used an even number of times (closed, maybe inconsistently oriented)
+};
+
+Topology topology(const TriMesh& m) {
+  std::map<std::pair<int, int>, std::pair<int, int>> uses;  // (lo, hi) -> (uses lo->hi, uses hi->lo)
+  for (const auto& t : m.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      if (a < b) ++uses[{a, b}].first;
+      else ++uses[{b, a}].second;
+    }
+  Topology top;
+  for (const auto& [e, u] : uses) {
+    const int total = u.first + u.second;
+    top.unbalanced_edges += u.first != u.second;
+    top.boundary_edges += total == 1;
+    top.non_manifold_edges += total > 2;
+    top.even = top.even && total % 2 == 0;
+  }
+  return top;
+}
+
+// Re-orients triangles consistently by walking across manifold edges (used by exactly two triangles): a neighbour
+// must use the shared edge in the opposite direction. Returns the number of triangles flipped.
+int orient_consistently(TriMesh& m) {
+  std::map<std::pair<int, int>, std::vector<int>> tris_of_edge;
+  for (int i = 0; i < static_cast<int>(m.triangles.size()); ++i)
+    for (int k = 0; k < 3; ++k) {
+      const int a = m.triangles[i][k], b = m.triangles[i][(k + 1) % 3];
+      tris_of_edge[{std::min(a, b), std::max(a, b)}].push_back(i);
+    }
+  auto uses_forward = [&](int t, int a, int b) {
+    for (int k = 0; k < 3; ++k)
+      if (m.triangles[t][k] == a && m.triangles[t][(k + 1) % 3] == b) return true;
+    return false;
+  };
+  std::vector<char> done(m.triangles.size(), 0);
+  int flipped = 0;
+  for (size_t seed = 0; seed < m.triangles.size(); ++seed) {
+    if (done[seed]) continue;
+    done[seed] = 1;
+    std::vector<int> queue{static_cast<int>(seed)};
+    for (size_t h = 0; h < queue.size(); ++h) {
+      const int t = queue[h];
+      for (int k = 0; k < 3; ++k) {
+        const int a = m.triangles[t][k], b = m.triangles[t][(k + 1) % 3];
+        const auto& nb = tris_of_edge[{std::min(a, b), std::max(a, b)}];
+        if (nb.size() != 2) continue;
+        const int u = nb[0] == t ? nb[1] : nb[0];
+        if (done[u]) continue;
+        done[u] = 1;
+        if (uses_forward(u, a, b)) {
+          std::swap(m.triangles[u][1], m.triangles[u][2]);
+          ++flipped;
+        }
+        queue.push_back(u);
+      }
+    }
+  }
+  return flipped;
+}
+
+void flip(TriMesh& m) {
+  for (auto& t : m.triangles) std::swap(t[1], t[2]);
+}
+
+// Welds vertices at identical positions and drops triangles that collapse; formats differ in how they share
+// vertices (OBJ groups, STL not at all) and assimp only joins vertices whose every attribute matches.
+TriMesh weld(const std::vector<Vec3>& v, const std::vector<std::array<int, 3>>& tris) {
+  TriMesh m;
+  std::map<std::array<double, 3>, int> index;
+  std::vector<int> remap(v.size());
+  for (size_t i = 0; i < v.size(); ++i) {
+    const auto [it, fresh] = index.emplace(std::array<double, 3>{v[i].x(), v[i].y(), v[i].z()},
+                                           static_cast<int>(m.vertices.size()));
+    if (fresh) m.vertices.push_back(v[i]);
+    remap[i] = it->second;
+  }
+  for (const auto& t : tris) {
+    const std::array<int, 3> u{remap[t[0]], remap[t[1]], remap[t[2]]};
+    if (u[0] != u[1] && u[1] != u[2] && u[2] != u[0]) m.triangles.push_back(u);
+  }
+  return m;
+}
+
+TriMesh merge(const std::vector<TriMesh>& parts) {
+  TriMesh m;
+  for (const TriMesh& p : parts) {
+    const int off = static_cast<int>(m.vertices.size());
+    m.vertices.insert(m.vertices.end(), p.vertices.begin(), p.vertices.end());
+    for (const auto& t : p.triangles) m.triangles.push_back({t[0] + off, t[1] + off, t[2] + off});
+  }
+  return m;
+}
+
+struct Bounds {
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+  Vec3 hi = Vec3::Constant(-std::numeric_limits<double>::infinity());
+  explicit Bounds(const std::vector<Vec3>& v) {
+    for (const Vec3& p : v) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  }
+  double diagonal() const { return (hi - lo).norm(); }
+  bool contains(const Vec3& p, double pad) const {
+    return (p.array() >= lo.array() - pad).all() && (p.array() <= hi.array() + pad).all();
+  }
+};
+
+// True if p is inside the convex mesh by more than `margin` (all its triangle planes at least `margin` above p).
+bool strictly_inside_convex(const TriMesh& m, const Vec3& p, double margin) {
+  for (const auto& t : m.triangles) {
+    const Vec3& a = m.vertices[t[0]];
+    const Vec3 n = (m.vertices[t[1]] - a).cross(m.vertices[t[2]] - a);
+    const double len = n.norm();
+    if (len == 0) continue;
+    if (n.dot(p - a) / len > -margin) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+// ---- generation and OBJ ----------------------------------------------------------------------------------------
+
+std::vector<TriMesh> generate_hull(const HullGeneratorOptions& o) {
+  {  // the options' own checks, also when the struct was filled in code rather than read from JSON
+    const Json none = Json::object();  // the reader keeps a reference: must outlive it
+    OptionReader r(none, "hull generator options", "");
+    const_cast<HullGeneratorOptions&>(o).visit(r);
+    r.finish();
+  }
+  const IcebreakerGeometry g(o);
+  const int n = o.sections;
+  // Stations evenly spaced, except that the one nearest the reamers moves onto them, so the widest waterline is
+  // a station and not cut off between two.
+  std::vector<double> xs(n + 1);
+  for (int i = 0; i <= n; ++i) xs[i] = g.x_aft() + (g.x_fwd() - g.x_aft()) * i / n;
+  const int near = static_cast<int>(std::lround((g.x_reamer() - g.x_aft()) / (g.x_fwd() - g.x_aft()) * n));
+  if (near > 0 && near < n) xs[near] = g.x_reamer();
+  std::vector<std::vector<Vec3>> stations(n + 1);
+  for (int i = 0; i <= n; ++i) {
+    const double x = grid(xs[i]);
+    if (g.wedge_bow()) {  // the whole section, cut by the wedge planes; its points on the centreline taken once
+      for (const auto& p : g.wedge_section(x)) stations[i].emplace_back(x, grid(p.x()), grid(p.y()));
+      auto less = [](const Vec3& a, const Vec3& b) {
+        return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+      };
+      std::sort(stations[i].begin(), stations[i].end(), less);
+      stations[i].erase(std::unique(stations[i].begin(), stations[i].end()), stations[i].end());
+      continue;
+    }
+    for (const auto& p : g.half_section(x)) {
+      const double y = grid(p.x()), z = grid(p.y());
+      stations[i].emplace_back(x, y, z);
+      stations[i].emplace_back(x, -y, z);
+    }
+  }
+  std::vector<TriMesh> parts;
+  for (int i = 0; i < n; ++i) {
+    std::vector<Vec3> pts = stations[i];
+    pts.insert(pts.end(), stations[i + 1].begin(), stations[i + 1].end());
+    parts.push_back(convex_hull(pts));
+  }
+  return parts;
+}
+
+void write_obj(const fs::path& file, const std::vector<TriMesh>& parts, const std::string& header) {
+  AtomicFile f(file);
+  {
+    std::ostringstream out;
+    std::istringstream h(header);
+    for (std::string line; std::getline(h, line);) out << "# " << line << "\n";
+    int base = 1;
+    char buf[128];
+    for (size_t k = 0; k < parts.size(); ++k) {
+      out << "o part_" << k << "\n";
+      for (const Vec3& v : parts[k].vertices) {
+        // %.17g round-trips any double; for the generator's grid coordinates it prints them short and exact.
+        std::snprintf(buf, sizeof buf, "v %.17g %.17g %.17g\n", v.x(), v.y(), v.z());
+        out << buf;
+      }
+      for (const auto& t : parts[k].triangles) out << "f " << t[0] + base << " " << t[1] + base << " " << t[2] + base << "\n";
+      base += static_cast<int>(parts[k].vertices.size());
+    }
+    write_file_checked(f.tmp(), out.str(), file);  // every write checked: a full disk is an error, named
+  }
+  f.commit();
+}
+
+// ---- hydrostatics ------------------------------------------------------------------------------------------------
+
+Hydrostatics hydrostatics(const std::vector<TriMesh>& parts, double rho_w, double z0) {
+  Hydrostatics h;
+  const TriMesh surface = merge(parts);
+  FLOESIM_REQUIRE(!surface.triangles.empty(), "hydrostatics: the hull has no triangles");
+  // Faces shared by two parts cancel in the signed sums (opposite orientations), so clipping the merged surface
+  // gives the union's displaced volume and waterplane as long as the parts do not overlap.
+  const Submerged s = submerged_part(surface.vertices, surface.triangles, z0);
+  const Bounds all(surface.vertices);
+  h.volume_m3 = s.volume;
+  h.displacement_t = rho_w * s.volume / 1000.0;
+  h.waterplane_area_m2 = s.waterplane_area;
+  h.centre_of_buoyancy = s.centroid;
+  h.lcb_m = s.centroid.x();
+  h.kb_m = s.centroid.z() - all.lo.z();
+  h.draught_m = z0 - all.lo.z();
+
+  // Waterplane extents from the points where edges cross z0.
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const auto& t : surface.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 &a = surface.vertices[t[k]], &b = surface.vertices[t[(k + 1) % 3]];
+      if ((a.z() - z0) * (b.z() - z0) > 0 || a.z() == b.z()) continue;
+      const Vec3 p = a + (b - a) * ((z0 - a.z()) / (b.z() - a.z()));
+      lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    }
+  if (lo.x() <= hi.x()) {
+    h.length_wl_m = hi.x() - lo.x();
+    h.beam_wl_m = hi.y() - lo.y();
+  }
+  if (h.length_wl_m > 0 && h.beam_wl_m > 0 && h.draught_m > 0)
+    h.block_coefficient = h.volume_m3 / (h.length_wl_m * h.beam_wl_m * h.draught_m);
+
+  // Wetted surface: area of each part's triangles below z0, except where material lies on both sides (a face
+  // shared with a neighbouring part): tested by nudging the clipped piece's centroid outwards and asking whether
+  // it is inside another part.
+  const double nudge = 1e-6 * all.diagonal();
+  std::vector<Bounds> boxes;
+  for (const TriMesh& p : parts) boxes.emplace_back(p.vertices);
+  for (size_t a = 0; a < parts.size(); ++a) {
+    const TriMesh& pa = parts[a];
+    for (const auto& t : pa.triangles) {
+      const Vec3* v[3] = {&pa.vertices[t[0]], &pa.vertices[t[1]], &pa.vertices[t[2]]};
+      std::vector<Vec3> poly;  // the triangle clipped to z < z0
+      for (int k = 0; k < 3; ++k) {
+        const Vec3 &p = *v[k], &q = *v[(k + 1) % 3];
+        const bool in_p = p.z() < z0, in_q = q.z() < z0;
+        if (in_p) poly.push_back(p);
+        if (in_p != in_q) poly.push_back(p + (q - p) * ((z0 - p.z()) / (q.z() - p.z())));
+      }
+      if (poly.size() < 3) continue;
+      Vec3 area_vec = Vec3::Zero(), c = Vec3::Zero();
+      double area = 0;
+      for (size_t k = 1; k + 1 < poly.size(); ++k) {
+        const Vec3 cr = (poly[k] - poly[0]).cross(poly[k + 1] - poly[0]);
+        area_vec += cr;
+        area += 0.5 * cr.norm();
+        c += 0.5 * cr.norm() * (poly[0] + poly[k] + poly[k + 1]) / 3.0;
+      }
+      if (area <= 0) continue;
+      const Vec3 probe = c / area + nudge * area_vec.normalized();
+      bool shared = false;
+      for (size_t b = 0; b < parts.size() && !shared; ++b)
+        shared = b != a && boxes[b].contains(probe, nudge) && strictly_inside_convex(parts[b], probe, 0.25 * nudge);
+      if (!shared) h.wetted_surface_m2 += area;
+    }
+  }
+  return h;
+}
+
+namespace {
+// The hydrostatics block of a hull sidecar (generated and imported hulls alike).
+nlohmann::json hydrostatics_json(const Hydrostatics& h, double rho_w) {
+  return {{"rho_w_kg_m3", rho_w},
+          {"volume_m3", h.volume_m3},
+          {"displacement_t", h.displacement_t},
+          {"waterplane_area_m2", h.waterplane_area_m2},
+          {"lcb_m", h.lcb_m},
+          {"kb_m", h.kb_m},
+          {"wetted_surface_m2", h.wetted_surface_m2},
+          {"length_wl_m", h.length_wl_m},
+          {"beam_wl_m", h.beam_wl_m},
+          {"draught_m", h.draught_m},
+          {"block_coefficient", h.block_coefficient},
+          {"centre_of_buoyancy_m", {h.centre_of_buoyancy.x(), h.centre_of_buoyancy.y(), h.centre_of_buoyancy.z()}}};
+}
+
+// The particulars the ice-resistance formulas take, measured from `surface`, into the sidecar and the summary. A hull
+// whose bow cannot be measured (a catamaran has no stem on its centreline) is still written: the sidecar then holds
+// "particulars": null and the reason, which floesim-resistance reports.
+void add_particulars(const TriMesh& surface, const std::string& where, nlohmann::json& side, std::ostream& sum) {
+  try {
+    const HullParticulars p = measure_particulars(surface, where);
+    side["particulars"] = particulars_json(p);
+    sum << "  ice particulars      L " << fmt_num(p.length_m) << " m, B " << fmt_num(p.beam_m) << " m, T "
+        << fmt_num(p.draught_m) << " m; stem angle phi " << fmt_num(p.stem_angle_deg, 4) << " deg, entrance angle alpha "
+        << fmt_num(p.entrance_angle_deg, 4) << " deg (at B/4), normal flare psi " << fmt_num(p.normal_flare_deg, 4)
+        << " deg; phi at B/4 " << fmt_num(p.bow_angle_b4_deg, 4) << " deg; parallel midbody "
+        << fmt_num(p.parallel_midbody_m, 4) << " m, bow length " << fmt_num(p.bow_length_m, 4) << " m\n";
+  } catch (const Error& e) {
+    side["particulars"] = nullptr;
+    side["particulars_error"] = e.what();
+    sum << "  ice particulars      not measured: " << e.what() << "\n";
+  }
+}
+
+}  // namespace
+
+std::string write_generated_hull(const HullGeneratorOptions& o, const fs::path& out_obj, const fs::path& config_file) {
+  const std::vector<TriMesh> parts = generate_hull(o);
+  constexpr double rho_w = 1025.0;
+  const Hydrostatics h = hydrostatics(parts, rho_w, 0.0);
+  const Bounds b(merge(parts).vertices);
+  size_t nv = 0, nt = 0;
+  for (const TriMesh& p : parts) nv += p.vertices.size(), nt += p.triangles.size();
+
+  std::ostringstream head;
+  head << "floesim parametric icebreaker (Oden's main particulars), " << parts.size() << " convex parts\n"
+       << "written by floesim-hull " << version() << "; frame: x forward, y to port, z up, metres; calm waterline"
+       << " z = 0; origin midship on the centreline\n"
+       << "length_m " << o.length_m << ", beam_m " << o.beam_m << ", reamer_beam_m " << o.reamer_beam_m
+       << ", draught_m " << o.draught_m << ", depth_m " << o.depth_m << ", stem_angle_deg " << o.stem_angle_deg
+       << ", entrance_angle_deg " << o.entrance_angle_deg << ", sections " << o.sections << "\n"
+       << "volume below z = 0: " << fmt_num(h.volume_m3) << " m^3; displacement " << fmt_num(h.displacement_t)
+       << " t at rho_w = " << rho_w << " kg/m^3\n"
+       << "waterplane area " << fmt_num(h.waterplane_area_m2) << " m^2, LCB " << fmt_num(h.lcb_m) << " m, KB "
+       << fmt_num(h.kb_m) << " m, wetted surface " << fmt_num(h.wetted_surface_m2) << " m^2\n";
+
+  nlohmann::json side;
+  side["provenance"] = make_provenance(
+      "floesim-hull",
+      config_file.empty() ? std::vector<NamedInput>{} : std::vector<NamedInput>{{"config", config_file}},
+      options_to_json(o));
+  side["hull_file"] = out_obj.filename().string();
+  side["frame"] = "x forward, y to port, z up; calm waterline z = 0; origin midship on the centreline; metres";
+  side["parts"] = parts.size();
+  side["vertices"] = nv;
+  side["triangles"] = nt;
+  side["extent_m"] = {{"x", {b.lo.x(), b.hi.x()}}, {"y", {b.lo.y(), b.hi.y()}}, {"z", {b.lo.z(), b.hi.z()}}};
+  side["hydrostatics"] = hydrostatics_json(h, rho_w);
+  std::ostringstream particulars_text;
+  add_particulars(merge(parts), "the generated hull", side, particulars_text);
+
+  fs::path sidecar = out_obj;
+  sidecar.replace_extension(".json");
+  FLOESIM_REQUIRE(sidecar != out_obj, out_obj.string(), ": the hull file must not end in .json (the sidecar does)");
+  ensure_directory(out_obj.parent_path());
+  write_obj(out_obj, parts, head.str());
+  write_text_atomic(sidecar, side.dump(2) + "\n");
+
+  std::ostringstream sum;
+  sum << "hull: " << parts.size() << " convex parts, " << nv << " vertices, " << nt << " triangles -> "
+      << out_obj.string() << " (+ " << sidecar.filename().string() << ")\n"
+      << "  extent x " << fmt_num(b.lo.x()) << " .. " << fmt_num(b.hi.x()) << " m, y " << fmt_num(b.lo.y()) << " .. "
+      << fmt_num(b.hi.y()) << " m, z " << fmt_num(b.lo.z()) << " .. " << fmt_num(b.hi.z()) << " m\n"
+      << "  volume below z = 0   " << fmt_num(h.volume_m3) << " m^3\n"
+      << "  displacement         " << fmt_num(h.displacement_t) << " t (rho_w " << rho_w << " kg/m^3)\n"
+      << "  waterplane area      " << fmt_num(h.waterplane_area_m2) << " m^2\n"
+      << "  waterline L x B      " << fmt_num(h.length_wl_m) << " x " << fmt_num(h.beam_wl_m) << " m\n"
+      << "  block coefficient    " << fmt_num(h.block_coefficient, 3) << " (on the waterline length and beam)\n"
+      << "  LCB                  " << fmt_num(h.lcb_m) << " m (x of the centre of buoyancy; + is forward of midship)\n"
+      << "  KB                   " << fmt_num(h.kb_m) << " m\n"
+      << "  wetted surface       " << fmt_num(h.wetted_surface_m2) << " m^2\n";
+  sum << particulars_text.str();
+  return sum.str();
+}
+
+// ---- loading ---------------------------------------------------------------------------------------------------
+
+namespace {
+
+struct Body {
+  std::string name;
+  TriMesh mesh;
+  std::string notes;  // topology repairs, for the report
+};
+
+// Sutherland-Hodgman step: keeps the part of `poly` with sign * (p[axis] - value) >= 0. A crossing point is
+// interpolated from the lexicographically smaller end of its edge, so neighbouring cells cut the same edge into the
+// same point.
+void clip_polygon(std::vector<Vec3>& poly, int axis, double value, double sign) {
+  if (poly.empty()) return;
+  std::vector<Vec3> out;
+  const size_t n = poly.size();
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3& p = poly[i];
+    const Vec3& q = poly[(i + 1) % n];
+    const double dp = sign * (p[axis] - value), dq = sign * (q[axis] - value);
+    if (dp >= 0) out.push_back(p);
+    if ((dp > 0 && dq < 0) || (dp < 0 && dq > 0)) {
+      const bool p_first = std::lexicographical_compare(p.data(), p.data() + 3, q.data(), q.data() + 3);
+      const Vec3& a = p_first ? p : q;
+      const Vec3& c = p_first ? q : p;
+      Vec3 x = a + (c - a) * ((value - a[axis]) / (c[axis] - a[axis]));
+      x[axis] = value;
+      out.push_back(x);
+    }
+  }
+  poly.swap(out);
+}
+
+// Volume of the closed mesh where x < x0: the triangles clipped to that half-space, summed as signed tetrahedra
+// with their apex on the plane x = x0, where the cap lies (so the cap adds nothing).
+double volume_behind(const TriMesh& m, double x0, const Vec3& centre) {
+  const Vec3 ref(x0, centre.y(), centre.z());
+  double v6 = 0;
+  std::vector<Vec3> poly;
+  for (const auto& t : m.triangles) {
+    poly = {m.vertices[t[0]], m.vertices[t[1]], m.vertices[t[2]]};
+    clip_polygon(poly, 0, x0, -1.0);
+    for (size_t k = 1; k + 1 < poly.size(); ++k)
+      v6 += (poly[0] - ref).dot((poly[k] - ref).cross(poly[k + 1] - ref));
+  }
+  return v6 / 6.0;
+}
+
+// The points whose convex hull is the hull of (solid inside the cell x in [a, b], z in [c, d]): every vertex of
+// the mesh's triangles clipped to the cell (mesh vertices inside it, edges crossing its planes, triangles crossing
+// its edge lines). Sorted and unique.
+std::vector<Vec3> cell_points(const TriMesh& m, const std::vector<int>& tris, double a, double b, double c, double d) {
+  std::vector<Vec3> pts, poly;
+  for (int i : tris) {
+    const auto& t = m.triangles[i];
+    poly = {m.vertices[t[0]], m.vertices[t[1]], m.vertices[t[2]]};
+    clip_polygon(poly, 0, a, 1.0);
+    clip_polygon(poly, 0, b, -1.0);
+    clip_polygon(poly, 2, c, 1.0);
+    clip_polygon(poly, 2, d, -1.0);
+    pts.insert(pts.end(), poly.begin(), poly.end());
+  }
+  auto less = [](const Vec3& p, const Vec3& q) {
+    return std::lexicographical_compare(p.data(), p.data() + 3, q.data(), q.data() + 3);
+  };
+  std::sort(pts.begin(), pts.end(), less);
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  return pts;
+}
+
+// Convex hull of a cell's points, or nothing if the cell holds no volume (a gap in the mesh along x or z).
+bool cell_hull(const std::vector<Vec3>& pts, double size, TriMesh& out) {
+  if (pts.size() < 4) return false;
+  const Bounds cb(pts);
+  if ((cb.hi - cb.lo).minCoeff() <= 1e-9 * size) return false;
+  out = convex_hull(pts);
+  return true;
+}
+
+struct Sliced {
+  std::vector<TriMesh> parts;
+  int layered_sections = 0;  // sections also cut horizontally
+  int max_layers = 1;
+  int merges = 0;            // neighbouring sections merged into one part
+};
+
+// Cuts a closed mesh into `n` sections along x and takes the convex hull of each. A section whose hull adds more
+// than `target` of its own volume (a bulbous bow, a skeg, flare over a narrow waterline: a concave cross-section)
+// is also cut by horizontal planes into 2, 4 or 8 layers, whichever first meets the target (else the best), with
+// one hull per cell. Cells share their cutting planes, so their hulls meet without overlapping. Then neighbouring
+// uncut sections are merged while the hull of both adds less than `merge` of their volume (a parallel middle body
+// needs no cuts), which keeps the part count, and so the contact work, down.
+Sliced slice_convex(const TriMesh& m, int n, double target, double merge) {
+  const Bounds b(m.vertices);
+  const double size = b.diagonal();
+  const Vec3 centre = 0.5 * (b.lo + b.hi);
+  std::vector<double> plane(n + 1);
+  for (int k = 0; k <= n; ++k) plane[k] = k == n ? b.hi.x() : b.lo.x() + (b.hi.x() - b.lo.x()) * k / n;
+  std::vector<double> behind(n + 1);
+  behind[0] = 0;
+  behind[n] = mass_properties(m).volume;
+  for (int k = 1; k < n; ++k) behind[k] = volume_behind(m, plane[k], centre);
+  // Triangles by section (those whose x range meets the section's).
+  std::vector<std::vector<int>> tris(n);
+  for (int i = 0; i < static_cast<int>(m.triangles.size()); ++i) {
+    const auto& t = m.triangles[i];
+    const double lo = std::min({m.vertices[t[0]].x(), m.vertices[t[1]].x(), m.vertices[t[2]].x()});
+    const double hi = std::max({m.vertices[t[0]].x(), m.vertices[t[1]].x(), m.vertices[t[2]].x()});
+    for (int k = 0; k < n; ++k)
+      if (hi >= plane[k] && lo <= plane[k + 1]) tris[k].push_back(i);
+  }
+  const double inf = std::numeric_limits<double>::infinity();
+  Sliced out;
+  bool open_run = false;  // the last part is an uncut section that the next may merge into
+  for (int k = 0; k < n; ++k) {
+    const double truth = behind[k + 1] - behind[k];
+    const std::vector<Vec3> pts = cell_points(m, tris[k], plane[k], plane[k + 1], -inf, inf);
+    TriMesh whole;
+    if (!cell_hull(pts, size, whole)) {
+      open_run = false;
+      continue;
+    }
+    std::vector<TriMesh> best{whole};
+    double best_excess = mass_properties(whole).volume - truth;
+    int best_layers = 1;
+    if (best_excess > target * truth) {
+      const Bounds sb(pts);
+      for (int layers : {2, 4, 8}) {
+        std::vector<TriMesh> cells;
+        double v = 0;
+        for (int j = 0; j < layers; ++j) {
+          const double c = j == 0 ? -inf : sb.lo.z() + (sb.hi.z() - sb.lo.z()) * j / layers;
+          const double d = j == layers - 1 ? inf : sb.lo.z() + (sb.hi.z() - sb.lo.z()) * (j + 1) / layers;
+          TriMesh cell;
+          if (!cell_hull(cell_points(m, tris[k], plane[k], plane[k + 1], c, d), size, cell)) continue;
+          v += mass_properties(cell).volume;
+          cells.push_back(std::move(cell));
+        }
+        if (v - truth < best_excess) best = std::move(cells), best_excess = v - truth, best_layers = layers;
+        if (best_excess <= target * truth) break;
+      }
+    }
+    if (best_layers > 1) {
+      ++out.layered_sections, out.max_layers = std::max(out.max_layers, best_layers);
+      for (TriMesh& p : best) out.parts.push_back(std::move(p));
+      open_run = false;
+      continue;
+    }
+    // Uncut section: merge into the previous part if that is an uncut section too and the union stays convex.
+    if (open_run) {
+      TriMesh& last = out.parts.back();
+      std::vector<Vec3> both = last.vertices;
+      both.insert(both.end(), whole.vertices.begin(), whole.vertices.end());
+      TriMesh merged = convex_hull(both);
+      const double v_sep = mass_properties(last).volume + mass_properties(whole).volume;
+      if (mass_properties(merged).volume - v_sep <= merge * v_sep) {
+        last = std::move(merged);
+        ++out.merges;
+        continue;
+      }
+    }
+    out.parts.push_back(std::move(whole));
+    open_run = true;
+  }
+  return out;
+}
+
+
+}  // namespace
+
+// A section whose convex hull adds more than this fraction of its volume is also cut horizontally.
+constexpr double kSectionExcessTarget = 0.02;
+// Neighbouring sections are merged into one part while the hull of both adds less than this fraction.
+constexpr double kMergeExcess = 0.001;
+
+HullModel hull_model_from_parts(std::vector<TriMesh> parts) {
+  HullModel h;
+  h.parts = std::move(parts);
+  h.surface = merge(h.parts);
+  h.mesh = h.surface;
+  return h;
+}
+
+HullModel load_hull(const fs::path& file, const HullLoadOptions& o, const HullPlacement& placement) {
+  const std::string where = file.string();
+  FLOESIM_REQUIRE(fs::exists(file), where, ": hull file not found");
+  FLOESIM_REQUIRE(fs::is_regular_file(file), where, ": not a regular file");
+  FLOESIM_REQUIRE(o.non_convex == "slice" || o.non_convex == "refuse", where,
+                  ": non_convex must be \"slice\" or \"refuse\", got \"", o.non_convex, "\"");
+  FLOESIM_REQUIRE(o.slices >= 2, where, ": slices must be >= 2, got ", o.slices);
+  FLOESIM_REQUIRE(placement.scale > 0 && std::isfinite(placement.scale), where, ": scale must be > 0, got ",
+                  placement.scale);
+  FLOESIM_REQUIRE(placement.origin_m.size() == 2, where, ": origin_m must be [x, y]");
+  try {
+    place_point(placement, Vec3::Zero());  // checks up_direction and bow_direction
+  } catch (const Error& e) {
+    throw Error(where + ": " + e.what());
+  }
+
+  Assimp::Importer importer;
+  // Our world is z-up like most CAD exports. assimp would turn a Collada file declaring Z_UP into its own y-up
+  // convention with a root rotation; keep the file's axes instead. (glTF is y-up by definition: such a hull must
+  // be exported z-up.)
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
+  // Triangulate n-gons; join identical vertices. No PreTransformVertices: node transforms are applied below, so
+  // a mesh instanced twice stays two parts.
+  const aiScene* scene = importer.ReadFile(where, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+  FLOESIM_REQUIRE(scene != nullptr, where, ": cannot read as a mesh file: ", importer.GetErrorString());
+  FLOESIM_REQUIRE(!(scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE), where, ": the file is incomplete or damaged");
+  FLOESIM_REQUIRE(scene->mRootNode != nullptr && scene->mNumMeshes > 0, where, ": the file holds no meshes");
+
+  // Every mesh instance in the node tree, in world coordinates.
+  struct Instance {
+    std::string name;
+    std::vector<Vec3> v;
+    std::vector<std::array<int, 3>> t;
+    int skipped_faces = 0;  // points and lines
+  };
+  std::vector<Instance> instances;
+  std::function<void(const aiNode*, const Eigen::Matrix4d&)> walk = [&](const aiNode* node, const Eigen::Matrix4d& up) {
+    Eigen::Matrix4d local;
+    const aiMatrix4x4& a = node->mTransformation;
+    local << a.a1, a.a2, a.a3, a.a4, a.b1, a.b2, a.b3, a.b4, a.c1, a.c2, a.c3, a.c4, a.d1, a.d2, a.d3, a.d4;
+    const Eigen::Matrix4d world = up * local;
+    const bool mirrored = world.topLeftCorner<3, 3>().determinant() < 0;
+    for (unsigned i = 0; i < node->mNumMeshes; ++i) {
+      // assimp does not validate what its importers build (no aiProcess_ValidateDataStructure, which also refuses
+      // harmless files): indices are checked here before they index anything.
+      FLOESIM_REQUIRE(node->mMeshes[i] < scene->mNumMeshes && scene->mMeshes[node->mMeshes[i]] != nullptr, where,
+                      ": the file's node tree references mesh ", node->mMeshes[i], " of ", scene->mNumMeshes,
+                      " (damaged file)");
+      const aiMesh* mesh = scene->mMeshes[node->mMeshes[i]];
+      Instance in;
+      in.name = mesh->mName.length > 0 ? mesh->mName.C_Str()
+                                       : (node->mName.length > 0 ? std::string(node->mName.C_Str()) : "mesh") +
+                                             "#" + std::to_string(node->mMeshes[i]);
+      for (unsigned k = 0; k < mesh->mNumVertices; ++k) {
+        const aiVector3D& p = mesh->mVertices[k];
+        const Eigen::Vector4d w = world * Eigen::Vector4d(p.x, p.y, p.z, 1.0);
+        in.v.emplace_back(w.x() / w.w(), w.y() / w.w(), w.z() / w.w());
+      }
+      for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+        const aiFace& face = mesh->mFaces[f];
+        if (face.mNumIndices != 3) {
+          ++in.skipped_faces;
+          continue;
+        }
+        for (unsigned k = 0; k < 3; ++k)
+          FLOESIM_REQUIRE(face.mIndices[k] < mesh->mNumVertices, where, ": mesh '", in.name, "' face ", f,
+                          " names vertex ", face.mIndices[k], " of ", mesh->mNumVertices, " (damaged file)");
+        std::array<int, 3> t{int(face.mIndices[0]), int(face.mIndices[1]), int(face.mIndices[2])};
+        if (mirrored) std::swap(t[1], t[2]);  // a mirroring transform turns outward normals inward
+        in.t.push_back(t);
+      }
+      instances.push_back(std::move(in));
+    }
+    for (unsigned c = 0; c < node->mNumChildren; ++c) walk(node->mChildren[c], world);
+  };
+  walk(scene->mRootNode, Eigen::Matrix4d::Identity());
+  FLOESIM_REQUIRE(!instances.empty(), where, ": the file's node tree references no meshes");
+
+  // The placement, before anything else: welding, slicing along x and the hydrostatics all work in the hull frame.
+  // Equal file positions stay equal (one deterministic map), so welding is unchanged. A proper rotation keeps the
+  // triangles' orientation.
+  double file_max_abs = 0;  // largest file coordinate: sets the rounding of single-precision input
+  for (Instance& in : instances)
+    for (Vec3& p : in.v) {
+      if (p.allFinite()) file_max_abs = std::max(file_max_abs, p.cwiseAbs().maxCoeff());
+      p = place_point(placement, p);
+    }
+
+  std::ostringstream report;
+  report << "placement: " << describe_placement(placement) << "\n";
+  // Closed meshes are bodies of their own. Meshes that are open on their own (an OBJ whose hull, deck and transom
+  // are separate groups, as in the KCS and DTMB 5415 benchmark files) are welded together and accepted as one body
+  // if together they close; otherwise the file is refused: buoyancy needs a watertight hull.
+  std::vector<Body> bodies;
+  std::vector<const Instance*> open;
+  for (const Instance& in : instances) {
+    for (const Vec3& p : in.v)
+      FLOESIM_REQUIRE(p.allFinite(), where, ": mesh '", in.name, "' has a non-finite vertex coordinate");
+    Body body{in.name, weld(in.v, in.t), ""};
+    if (in.skipped_faces > 0) body.notes += std::to_string(in.skipped_faces) + " point/line faces ignored; ";
+    FLOESIM_REQUIRE(!body.mesh.triangles.empty(), where, ": mesh '", in.name, "' has no triangles (degenerate mesh)");
+    Topology top = topology(body.mesh);
+    if (top.unbalanced_edges > 0 && top.even) {
+      const int f = orient_consistently(body.mesh);
+      top = topology(body.mesh);
+      if (top.unbalanced_edges == 0) body.notes += std::to_string(f) + " triangles re-oriented consistently; ";
+    }
+    if (top.unbalanced_edges == 0) {
+      if (top.non_manifold_edges > 0)
+        body.notes += std::to_string(top.non_manifold_edges) + " non-manifold edges; ";
+      bodies.push_back(std::move(body));
+    } else {
+      open.push_back(&in);
+    }
+  }
+  if (!open.empty()) {
+    Instance all;
+    std::string names;
+    for (const Instance* in : open) {
+      const int off = static_cast<int>(all.v.size());
+      all.v.insert(all.v.end(), in->v.begin(), in->v.end());
+      for (const auto& t : in->t) all.t.push_back({t[0] + off, t[1] + off, t[2] + off});
+      names += (names.empty() ? "'" : ", '") + in->name + "'";
+    }
+    Body body{open.size() == 1 ? open[0]->name : "", weld(all.v, all.t), ""};
+    if (open.size() > 1)
+      for (const Instance* in : open) body.name += (body.name.empty() ? "" : "+") + in->name;
+    Topology top = topology(body.mesh);
+    int flipped = 0;
+    if (top.unbalanced_edges > 0 && top.even) {
+      flipped = orient_consistently(body.mesh);
+      top = topology(body.mesh);
+    }
+    FLOESIM_REQUIRE(top.unbalanced_edges == 0, where, ": mesh", open.size() > 1 ? "es " : " ", names,
+                    open.size() > 1 ? " are" : " is", " not closed (", top.unbalanced_edges,
+                    " edges without a matching opposite edge, ", top.boundary_edges, " of them boundary edges, i.e. holes",
+                    open.size() > 1 ? ", also when welded together" : "",
+                    "); a hull must be watertight for buoyancy. Close the holes (e.g. Blender: Select > All by Trait >"
+                    " Non Manifold, then F to fill) and export again.");
+    if (open.size() > 1) body.notes += "open on their own, closed when welded together: one body; ";
+    if (flipped > 0) body.notes += std::to_string(flipped) + " triangles re-oriented consistently; ";
+    if (top.non_manifold_edges > 0) body.notes += std::to_string(top.non_manifold_edges) + " non-manifold edges; ";
+    bodies.push_back(std::move(body));
+  }
+
+  {  // where meshes meet (the KCS rudder on its hull): edges shared by more than two triangles of the whole file
+    Instance all;
+    for (const Instance& in : instances) {
+      const int off = static_cast<int>(all.v.size());
+      all.v.insert(all.v.end(), in.v.begin(), in.v.end());
+      for (const auto& t : in.t) all.t.push_back({t[0] + off, t[1] + off, t[2] + off});
+    }
+    int within = 0;
+    for (const Body& body : bodies) within += topology(body.mesh).non_manifold_edges;
+    const int total = topology(weld(all.v, all.t)).non_manifold_edges;
+    if (instances.size() > 1 && total > within)
+      report << "meshes touch each other along " << total - within
+             << " non-manifold edges (accepted: each body above is closed on its own)\n";
+  }
+
+  HullModel model;
+  for (Body& body : bodies) {
+    const Bounds bb(body.mesh.vertices);
+    const double size = bb.diagonal();
+    MassProperties mp = mass_properties(body.mesh);
+    FLOESIM_REQUIRE(body.mesh.vertices.size() >= 4 && size > 0 && std::abs(mp.volume) > 1e-9 * size * size * size,
+                    where, ": mesh '", body.name, "' is degenerate (it encloses no volume)");
+    if (mp.volume < 0) {
+      flip(body.mesh);
+      mp.volume = -mp.volume;
+      body.notes += "triangles faced inwards: flipped; ";
+    }
+    model.mesh_volume_m3 += mp.volume;
+    model.mesh = merge({model.mesh, body.mesh});
+    std::ostringstream line;
+    line << "mesh '" << body.name << "': closed, " << body.mesh.triangles.size() << " triangles, volume "
+         << fmt_num(mp.volume) << " m^3; " << body.notes;
+    // Tolerance relative to the mesh: assimp stores single-precision coordinates (relative error ~6e-8).
+    const double max_abs = std::max(bb.lo.cwiseAbs().maxCoeff(), bb.hi.cwiseAbs().maxCoeff());
+    const double tol = 1e-6 * std::max({size, max_abs, file_max_abs * placement.scale});
+    if (is_convex(body.mesh, tol)) {
+      line << "convex: kept as 1 part";
+      model.parts.push_back(std::move(body.mesh));
+      model.parts_volume_m3 += mp.volume;
+    } else {
+      FLOESIM_REQUIRE(o.non_convex == "slice", where, ": mesh '", body.name,
+                      "' is not convex (a vertex lies more than ", fmt_num(tol),
+                      " m outside the plane of a face); set \"non_convex\": \"slice\" to cut it into convex sections"
+                      " along x, or split it into convex meshes (one per object) yourself");
+      Sliced sliced;
+      try {
+        sliced = slice_convex(body.mesh, o.slices, kSectionExcessTarget, kMergeExcess);
+      } catch (const Error& e) {
+        throw Error(where + ": mesh '" + body.name + "': slicing into convex parts failed: " + e.what());
+      }
+      std::vector<TriMesh>& pieces = sliced.parts;
+      double v = 0;
+      for (const TriMesh& p : pieces) v += mass_properties(p).volume;
+      const double err = (v - mp.volume) / mp.volume;
+      FLOESIM_REQUIRE(std::abs(err) <= o.max_volume_error, where, ": mesh '", body.name, "' is not convex and its ",
+                      pieces.size(), " convex parts change its volume by ", percent(err), " (", fmt_num(mp.volume),
+                      " -> ", fmt_num(v), " m^3), more than max_volume_error = ", o.max_volume_error,
+                      "; raise \"slices\" or split the mesh into convex meshes (one per object) yourself");
+      line << "not convex: cut into " << o.slices << " sections along x";
+      if (sliced.layered_sections > 0)
+        line << " (" << sliced.layered_sections << " of them also into up to " << sliced.max_layers
+             << " horizontal layers)";
+      if (sliced.merges > 0) line << ", " << sliced.merges << " neighbouring sections merged";
+      line << ", " << pieces.size() << " convex part" << (pieces.size() == 1 ? "" : "s") << ", volume " << fmt_num(v) << " m^3 (" << percent(err) << ")";
+      model.parts_volume_m3 += v;
+      for (TriMesh& p : pieces) model.parts.push_back(std::move(p));
+    }
+    report << line.str() << "\n";
+  }
+  model.surface = merge(model.parts);
+  model.placement = placement;
+  report << "total: " << model.parts.size() << " convex part" << (model.parts.size() == 1 ? "" : "s")
+         << ", mesh volume " << fmt_num(model.mesh_volume_m3)
+         << " m^3, parts volume " << fmt_num(model.parts_volume_m3) << " m^3 ("
+         << percent((model.parts_volume_m3 - model.mesh_volume_m3) / model.mesh_volume_m3) << ")\n";
+  model.report = report.str();
+  return model;
+}
+
+
+// ---- placement of a mesh from CAD --------------------------------------------------------------------------------
+
+namespace {
+
+// A file axis named "+x" .. "-z": its index (0..2) and sign; Error naming `key` otherwise.
+struct Axis {
+  int index;
+  double sign;
+};
+Axis file_axis(const std::string& d, const char* key, const char* allowed) {
+  if (d.size() == 2 && (d[0] == '+' || d[0] == '-') && d[1] >= 'x' && d[1] <= 'z')
+    return {d[1] - 'x', d[0] == '+' ? 1.0 : -1.0};
+  throw Error(std::string(key) + " must be one of " + allowed + ", got \"" + d + "\"");
+}
+
+// The rotation of the placement as a signed permutation (hull axis k is file axis index[k] times sign[k]) and the
+// file point that becomes the hull origin.
+struct Frame {
+  int index[3];
+  double sign[3];
+  Vec3 origin;
+};
+Frame placement_frame(const HullPlacement& p) {
+  const Axis up = file_axis(p.up_direction, "up_direction", "+z, -z, +y, -y, +x, -x");
+  const Axis bow = file_axis(p.bow_direction, "bow_direction", "+x, -x, +y, -y, +z, -z");
+  FLOESIM_REQUIRE(up.index != bow.index, "bow_direction must be horizontal, across up_direction = \"",
+                  p.up_direction, "\", got \"", p.bow_direction,
+                  "\": set up_direction to the file's vertical axis (\"+y\" for a y-up export) and bow_direction to "
+                  "the axis the bow points along");
+  // Port = up x bow (z x x = y): the hull frame is right-handed whatever the two axes, so the map is a rotation.
+  Vec3 u = Vec3::Zero(), b = Vec3::Zero();
+  u[up.index] = up.sign;
+  b[bow.index] = bow.sign;
+  const Vec3 port = u.cross(b);
+  Frame f;
+  f.index[0] = bow.index, f.sign[0] = bow.sign;
+  f.index[2] = up.index, f.sign[2] = up.sign;
+  f.index[1] = 3 - up.index - bow.index, f.sign[1] = port[f.index[1]];
+  // origin_m on the horizontal axes in axis order, the waterline's height along up.
+  int h = 0;
+  for (int k = 0; k < 3; ++k) {
+    if (k == up.index) f.origin[k] = up.sign * p.waterline_z_m;
+    else f.origin[k] = p.origin_m.size() == 2 ? p.origin_m[h++] : 0.0;
+  }
+  return f;
+}
+
+std::string axis_name(int index, double sign) { return std::string(sign > 0 ? "+" : "-") + char('x' + index); }
+
+// The turn about z of a z-up placement (the hull's x from the bow), degrees.
+double bow_turn_deg(const std::string& bow) {
+  return bow == "-x" ? 180.0 : bow == "+y" ? -90.0 : bow == "-y" ? 90.0 : 0.0;
+}
+
+}  // namespace
+
+Vec3 place_point(const HullPlacement& p, const Vec3& q) {
+  // A permutation with signs (no products with zero): exact in floating point, and a proper rotation (port stays
+  // port, normals outward).
+  const Frame f = placement_frame(p);
+  const Vec3 d = q - f.origin;
+  return p.scale * Vec3(f.sign[0] * d[f.index[0]], f.sign[1] * d[f.index[1]], f.sign[2] * d[f.index[2]]);
+}
+
+std::string describe_placement(const HullPlacement& p) {
+  const Frame f = placement_frame(p);
+  std::ostringstream s;
+  s << "scale " << fmt_num(p.scale) << "; ";
+  if (p.up_direction == "+z") {
+    s << "bow towards " << p.bow_direction;
+    if (p.bow_direction == "+x") s << " (no turn)";
+    else s << ", turned " << fmt_num(bow_turn_deg(p.bow_direction)) << " deg about z to +x";
+    s << "; calm waterline at file z = " << fmt_num(p.waterline_z_m) << " -> z = 0";
+    s << "; file (x, y) = (" << fmt_num(f.origin.x()) << ", " << fmt_num(f.origin.y()) << ") -> origin";
+  } else {
+    // Which file axis each hull axis is, and the file point that becomes the origin.
+    s << "up towards " << p.up_direction << ", bow towards " << p.bow_direction << ": hull x = file "
+      << axis_name(f.index[0], f.sign[0]) << ", y = file " << axis_name(f.index[1], f.sign[1]) << ", z = file "
+      << axis_name(f.index[2], f.sign[2]) << "; calm waterline at file " << p.up_direction.substr(1) << " = "
+      << fmt_num(f.origin[p.up_direction[1] - 'x']) << " -> z = 0; file (x, y, z) = (" << fmt_num(f.origin.x())
+      << ", " << fmt_num(f.origin.y()) << ", " << fmt_num(f.origin.z()) << ") -> origin";
+  }
+  return s.str();
+}
+
+void require_floating(const HullModel& hull, const std::string& where) {
+  FLOESIM_REQUIRE(!hull.surface.vertices.empty(), where, ": the hull has no parts");
+  const Bounds b(hull.surface.vertices);
+  const HullPlacement& p = hull.placement;
+  // The hull's z range in the file's own frame and units, for the message.
+  const double f_lo = b.lo.z() / p.scale + p.waterline_z_m, f_hi = b.hi.z() / p.scale + p.waterline_z_m;
+  const std::string height = p.up_direction == "+z" ? std::string("file z") : "height along " + p.up_direction;
+  const std::string fix = "; set waterline_z_m to the height of the calm waterline in the mesh's own frame, "
+                          "between its keel and deck (" + height + " from " + fmt_num(f_lo) + " to " + fmt_num(f_hi) +
+                          "; e.g. keel + draught for a mesh with its keel at height 0), and up_direction to the "
+                          "file's vertical axis if the mesh lies on its side or upside down (\"+y\" for a y-up "
+                          "export)";
+  FLOESIM_REQUIRE(b.lo.z() < 0, where, ": waterline_z_m = ", fmt_num(p.waterline_z_m),
+                  " puts the whole hull above the water (its lowest point is ", fmt_num(b.lo.z()),
+                  " m above the waterline): it would displace nothing", fix);
+  FLOESIM_REQUIRE(b.hi.z() > 0, where, ": waterline_z_m = ", fmt_num(p.waterline_z_m),
+                  " puts the whole hull under water (its highest point is ", fmt_num(-b.hi.z()),
+                  " m below the waterline): a ship must pierce the surface", fix);
+  // A waterline at the keel (a few micrometres of keel below it) or at the deck is a placement error too: a ship
+  // displaces a good part of its volume (half or so), not nothing and not all of it.
+  const double v = submerged_part(hull.surface.vertices, hull.surface.triangles, 0.0).volume;
+  const double f = v / hull.parts_volume_m3;
+  FLOESIM_REQUIRE(f >= 0.01, where, ": waterline_z_m = ", fmt_num(p.waterline_z_m),
+                  " leaves the hull a displacement of (almost) zero (", fmt_num(v), " m^3 below the waterline, ",
+                  percent(f), " of its volume)", fix);
+  FLOESIM_REQUIRE(f <= 0.99, where, ": waterline_z_m = ", fmt_num(p.waterline_z_m), " puts (almost) the whole hull "
+                  "under water (", percent(f), " of its volume below the waterline)", fix);
+}
+
+namespace {
+
+// Mass in the unit that reads best: kg for a model, t for a ship.
+std::string mass_text(double kg) { return kg < 1e4 ? fmt_num(kg, 4) + " kg" : fmt_num(kg / 1000.0, 5) + " t"; }
+
+}  // namespace
+
+std::string write_imported_hull(const HullImportOptions& o, const fs::path& out_obj, const fs::path& config_file) {
+  const std::string where = config_file.empty() ? std::string("hull options") : config_file.string();
+  {  // the options' own checks, also when the struct was filled in code rather than read from JSON
+    const Json none = Json::object();
+    OptionReader r(none, where, "");
+    const_cast<HullImportOptions&>(o).visit(r);
+    r.finish();
+  }
+  fs::path mesh_file = o.file;
+  if (mesh_file.is_relative() && !config_file.empty()) mesh_file = config_file.parent_path() / mesh_file;
+  FLOESIM_REQUIRE(fs::exists(mesh_file), where, ": file names ", mesh_file.string(), ", which does not exist");
+
+  // 1. Load, place, decompose; refuse a hull that does not float.
+  HullModel m = load_hull(mesh_file, o.load, o.placement);
+  require_floating(m, where);
+  // The parts go to an OBJ that the simulator reads with assimp in single precision. Rounded to float, a part's
+  // sliver faces would tilt and the part would no longer pass as convex. So, as for the generated hull, each part
+  // is snapped to a binary grid that floats hold exactly (the float spacing at the hull's largest coordinate) and
+  // is rebuilt as the convex hull of its snapped vertices: what is written is read back bit for bit, and convex.
+  {
+    const Bounds all(m.surface.vertices);
+    const double max_abs = std::max(all.lo.cwiseAbs().maxCoeff(), all.hi.cwiseAbs().maxCoeff());
+    const double g = std::ldexp(1.0, static_cast<int>(std::ceil(std::log2(max_abs))) - 23);
+    double v = 0;
+    for (TriMesh& part : m.parts) {
+      for (Vec3& p : part.vertices) p = (p / g).array().round().matrix() * g;
+      part = convex_hull(part.vertices);
+      v += mass_properties(part).volume;
+    }
+    m.parts_volume_m3 = v;
+    m.surface = merge(m.parts);
+  }
+
+  // 2. What it displaces, by the convex parts (what the simulator floats) and by the mesh itself (the reference).
+  const double rho = o.water_density_kg_m3;
+  const Hydrostatics h = hydrostatics(m.parts, rho, 0.0);
+  const double v_mesh = submerged_part(m.mesh.vertices, m.mesh.triangles, 0.0).volume;
+  const double volume_error = (m.parts_volume_m3 - m.mesh_volume_m3) / m.mesh_volume_m3;
+  const double displacement_error = (h.volume_m3 - v_mesh) / v_mesh;
+  const Bounds b(m.surface.vertices);
+  // The draught at mid-waterline-length (the keel line there: a sonar dome or skeg does not count) and the deepest.
+  double x_wl_lo = std::numeric_limits<double>::infinity(), x_wl_hi = -x_wl_lo;
+  for (const auto& t : m.surface.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 &a = m.surface.vertices[t[k]], &c = m.surface.vertices[t[(k + 1) % 3]];
+      if (a.z() * c.z() > 0 || a.z() == c.z()) continue;
+      const double x = a.x() + (c.x() - a.x()) * (-a.z() / (c.z() - a.z()));
+      x_wl_lo = std::min(x_wl_lo, x), x_wl_hi = std::max(x_wl_hi, x);
+    }
+  const double x_mid = 0.5 * (x_wl_lo + x_wl_hi);
+  const double draught_mid = -lowest_z_at(m.surface, x_mid);
+  size_t nv = 0, nt = 0;
+  for (const TriMesh& p : m.parts) nv += p.vertices.size(), nt += p.triangles.size();
+
+  std::ostringstream head;
+  head << "floesim hull from " << mesh_file.filename().string() << ", " << m.parts.size() << " convex parts\n"
+       << "written by floesim-hull " << version() << "; frame: x forward, y to port, z up, metres; calm waterline"
+       << " z = 0\n"
+       << "placement: " << describe_placement(o.placement) << "\n"
+       << "volume below z = 0: " << fmt_num(h.volume_m3) << " m^3 (mesh " << fmt_num(v_mesh) << " m^3, "
+       << percent(displacement_error) << "); displacement " << mass_text(rho * h.volume_m3) << " at rho_w = " << rho
+       << " kg/m^3\n";
+
+  nlohmann::json side;
+  std::vector<NamedInput> inputs;
+  inputs.push_back({"mesh", mesh_file});
+  if (!config_file.empty()) inputs.push_back({"config", config_file});
+  side["provenance"] = make_provenance("floesim-hull", inputs, options_to_json(o));
+  side["hull_file"] = out_obj.filename().string();
+  side["source_file"] = mesh_file.string();
+  side["frame"] = "x forward, y to port, z up; calm waterline z = 0; origin at the placement's origin_m; metres";
+  {
+    const Frame f = placement_frame(o.placement);
+    side["placement"] = {{"scale", o.placement.scale},
+                         {"up_direction", o.placement.up_direction},
+                         {"bow_direction", o.placement.bow_direction},
+                         {"hull_axes_in_file", {axis_name(f.index[0], f.sign[0]), axis_name(f.index[1], f.sign[1]),
+                                                axis_name(f.index[2], f.sign[2])}},
+                         {"waterline_z_m", o.placement.waterline_z_m},
+                         {"origin_m", o.placement.origin_m},
+                         {"origin_in_file_m", {f.origin.x(), f.origin.y(), f.origin.z()}},
+                         {"description", describe_placement(o.placement)}};
+    // The turn about z alone describes a z-up file's placement.
+    if (o.placement.up_direction == "+z") side["placement"]["turn_about_z_deg"] = bow_turn_deg(o.placement.bow_direction);
+  }
+  side["parts"] = m.parts.size();
+  side["vertices"] = nv;
+  side["triangles"] = nt;
+  side["extent_m"] = {{"x", {b.lo.x(), b.hi.x()}}, {"y", {b.lo.y(), b.hi.y()}}, {"z", {b.lo.z(), b.hi.z()}}};
+  side["mesh_volume_m3"] = m.mesh_volume_m3;
+  side["parts_volume_m3"] = m.parts_volume_m3;
+  side["volume_error"] = volume_error;
+  side["mesh_displaced_volume_m3"] = v_mesh;
+  side["displaced_volume_error"] = displacement_error;
+  side["displacement_kg"] = rho * h.volume_m3;
+  side["waterline"] = {{"z_in_file", o.placement.waterline_z_m},
+                       {"length_wl_m", h.length_wl_m},
+                       {"beam_wl_m", h.beam_wl_m},
+                       {"x_wl_m", {x_wl_lo, x_wl_hi}},
+                       {"draught_mid_wl_m", draught_mid},
+                       {"draught_max_m", h.draught_m}};
+  side["hydrostatics"] = hydrostatics_json(h, rho);
+  // The particulars of the mesh as read and placed (the reference), not of its convex parts.
+  std::ostringstream particulars_text;
+  add_particulars(m.mesh, mesh_file.string(), side, particulars_text);
+  {  // what the loader did, one line per entry (placement, meshes, total)
+    nlohmann::json lines = nlohmann::json::array();
+    std::istringstream rep(m.report);
+    for (std::string line; std::getline(rep, line);) lines.push_back(line);
+    side["loader_report"] = lines;
+  }
+
+  fs::path sidecar = out_obj;
+  sidecar.replace_extension(".json");
+  FLOESIM_REQUIRE(sidecar != out_obj, out_obj.string(), ": the hull file must not end in .json (the sidecar does)");
+  ensure_directory(out_obj.parent_path());
+  write_obj(out_obj, m.parts, head.str());
+  write_text_atomic(sidecar, side.dump(2) + "\n");
+
+  std::ostringstream sum;
+  sum << "hull: " << mesh_file.filename().string() << " -> " << m.parts.size() << " convex parts, " << nv
+      << " vertices, " << nt << " triangles -> " << out_obj.string() << " (+ " << sidecar.filename().string() << ")\n"
+      << "  placement            " << describe_placement(o.placement) << "\n"
+      << "  extent x " << fmt_num(b.lo.x()) << " .. " << fmt_num(b.hi.x()) << " m, y " << fmt_num(b.lo.y()) << " .. "
+      << fmt_num(b.hi.y()) << " m, z " << fmt_num(b.lo.z()) << " .. " << fmt_num(b.hi.z()) << " m\n"
+      << "  volume               mesh " << fmt_num(m.mesh_volume_m3) << " m^3, convex parts "
+      << fmt_num(m.parts_volume_m3) << " m^3 (" << percent(volume_error) << ")\n"
+      << "  volume below z = 0   mesh " << fmt_num(v_mesh) << " m^3, convex parts " << fmt_num(h.volume_m3)
+      << " m^3 (" << percent(displacement_error) << ")\n"
+      << "  displacement         " << mass_text(rho * h.volume_m3) << " (rho_w " << rho << " kg/m^3)\n"
+      << "  waterline            "
+      << (o.placement.up_direction == "+z" ? std::string("file z") : "height along file " + o.placement.up_direction)
+      << " = " << fmt_num(o.placement.waterline_z_m) << "; L x B "
+      << fmt_num(h.length_wl_m) << " x " << fmt_num(h.beam_wl_m) << " m, x " << fmt_num(x_wl_lo) << " .. "
+      << fmt_num(x_wl_hi) << " m\n"
+      << "  draught              " << fmt_num(draught_mid) << " m at mid waterline length, " << fmt_num(h.draught_m)
+      << " m at the deepest point\n"
+      << "  waterplane area      " << fmt_num(h.waterplane_area_m2) << " m^2, LCB " << fmt_num(h.lcb_m) << " m, KB "
+      << fmt_num(h.kb_m) << " m, wetted surface " << fmt_num(h.wetted_surface_m2) << " m^2\n"
+      << particulars_text.str() << "loader:\n";
+  std::istringstream rep(m.report);
+  for (std::string line; std::getline(rep, line);) sum << "  " << line << "\n";
+  return sum.str();
+}
+
+}  // namespace floesim::sim
