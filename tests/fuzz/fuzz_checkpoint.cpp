@@ -49,6 +49,7 @@ constexpr size_t kHashChars = 64;
 
 // The run the checkpoints belong to (tests/sim/small_breaking_run.h, shared with sim_checkpoint_test).
 using floesim::sim::testing::fresh_results;
+using floesim::sim::testing::small_breaking_run_options;
 
 const Model& the_model() {
   static const Model model = floesim::sim::testing::small_breaking_run();
@@ -139,7 +140,7 @@ void write_seeds(const fs::path& dir) {
   plan.dir = run / "checkpoint";
   plan.provenance = the_provenance();
   RunStats stats;
-  const Results r = simulate(the_model(), stats, nullptr, &plan);
+  const Results r = simulate(small_breaking_run_options(), the_model(), stats, nullptr, &plan);
   std::vector<std::string> files = {read_file(plan.dir / "checkpoint.bin")};
   for (size_t k = 1; fs::exists(records_file(plan.dir, k)); ++k) files.push_back(read_file(records_file(plan.dir, k)));
   std::string raw(1, '\0'), sealed(1, '\2');
@@ -196,7 +197,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     Checkpointer cp(dir, the_provenance(), spill);
     Results r = fresh_results();
     RecorderSums sums;
-    const std::unique_ptr<World> w = cp.resume(model, r, sums, nullptr);
+    const std::unique_ptr<World> w = cp.resume(small_breaking_run_options(), model, r, sums, nullptr);
     if (!w) std::abort();  // checkpoint.bin was written: resume must read it or refuse it
     // What an accepted checkpoint promises simulate(), which goes on appending to these arrays and then writes them:
     // the world and the results at the same step, every series step x columns, frames indexing their states.
