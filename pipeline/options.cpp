@@ -54,13 +54,44 @@ OptionReader::OptionReader(const Json& j, std::string file, std::string path,
                            std::shared_ptr<std::vector<std::string>> p)
     : j_(j), file_(std::move(file)), path_(std::move(path)), problems_(std::move(p)) {}
 
+namespace {
+
+// Levenshtein distance between two keys (insertions, deletions and substitutions of one character each).
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+}  // namespace
+
+std::string closest_key(const std::string& key, const std::vector<std::string>& known) {
+  std::string best;
+  size_t best_d = std::max<size_t>(2, key.size() / 3) + 1;  // a typo: at most a third of the key (2 for short ones)
+  for (const std::string& k : known)
+    if (const size_t d = edit_distance(key, k); d < best_d) best = k, best_d = d;
+  return best;
+}
+
 void OptionReader::check_unknown() {
   if (!j_.is_object()) return;
   for (auto it = j_.begin(); it != j_.end(); ++it) {
     if (std::find(seen_.begin(), seen_.end(), it.key()) != seen_.end()) continue;
     std::string known;
     for (auto& s : seen_) known += (known.empty() ? "" : ", ") + s;
-    problems_->push_back(where(it.key()) + " is not a known key (a typo?); known keys here: " + known);
+    const std::string guess = closest_key(it.key(), seen_);
+    problems_->push_back(where(it.key()) + " is not a known key" +
+                         (guess.empty() ? std::string(" (a typo?); known") : "; did you mean " + guess + "? Known") +
+                         " keys here: " + known);
   }
 }
 

@@ -43,6 +43,10 @@ Check<std::string> one_of(std::vector<std::string> choices);
 Json load_json_file(const std::filesystem::path& file);
 
 // Collects problems while visiting; throws one Error listing all of them in finish().
+// The known key a mistyped one most likely meant (edit distance at most a third of its length, 2 for short keys);
+// "" when none is that close.
+std::string closest_key(const std::string& key, const std::vector<std::string>& known);
+
 class OptionReader {
  public:
   OptionReader(const Json& j, std::string file, std::string path);
@@ -248,17 +252,31 @@ S read_options(const Json& j, const std::string& file, const std::string& path =
   return s;
 }
 
+// Runs the options' own checks (ranges and cross-field checks) on a struct filled in code rather than read from
+// JSON, and throws every problem at once as read_options does, naming `where`. The visit reads a copy: a visit
+// takes its struct by reference for reading, and the caller's stays as it is.
+template <class S>
+void check_options(const S& s, const std::string& where) {
+  const Json none = Json::object();  // the reader keeps a reference: must outlive it
+  OptionReader r(none, where, "");
+  S copy = s;
+  copy.visit(r);
+  r.finish();
+}
+
 template <class S>
 Json options_to_json(const S& s) {
   OptionWriter w;
-  const_cast<S&>(s).visit(w);
+  S copy = s;  // visit takes its struct by reference, for reading as for writing
+  copy.visit(w);
   return w.out;
 }
 
 template <class S>
 std::string options_doc(const S& s) {
   OptionDocWriter w;
-  const_cast<S&>(s).visit(w);
+  S copy = s;
+  copy.visit(w);
   return "| key | default | unit | meaning |\n|---|---|---|---|\n" + w.rows;
 }
 

@@ -3,7 +3,7 @@
 #include <iostream>
 
 #include "pipeline/stage_main.h"
-#include "render/gather.h"
+#include "render/sweep_plots.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"Gather the members of a sweep: one row per member, ensemble means with 95 % confidence intervals "
@@ -13,9 +13,9 @@ int main(int argc, char** argv) {
   app.add_option("--plan", plan, "the sweep's plan (RUN/plan.json, written by floesim sweep)")->required();
   app.add_option("--out", out, "output directory (usually RUN)")->required();
   return floesim::run_stage(app, argc, argv, [&] {
-    const floesim::render::SweepPlan p = floesim::render::read_sweep_plan(plan);
+    const floesim::sweep::SweepPlan p = floesim::sweep::read_sweep_plan(plan);
     const auto g = floesim::render::gather_sweep(p, plan, out);
-    std::cout << floesim::render::gather_table(p, g) << "wrote";
+    std::cout << floesim::sweep::gather_table(p, g) << "wrote";
     for (const auto& f : g.files) std::cout << " " << (std::filesystem::path(out) / f).string();
     std::cout << "\n";
   });

@@ -59,235 +59,262 @@ void write_decimated(std::ostream& os, const std::vector<double>& t, const std::
 
 }  // namespace
 
-std::vector<double> surge_ice_resistance_kN(const Results& r, const std::string& source) {
-  const std::vector<double>& t = r.get("time_s");
-  const std::vector<double>& load = r.get("ice_load");
-  FLOESIM_REQUIRE(load.size() == 6 * t.size(), source, ": series ice_load does not have 6 columns per step");
-  std::vector<double> res(t.size());
-  for (size_t i = 0; i < t.size(); ++i) res[i] = -load[6 * i] / 1000.0;
-  for (size_t i = 0; i < t.size(); ++i)
-    FLOESIM_REQUIRE(std::isfinite(res[i]) && std::isfinite(t[i]), source, ": ice_load or time_s is not finite at step ",
-                    i, " (t = ", t[i], " s); the simulation blew up");
-  return res;
-}
+namespace {
 
-std::string recorded_contact_model(const Results& r, const std::string& source) {
-  const Json& attrs = r.attributes;
-  if (!attrs.contains("contact_model")) return "rigid";
-  FLOESIM_REQUIRE(attrs["contact_model"].is_string(), source, ": attribute contact_model must be a string");
-  const std::string m = attrs["contact_model"].get<std::string>();
-  FLOESIM_REQUIRE(m == "rigid" || m == "compliant" || m == "mixed", source, ": attribute contact_model is \"", m,
-                  "\"; expected rigid, compliant or mixed");
-  return m;
-}
+// The centred moving average of step 2.
+struct MovingAverage {
+  std::vector<double> ma;
+  size_t f0 = 0, f1 = 0;  // [f0, f1): the samples reported (whole windows; all if the run is shorter)
+};
 
-double auto_moving_average_window_s(const Results& r, const std::string& source) {
-  return recorded_contact_model(r, source) == "rigid" ? 20.0 : 0.5;
-}
-
-double recorded_steady_start_s(const Results& r, const std::string& source) {
-  if (!r.attributes.contains("steady_start_s")) return 0;
-  FLOESIM_REQUIRE(r.attributes["steady_start_s"].is_number(), source, ": attribute steady_start_s must be a number");
-  return r.attributes["steady_start_s"].get<double>();
-}
-
-SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const fs::path& out_dir,
-                                 const nlohmann::json& provenance, const std::string& source) {
-  SurgeLoadSummary s;
-  // 1. The signal: ice resistance = -Fx (body x, surge) in kN.
-  const std::vector<double>& t = r.get("time_s");
-  const std::vector<double> res = surge_ice_resistance_kN(r, source);
-  s.time_step_s = uniform_step(t, (source + ": series time_s").c_str());
-
-  // 2. The window: "auto" follows the contact model the simulator recorded (PHYSICS.md §5).
+// 2. The window ("auto" follows the contact model the simulator recorded, PHYSICS.md §5) and the centred moving
+// average. Only samples whose whole window lies in the run are reported: near the ends a cut window averages what
+// is left (e.g. 10 s of open water and one spike) and looks like data it is not. If the run is shorter than the
+// window, the cut averages are all there is; they are shown and flagged.
+MovingAverage centred_moving_average(const Results& r, const PlotOptions& o, const std::vector<double>& res,
+                                     const std::string& source, SurgeLoadSummary& s) {
   s.contact_model = recorded_contact_model(r, source);
   s.window_s = o.moving_average_window_s.is_string() ? auto_moving_average_window_s(r, source)
                                                      : o.moving_average_window_s.get<double>();
   s.window_samples = window_samples(s.window_s, s.time_step_s);
-  const std::vector<double> ma = moving_average_centred(res, s.window_samples);
-  // Only samples whose whole window lies in the run are reported: near the ends a cut window averages what is
-  // left (e.g. 10 s of open water and one spike) and looks like data it is not. If the run is shorter than the
-  // window, the cut averages are all there is; they are shown and flagged.
+  MovingAverage m;
+  m.ma = moving_average_centred(res, s.window_samples);
   auto [f0, f1] = full_window_range(res.size(), s.window_samples);
   s.moving_average_complete = f0 < f1;
   if (!s.moving_average_complete) f0 = 0, f1 = res.size();
+  m.f0 = f0;
+  m.f1 = f1;
+  return m;
+}
 
-  // 3. The steady part and its mean (of the unfiltered signal: the primary validation metric).
+// 3. The steady part and its mean (of the unfiltered signal: the primary validation metric), the moving average's
+// spread and peak over it (reported samples only), and the raw peak.
+void steady_statistics(const Results& r, const PlotOptions& o, const std::vector<double>& t,
+                       const std::vector<double>& res, const MovingAverage& m, const std::string& source,
+                       SurgeLoadSummary& s) {
   s.steady_start_s =
       o.steady_start_s.is_number() ? o.steady_start_s.get<double>() : recorded_steady_start_s(r, source);
-  const SteadyMean m = mean_from(t, res, s.steady_start_s);
-  s.mean_kN = m.mean;
-  s.steady_samples = m.samples;
-  {
-    double sum2 = 0, mx = -1e300;
-    size_t c = 0;
-    for (size_t i = f0; i < f1; ++i)
-      if (t[i] >= s.steady_start_s) {
-        const double d = ma[i] - m.mean;
-        sum2 += d * d, mx = std::max(mx, ma[i]), ++c;
-      }
-    s.moving_average_std_kN = c > 0 ? std::sqrt(sum2 / static_cast<double>(c)) : std::nan("");
-    s.moving_average_max_kN = c > 0 ? mx : std::nan("");
-  }
+  const SteadyMean sm = mean_from(t, res, s.steady_start_s);
+  s.mean_kN = sm.mean;
+  s.steady_samples = sm.samples;
+  double sum2 = 0, mx = -1e300;
+  size_t c = 0;
+  for (size_t i = m.f0; i < m.f1; ++i)
+    if (t[i] >= s.steady_start_s) {
+      const double d = m.ma[i] - sm.mean;
+      sum2 += d * d, mx = std::max(mx, m.ma[i]), ++c;
+    }
+  s.moving_average_std_kN = c > 0 ? std::sqrt(sum2 / static_cast<double>(c)) : std::nan("");
+  s.moving_average_max_kN = c > 0 ? mx : std::nan("");
   s.raw_max_kN = *std::max_element(res.begin(), res.end());
+}
 
-  // 4. Fracture events. Only those at the vessel are marked: the plot is of the load on the vessel, and a floe
-  // that breaks against another floe changes it only indirectly. Every event goes into fracture_events.csv.
+// The times of the fracture events at the vessel, by marker style.
+struct VesselEvents {
+  std::vector<double> split_t, bend_t;
+};
+
+// 4. Fracture events. Only those at the vessel are marked: the plot is of the load on the vessel, and a floe that
+// breaks against another floe changes it only indirectly. Every event goes into fracture_events.csv.
+VesselEvents vessel_fracture_events(const Results& r, const std::string& source, SurgeLoadSummary& s) {
   const size_t events = r.fracture_time_s.size();
   const std::string problem = fracture_problem(r);
   FLOESIM_REQUIRE(problem.empty(), source, ": ", problem);
-  std::vector<double> split_t, bend_t;  // times of the events at the vessel, by marker style
+  VesselEvents ev;
   for (size_t k = 0; k < events; ++k)
     if (r.fracture_at_structure[k] == 1)
-      (r.fracture_mode[k] == kFractureSplitting ? split_t : bend_t).push_back(r.fracture_time_s[k]);
+      (r.fracture_mode[k] == kFractureSplitting ? ev.split_t : ev.bend_t).push_back(r.fracture_time_s[k]);
   s.fracture_events = events;
-  s.vessel_splitting_events = split_t.size();
-  s.vessel_bending_radial_events = bend_t.size();
+  s.vessel_splitting_events = ev.split_t.size();
+  s.vessel_bending_radial_events = ev.bend_t.size();
+  return ev;
+}
 
-  ensure_directory(out_dir);
-  AtomicFile png(out_dir / "surge_ice_load.png"), svg(out_dir / "surge_ice_load.svg"),
-      csv(out_dir / "surge_ice_load.csv"), events_csv(out_dir / "fracture_events.csv"), side(out_dir / "plot.json");
-  // Working files: AtomicFiles never committed, so they are removed whatever happens.
-  AtomicFile data(out_dir / "surge_ice_load.plot-data.txt"), script(out_dir / "surge_ice_load.plot.gp"),
-      log(out_dir / "surge_ice_load.gnuplot.log");
+// 5. The CSV of every sample; the average is empty where its window is cut.
+void write_samples_csv(const AtomicFile& csv, const std::vector<double>& t, const std::vector<double>& res,
+                       const MovingAverage& m) {
+  std::ostringstream os;
+  os << "time_s,ice_resistance_kN,moving_average_kN\n";  // average empty where its window is cut
+  for (size_t i = 0; i < t.size(); ++i)
+    os << fmt("%.10g", t[i]) << ',' << fmt("%.10g", res[i]) << ','
+       << (i >= m.f0 && i < m.f1 ? fmt("%.10g", m.ma[i]) : std::string()) << '\n';
+  write_file_checked(csv.tmp(), os.str(), csv.path());
+}
 
-  // 5. CSVs: every sample, and every fracture event (force on the floe in the world frame, as recorded).
-  {
-    std::ostringstream os;
-    os << "time_s,ice_resistance_kN,moving_average_kN\n";  // average empty where its window is cut
-    for (size_t i = 0; i < t.size(); ++i)
-      os << fmt("%.10g", t[i]) << ',' << fmt("%.10g", res[i]) << ','
-         << (i >= f0 && i < f1 ? fmt("%.10g", ma[i]) : std::string()) << '\n';
-    write_file_checked(csv.tmp(), os.str(), csv.path());
+// 5. The CSV of every fracture event (force on the floe in the world frame, as recorded).
+void write_events_csv(const AtomicFile& events_csv, const Results& r) {
+  std::ostringstream os;
+  os << "time_s,mode,parent_id,at_structure,force_x_n,force_y_n,force_z_n,threshold_n,children\n";
+  for (size_t k = 0; k < r.fracture_time_s.size(); ++k) {
+    os << fmt("%.10g", r.fracture_time_s[k]) << ',' << fracture_mode_name(r.fracture_mode[k]) << ','
+       << r.fracture_parent_id[k] << ',' << r.fracture_at_structure[k];
+    for (int c = 0; c < 3; ++c) os << ',' << fmt("%.10g", r.fracture_force_n[3 * k + c]);
+    os << ',' << fmt("%.10g", r.fracture_threshold_n[k]) << ',';
+    // The pieces' floe ids, space-separated in one field (a CSV cell per event, however many pieces).
+    for (int64_t c = r.fracture_child_offset[k]; c < r.fracture_child_offset[k + 1]; ++c)
+      os << (c > r.fracture_child_offset[k] ? " " : "") << r.fracture_child_id[c];
+    os << '\n';
   }
-  {
-    std::ostringstream os;
-    os << "time_s,mode,parent_id,at_structure,force_x_n,force_y_n,force_z_n,threshold_n,children\n";
-    for (size_t k = 0; k < events; ++k) {
-      os << fmt("%.10g", r.fracture_time_s[k]) << ',' << fracture_mode_name(r.fracture_mode[k]) << ','
-         << r.fracture_parent_id[k] << ',' << r.fracture_at_structure[k];
-      for (int c = 0; c < 3; ++c) os << ',' << fmt("%.10g", r.fracture_force_n[3 * k + c]);
-      os << ',' << fmt("%.10g", r.fracture_threshold_n[k]) << ',';
-      // The pieces' floe ids, space-separated in one field (a CSV cell per event, however many pieces).
-      for (int64_t c = r.fracture_child_offset[k]; c < r.fracture_child_offset[k + 1]; ++c)
-        os << (c > r.fracture_child_offset[k] ? " " : "") << r.fracture_child_id[c];
-      os << '\n';
-    }
-    write_file_checked(events_csv.tmp(), os.str(), events_csv.path());
-  }
+  write_file_checked(events_csv.tmp(), os.str(), events_csv.path());
+}
 
-  // 6. Plot data (decimated to ~2 points per pixel column) and the script, in the unit that suits the loads' size
-  // (N for a tank model, kN for a ship): chosen from the larger of the mean and the moving average's peak.
-  const double ma_abs_max = std::max(std::abs(*std::max_element(ma.begin() + static_cast<long>(f0), ma.begin() + static_cast<long>(f1))),
-                                     std::abs(*std::min_element(ma.begin() + static_cast<long>(f0), ma.begin() + static_cast<long>(f1))));
-  const ForceUnit unit = force_unit_for(1000.0 * std::max(std::abs(s.mean_kN), ma_abs_max));
-  s.display_unit = unit;
+// 6. The unit that suits the loads' size (N for a tank model, kN for a ship): chosen from the larger of the mean
+// and the moving average's peak.
+ForceUnit plot_unit(const MovingAverage& m, double mean_kN) {
+  const auto b = m.ma.begin() + static_cast<long>(m.f0), e = m.ma.begin() + static_cast<long>(m.f1);
+  const double ma_abs_max = std::max(std::abs(*std::max_element(b, e)), std::abs(*std::min_element(b, e)));
+  return force_unit_for(1000.0 * std::max(std::abs(mean_kN), ma_abs_max));
+}
+
+// A series in kN times to_unit (into the display unit).
+std::vector<double> scaled(const std::vector<double>& x, double to_unit) {
+  std::vector<double> y(x);
+  for (double& v : y) v *= to_unit;
+  return y;
+}
+
+// 6. The plot data, in the display unit (to_unit per kN): the raw series and the moving average decimated to ~2
+// points per pixel column (bins), the steady mean's line, and the event times (the script places the markers).
+void write_plot_data(const AtomicFile& data, const std::vector<double>& t, const std::vector<double>& res,
+                     const MovingAverage& m, const VesselEvents& ev, const SurgeLoadSummary& s, double to_unit,
+                     size_t bins) {
+  std::ostringstream os;
+  write_decimated(os, t, scaled(res, to_unit), bins);
+  os << "\n\n";
+  const std::vector<double> tm(t.begin() + static_cast<long>(m.f0), t.begin() + static_cast<long>(m.f1)),
+      mm(m.ma.begin() + static_cast<long>(m.f0), m.ma.begin() + static_cast<long>(m.f1));
+  write_decimated(os, tm, scaled(mm, to_unit), bins);
+  os << "\n\n";
+  const double t_mean0 = std::max(s.steady_start_s, t.front());
+  os << fmt("%.9g", t_mean0) << ' ' << fmt("%.9g", s.mean_kN * to_unit) << '\n'
+     << fmt("%.9g", t.back()) << ' ' << fmt("%.9g", s.mean_kN * to_unit) << '\n';
+  // Event times only: the script places the markers along the bottom of the plot area.
+  for (const auto* times : {&ev.split_t, &ev.bend_t}) {
+    if (times->empty()) continue;  // an empty block would be an empty plot element (a gnuplot error)
+    os << "\n\n";
+    for (double te : *times) os << fmt("%.9g", te) << '\n';
+  }
+  write_file_checked(data.tmp(), os.str(), data.path());
+}
+
+// The plot's axes, loads in kN.
+struct PlotRange {
+  double x_lo = 0;
+  double y_lo = 0, y_hi = 0;
+  double raw_min = 0;  // the raw series' lowest value (for the note on cut-off spikes)
+};
+
+// 6. The axes. Rigid contacts give single-step spikes one or two orders of magnitude above the average; "auto"
+// keeps the average readable (top at 3 x its peak, or the raw peak if lower); negative surge loads (ice pushing the
+// hull ahead) are brief: shown down to a fifth of the top. Time starts at 0 when the series starts within the
+// first 5 % (it starts at the first step's end).
+PlotRange plot_range(const std::vector<double>& t, const std::vector<double>& res, const MovingAverage& m,
+                     const PlotOptions& o, const SurgeLoadSummary& s) {
+  PlotRange p;
+  const double ma_max = *std::max_element(m.ma.begin() + static_cast<long>(m.f0), m.ma.begin() + static_cast<long>(m.f1)),
+               ma_min = *std::min_element(m.ma.begin() + static_cast<long>(m.f0), m.ma.begin() + static_cast<long>(m.f1));
+  p.raw_min = *std::min_element(res.begin(), res.end());
+  p.y_hi = o.y_max_kN.is_number() ? o.y_max_kN.get<double>()
+                                  : std::max({std::min(s.raw_max_kN, 3.0 * ma_max), 1.25 * s.mean_kN, 1e-3});
+  p.y_lo = std::min({0.0, ma_min, std::max(p.raw_min, -0.2 * p.y_hi)});
+  p.y_lo -= 0.03 * (p.y_hi - p.y_lo);
+  if (!o.y_max_kN.is_number()) p.y_hi += 0.05 * (p.y_hi - p.y_lo);
+  p.x_lo = t.front() > 0 && t.front() < 0.05 * t.back() ? 0.0 : t.front();
+  return p;
+}
+
+// A load given in kN as text in the display unit, with the unit's name.
+std::string load_text_in(double x_kN, const ForceUnit& unit) {
   const double to_unit = 1000.0 / unit.newtons;  // kN -> the display unit
-  auto in_unit = [&](const std::vector<double>& x) {
-    std::vector<double> y(x);
-    for (double& v : y) v *= to_unit;
-    return y;
+  return load_number(x_kN * to_unit) + " " + unit.name;
+}
+
+// 6. The script's settings: PNG terminal, labels, grid, key and ranges in the display unit, and a note on how far
+// the raw signal goes when the axis cuts it off.
+void script_settings(std::ostream& gp, const AtomicFile& png, const PlotOptions& o, const SurgeLoadSummary& s,
+                     const std::vector<double>& t, const PlotRange& p, bool marked) {
+  const ForceUnit& unit = s.display_unit;
+  const double to_unit = 1000.0 / unit.newtons;  // kN -> the display unit
+  const double y_lo_u = p.y_lo * to_unit, y_hi_u = p.y_hi * to_unit;  // the axis, in the display unit
+  const bool clipped = s.raw_max_kN > p.y_hi || p.raw_min < p.y_lo;
+  gp << "set encoding utf8\n"
+     << "set terminal pngcairo size " << o.width_px << "," << o.height_px
+     << " enhanced font 'DejaVu Sans,11' linewidth 1.0\n"
+     << "set output " << quoted(png.tmp().string()) << "\n";
+  if (!o.title.empty()) gp << "set title " << quoted(o.title) << " noenhanced font ',14'\n";
+  gp << "set xlabel 'Time (s)'\n"
+     << "set ylabel 'Ice resistance  −F_x  (" << unit.name << ")'\n"
+     << "set border lc rgb '#404040'\n"
+     << "set bmargin " << (marked ? 8 : 6) << "\n"
+     << "set grid xtics ytics mxtics lc rgb '#d9d9d9' lw 1 dt 1\n"
+     << "set mxtics 2\n"
+     << "set key outside below center horizontal maxrows " << (marked ? 2 : 1) << " samplen 2.5 width -6\n"
+     << "set style textbox opaque fillcolor rgb 'white' border lc rgb '#b0b0b0' margins 4,3\n"
+     << "set xrange [" << fmt("%.9g", p.x_lo) << ":" << fmt("%.9g", t.back()) << "]\n"
+     << "set yrange [" << fmt("%.9g", y_lo_u) << ":" << fmt("%.9g", y_hi_u) << "]\n"
+     << "set format y '%.0f'\n";
+  if (y_hi_u - y_lo_u < 10) gp << "set format y '%g'\n";
+  if (clipped)
+    gp << "set label 1 "
+       << quoted("raw signal spans " + load_text_in(p.raw_min, unit) + " to " + load_text_in(s.raw_max_kN, unit) +
+                 " (cut off here)")
+       << " at graph 0.99, graph 0.96 right boxed noenhanced font ',9' tc rgb '#505050' front\n";
+}
+
+// 6. The script's plot command: raw series, moving average, steady mean, and the fracture markers in the margin
+// below the lowest data (y_lo lies 3 % under it), in the video's colours: amber triangles for splitting, blue
+// diamonds for bending and radial.
+void script_plot_command(std::ostream& gp, const AtomicFile& data, const SurgeLoadSummary& s,
+                         const std::vector<double>& t, const PlotRange& p, const VesselEvents& ev) {
+  const double to_unit = 1000.0 / s.display_unit.newtons;  // kN -> the display unit
+  const double y_lo_u = p.y_lo * to_unit, y_hi_u = p.y_hi * to_unit;
+  const std::string mean_title =
+      (s.steady_start_s > t.front() ? "mean for t ≥ " + fmt("%g", s.steady_start_s) + " s: "
+                                    : std::string("mean: ")) +
+      load_text_in(s.mean_kN, s.display_unit);
+  gp << "plot " << quoted(data.tmp().string())
+     << " index 0 using 1:2 with lines lc rgb '#a9b8c6' lw 0.8 title "
+     << quoted("ice resistance, every time step (Δt = " + fmt("%g", s.time_step_s) + " s)") << " noenhanced, \\\n"
+     << "  '' index 1 using 1:2 with lines lc rgb '#101010' lw 2 title "
+     << quoted("centred moving average, " + fmt("%g", s.window_s) + " s window" +
+               (s.moving_average_complete ? "" : " (longer than the run: cut windows)")) << " noenhanced, \\\n"
+     << "  '' index 2 using 1:2 with lines lc rgb '#d1232a' lw 2.5 dt (8,4) title " << quoted(mean_title)
+     << " noenhanced";
+  const std::string y_mark = fmt("%.9g", y_lo_u + 0.012 * (y_hi_u - y_lo_u));
+  auto events_title = [](const char* what, size_t n) {
+    return std::string(what) + " at the vessel: " + std::to_string(n) + (n == 1 ? " event" : " events");
   };
-  auto load = [&](double x_kN) { return load_number(x_kN * to_unit) + " " + unit.name; };
-  const size_t bins = static_cast<size_t>(o.width_px);
-  {
-    std::ostringstream os;
-    write_decimated(os, t, in_unit(res), bins);
-    os << "\n\n";
-    const std::vector<double> tm(t.begin() + static_cast<long>(f0), t.begin() + static_cast<long>(f1)),
-        mm(ma.begin() + static_cast<long>(f0), ma.begin() + static_cast<long>(f1));
-    write_decimated(os, tm, in_unit(mm), bins);
-    os << "\n\n";
-    const double t_mean0 = std::max(s.steady_start_s, t.front());
-    os << fmt("%.9g", t_mean0) << ' ' << fmt("%.9g", s.mean_kN * to_unit) << '\n'
-       << fmt("%.9g", t.back()) << ' ' << fmt("%.9g", s.mean_kN * to_unit) << '\n';
-    // Event times only: the script places the markers along the bottom of the plot area.
-    for (const auto* times : {&split_t, &bend_t}) {
-      if (times->empty()) continue;  // an empty block would be an empty plot element (a gnuplot error)
-      os << "\n\n";
-      for (double te : *times) os << fmt("%.9g", te) << '\n';
-    }
-    write_file_checked(data.tmp(), os.str(), data.path());
-  }
-  // Rigid contacts give single-step spikes one or two orders of magnitude above the average; "auto" keeps the
-  // average readable (top at 3 x its peak, or the raw peak if lower) and says how high the cut-off spikes go.
-  const double ma_max = *std::max_element(ma.begin() + static_cast<long>(f0), ma.begin() + static_cast<long>(f1)),
-               ma_min = *std::min_element(ma.begin() + static_cast<long>(f0), ma.begin() + static_cast<long>(f1));
-  const double raw_min = *std::min_element(res.begin(), res.end());
-  double y_hi = o.y_max_kN.is_number() ? o.y_max_kN.get<double>()
-                                       : std::max({std::min(s.raw_max_kN, 3.0 * ma_max), 1.25 * s.mean_kN, 1e-3});
-  // Negative surge loads (ice pushing the hull ahead) are brief: show them down to a fifth of the top.
-  double y_lo = std::min({0.0, ma_min, std::max(raw_min, -0.2 * y_hi)});
-  y_lo -= 0.03 * (y_hi - y_lo);
-  if (!o.y_max_kN.is_number()) y_hi += 0.05 * (y_hi - y_lo);
-  const double y_lo_u = y_lo * to_unit, y_hi_u = y_hi * to_unit;  // the axis, in the display unit
-  // Start the axis at 0 when the series starts within the first 5 % (it starts at the first step's end).
-  const double x_lo = t.front() > 0 && t.front() < 0.05 * t.back() ? 0.0 : t.front();
-  {
-    const bool clipped = s.raw_max_kN > y_hi || raw_min < y_lo;
-    const bool marked = !split_t.empty() || !bend_t.empty();  // two legend rows then
-    std::ostringstream gp;
-    gp << "set encoding utf8\n"
-       << "set terminal pngcairo size " << o.width_px << "," << o.height_px
-       << " enhanced font 'DejaVu Sans,11' linewidth 1.0\n"
-       << "set output " << quoted(png.tmp().string()) << "\n";
-    if (!o.title.empty()) gp << "set title " << quoted(o.title) << " noenhanced font ',14'\n";
-    gp << "set xlabel 'Time (s)'\n"
-       << "set ylabel 'Ice resistance  −F_x  (" << unit.name << ")'\n"
-       << "set border lc rgb '#404040'\n"
-       << "set bmargin " << (marked ? 8 : 6) << "\n"
-       << "set grid xtics ytics mxtics lc rgb '#d9d9d9' lw 1 dt 1\n"
-       << "set mxtics 2\n"
-       << "set key outside below center horizontal maxrows " << (marked ? 2 : 1) << " samplen 2.5 width -6\n"
-       << "set style textbox opaque fillcolor rgb 'white' border lc rgb '#b0b0b0' margins 4,3\n"
-       << "set xrange [" << fmt("%.9g", x_lo) << ":" << fmt("%.9g", t.back()) << "]\n"
-       << "set yrange [" << fmt("%.9g", y_lo_u) << ":" << fmt("%.9g", y_hi_u) << "]\n"
-       << "set format y '%.0f'\n";
-    if (y_hi_u - y_lo_u < 10) gp << "set format y '%g'\n";
-    if (clipped)
-      gp << "set label 1 " << quoted("raw signal spans " + load(raw_min) + " to " + load(s.raw_max_kN) + " (cut off here)")
-         << " at graph 0.99, graph 0.96 right boxed noenhanced font ',9' tc rgb '#505050' front\n";
-    const std::string mean_title =
-        (s.steady_start_s > t.front() ? "mean for t ≥ " + fmt("%g", s.steady_start_s) + " s: "
-                                      : std::string("mean: ")) +
-        load(s.mean_kN);
-    gp << "plot " << quoted(data.tmp().string())
-       << " index 0 using 1:2 with lines lc rgb '#a9b8c6' lw 0.8 title "
-       << quoted("ice resistance, every time step (Δt = " + fmt("%g", s.time_step_s) + " s)") << " noenhanced, \\\n"
-       << "  '' index 1 using 1:2 with lines lc rgb '#101010' lw 2 title "
-       << quoted("centred moving average, " + fmt("%g", s.window_s) + " s window" +
-                  (s.moving_average_complete ? "" : " (longer than the run: cut windows)")) << " noenhanced, \\\n"
-       << "  '' index 2 using 1:2 with lines lc rgb '#d1232a' lw 2.5 dt (8,4) title " << quoted(mean_title)
-       << " noenhanced";
-    // Fracture markers in the margin below the lowest data (y_lo lies 3 % under it), in the video's colours:
-    // amber triangles for splitting, blue diamonds for bending and radial.
-    const std::string y_mark = fmt("%.9g", y_lo_u + 0.012 * (y_hi_u - y_lo_u));
-    auto events_title = [](const char* what, size_t n) {
-      return std::string(what) + " at the vessel: " + std::to_string(n) + (n == 1 ? " event" : " events");
-    };
-    int index = 3;
-    if (!split_t.empty())
-      gp << ", \\\n  '' index " << index++ << " using 1:(" << y_mark
-         << ") with points pt 9 ps 1.5 lc rgb '#e08a00' title "
-         << quoted(events_title("fracture by splitting", split_t.size())) << " noenhanced";
-    if (!bend_t.empty())
-      gp << ", \\\n  '' index " << index++ << " using 1:(" << y_mark
-         << ") with points pt 13 ps 1.5 lc rgb '#2f7fc1' title "
-         << quoted(events_title("fracture by bending or radial cracking", bend_t.size())) << " noenhanced";
-    gp << "\n"
-       << "set terminal svg size " << o.width_px << "," << o.height_px
-       << " dynamic enhanced font 'DejaVu Sans,11' background rgb 'white'\n"
-       << "set output " << quoted(svg.tmp().string()) << "\n"
-       << "replot\n"
-       << "unset output\n";
-    write_file_checked(script.tmp(), gp.str(), script.path());
-  }
+  int index = 3;
+  if (!ev.split_t.empty())
+    gp << ", \\\n  '' index " << index++ << " using 1:(" << y_mark
+       << ") with points pt 9 ps 1.5 lc rgb '#e08a00' title "
+       << quoted(events_title("fracture by splitting", ev.split_t.size())) << " noenhanced";
+  if (!ev.bend_t.empty())
+    gp << ", \\\n  '' index " << index++ << " using 1:(" << y_mark
+       << ") with points pt 13 ps 1.5 lc rgb '#2f7fc1' title "
+       << quoted(events_title("fracture by bending or radial cracking", ev.bend_t.size())) << " noenhanced";
+  gp << "\n";
+}
 
-  // 7. gnuplot, checked: exit status, and both images non-empty.
-  run_gnuplot(script.tmp(), log.tmp(), {png.tmp(), svg.tmp()}, png.path().string());
+// 6. The gnuplot script: the PNG, then the same plot again as SVG.
+void write_plot_script(const AtomicFile& script, const AtomicFile& png, const AtomicFile& svg,
+                       const AtomicFile& data, const PlotOptions& o, const SurgeLoadSummary& s,
+                       const std::vector<double>& t, const PlotRange& p, const VesselEvents& ev) {
+  const bool marked = !ev.split_t.empty() || !ev.bend_t.empty();  // two legend rows then
+  std::ostringstream gp;
+  script_settings(gp, png, o, s, t, p, marked);
+  script_plot_command(gp, data, s, t, p, ev);
+  gp << "set terminal svg size " << o.width_px << "," << o.height_px
+     << " dynamic enhanced font 'DejaVu Sans,11' background rgb 'white'\n"
+     << "set output " << quoted(svg.tmp().string()) << "\n"
+     << "replot\n"
+     << "unset output\n";
+  write_file_checked(script.tmp(), gp.str(), script.path());
+}
 
-  // 8. The numbers, then everything into place.
-  nlohmann::json j = {
+// 8. The numbers of the plot (plot.json), with the provenance.
+nlohmann::json plot_numbers(const SurgeLoadSummary& s, const VesselEvents& ev, const nlohmann::json& provenance) {
+  return {
       {"series", "ice_load column 0 (Fx, surge, body x)"},
       {"quantity", "ice resistance = -Fx"},
       {"unit", "kN"},
@@ -306,14 +333,55 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
       {"moving_average_max_kN", json_number(s.moving_average_max_kN)},
       {"raw_max_kN", s.raw_max_kN},
       {"fracture",
-       {{"events", events},
-        {"at_vessel", {{"splitting", split_t.size()}, {"bending_or_radial", bend_t.size()}}},
+       {{"events", s.fracture_events},
+        {"at_vessel", {{"splitting", ev.split_t.size()}, {"bending_or_radial", ev.bend_t.size()}}},
         {"marked", "events at the vessel (at_structure = 1), along the bottom of the plot"},
         {"csv", "fracture_events.csv: every event; force on the floe in the world frame (N)"}}},
       {"files", {"surge_ice_load.png", "surge_ice_load.svg", "surge_ice_load.csv", "fracture_events.csv"}},
       {"provenance", provenance},
   };
-  write_file_checked(side.tmp(), j.dump(2) + "\n", side.path());
+}
+
+}  // namespace
+
+SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const fs::path& out_dir,
+                                 const nlohmann::json& provenance, const std::string& source) {
+  SurgeLoadSummary s;
+  // 1. The signal: ice resistance = -Fx (body x, surge) in kN.
+  const std::vector<double>& t = r.get("time_s");
+  const std::vector<double> res = surge_ice_resistance_kN(r, source);
+  s.time_step_s = uniform_step(t, (source + ": series time_s").c_str());
+
+  // 2. The window and the centred moving average.
+  const MovingAverage ma = centred_moving_average(r, o, res, source, s);
+
+  // 3. The steady part and its mean (of the unfiltered signal: the primary validation metric).
+  steady_statistics(r, o, t, res, ma, source, s);
+
+  // 4. Fracture events (those at the vessel are marked).
+  const VesselEvents ev = vessel_fracture_events(r, source, s);
+
+  ensure_directory(out_dir);
+  AtomicFile png(out_dir / "surge_ice_load.png"), svg(out_dir / "surge_ice_load.svg"),
+      csv(out_dir / "surge_ice_load.csv"), events_csv(out_dir / "fracture_events.csv"), side(out_dir / "plot.json");
+  // Working files: AtomicFiles never committed, so they are removed whatever happens.
+  AtomicFile data(out_dir / "surge_ice_load.plot-data.txt"), script(out_dir / "surge_ice_load.plot.gp"),
+      log(out_dir / "surge_ice_load.gnuplot.log");
+
+  // 5. CSVs: every sample, and every fracture event.
+  write_samples_csv(csv, t, res, ma);
+  write_events_csv(events_csv, r);
+
+  // 6. Plot data and the script, in the unit that suits the loads' size (N for a tank model, kN for a ship).
+  s.display_unit = plot_unit(ma, s.mean_kN);
+  write_plot_data(data, t, res, ma, ev, s, 1000.0 / s.display_unit.newtons, static_cast<size_t>(o.width_px));
+  write_plot_script(script, png, svg, data, o, s, t, plot_range(t, res, ma, o, s), ev);
+
+  // 7. gnuplot, checked: exit status, and both images non-empty.
+  run_gnuplot(script.tmp(), log.tmp(), {png.tmp(), svg.tmp()}, png.path().string());
+
+  // 8. The numbers, then everything into place.
+  write_file_checked(side.tmp(), plot_numbers(s, ev, provenance).dump(2) + "\n", side.path());
   png.commit();
   svg.commit();
   csv.commit();

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pipeline/options.h"
+#include "pipeline/load_series.h"
 #include "pipeline/results_io.h"
 #include "pipeline/units.h"
 #include "render/render_options.h"  // auto_or_number
@@ -61,18 +62,6 @@ struct SurgeLoadSummary {
   size_t vessel_splitting_events = 0;        // at the vessel, marked on the plot
   size_t vessel_bending_radial_events = 0;   // at the vessel, marked on the plot
 };
-
-// The signal the plot stage averages, shared with the sweep gather so that both report the same mean: ice
-// resistance = -Fx (ice_load column 0, body x, surge) in kN, one sample per step. Error naming `source` if the
-// series is malformed or not finite (the simulation blew up).
-std::vector<double> surge_ice_resistance_kN(const Results& r, const std::string& source);
-// The contact model the simulation recorded (results attribute contact_model: rigid, compliant or mixed; "rigid" if
-// absent), and the moving-average window "auto" means for it (PHYSICS.md §5): 20 s for rigid, else 0.5 s. The plot
-// and the video's strip chart use both, so that they average alike.
-std::string recorded_contact_model(const Results& r, const std::string& source);
-double auto_moving_average_window_s(const Results& r, const std::string& source);
-// The steady start the simulation recorded (results attribute steady_start_s), 0 if absent.
-double recorded_steady_start_s(const Results& r, const std::string& source);
 
 // Writes DIR/surge_ice_load.{png,svg,csv}, DIR/fracture_events.csv and DIR/plot.json; each appears only when
 // complete.

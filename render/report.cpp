@@ -246,29 +246,26 @@ std::string case_description(const fs::path& case_json) {
   return "";
 }
 
-}  // namespace
-
-ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, const fs::path& out,
-                           const Json& resolved_config) {
-  ReportSummary rs;
-  rs.out = out;
-  Page pg;
-  pg.run = run_dir;
-
-  // 1. The summary is the run: without it there is nothing to report.
+// 1. The summary is the run: without it there is nothing to report. Checks the run folder and the summary's mean
+// load, and returns the summary (read through pg, for the provenance).
+Json read_run_summary(const fs::path& run_dir, Page& pg) {
   const fs::path summary_file = run_dir / "sim" / "summary.json";
   FLOESIM_REQUIRE(fs::is_directory(run_dir), run_dir.string(),
                   ": not a folder; give --run the output folder of `floesim run` (e.g. runs/<case>)");
   FLOESIM_REQUIRE(fs::is_regular_file(summary_file), summary_file.string(),
                   " is missing: the run has not simulated (run `floesim run <case> --out ", run_dir.string(),
                   "` first); no report written");
-  const Json summary = pg.json("sim/summary.json", "summary");
+  Json summary = pg.json("sim/summary.json", "summary");
   const Json* mean_n = find(summary, {"mean_surge_ice_resistance_N"});
   FLOESIM_REQUIRE(mean_n && mean_n->is_number(), summary_file.string(),
                   ": mean_surge_ice_resistance_N is missing or not a number; rerun the simulate stage");
+  return summary;
+}
 
-  // 2. The numbers of the mean-load table.
-  rs.mean_kN = mean_n->get<double>() / 1000;
+// 2. The numbers of the mean-load table into rs: mean, standard deviation, the applying moving average's peak, and
+// the mean against every reference.
+void mean_load_numbers(const Json& summary, const ReportOptions& o, ReportSummary& rs) {
+  rs.mean_kN = find(summary, {"mean_surge_ice_resistance_N"})->get<double>() / 1000;
   rs.std_kN = number_or_nan(summary, {"std_surge_ice_load_N"}) / 1000;
   rs.moving_average_max_kN = NAN;
   if (const Json* ma = find(summary, {"moving_average_surge_ice_load"}); ma && ma->is_array()) {
@@ -279,18 +276,21 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
       }
   }
   for (const ReferenceLoad& r : o.all_references()) rs.references.push_back(compare_to_reference(rs.mean_kN, r));
+}
 
-  // 3. The sections, each from its artefact; a missing one is named in the box at the top.
-  std::ostringstream body;
-  // The default title names the case (the folder of its case.json), else the run folder.
-  const std::string run_name = fs::absolute(run_dir).lexically_normal().string();
-  const fs::path case_json = case_file(run_dir).lexically_normal();
+// 3. The page's title: the options' title, else one naming the case (the folder of its case.json), else the run
+// folder.
+std::string report_title(const ReportOptions& o, const std::string& run_name, const fs::path& case_json) {
   std::string title = o.title;
   if (title.empty())
     title = "floesim report: " + (case_json.empty() ? fs::path(run_name).filename().string()
                                                     : case_json.parent_path().filename().string());
+  return title;
+}
 
-  // Case.
+// 3. Section "Case": the run folder, the case file and its description, the steady part, contact model, floes and
+// speed.
+void case_section(std::ostream& body, const std::string& run_name, const fs::path& case_json, const Json& summary) {
   body << "<h2>Case</h2>\n<table>\n<tr><th>run folder</th><td>" << html_escape(run_name) << "</td></tr>\n";
   if (const fs::path& cf = case_json; !cf.empty()) {
     body << "<tr><th>case file</th><td>" << html_escape(cf.string()) << "</td></tr>\n";
@@ -313,8 +313,11 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
        << "</td></tr>\n<tr><th>floes</th><td>" << scalar_text(summary.value("floes", Json()))
        << "</td></tr>\n<tr><th>mean vessel speed</th><td>"
        << scalar_text(summary.value("mean_vessel_speed_mps", Json())) << " m/s</td></tr>\n</table>\n";
+}
 
-  // Mean loads, in the unit that suits their size and the references' (N for a tank model, kN for a ship).
+// 3. Section "Mean loads", in the unit that suits their size and the references' (N for a tank model, kN for a
+// ship), and the table of references.
+void mean_loads_section(std::ostream& body, const ReportSummary& rs) {
   double typical_kN = std::max(std::abs(rs.mean_kN), std::isfinite(rs.moving_average_max_kN)
                                                          ? std::abs(rs.moving_average_max_kN) : 0.0);
   for (const auto& c : rs.references) typical_kN = std::max(typical_kN, std::abs(c.reference_kN));
@@ -340,8 +343,10 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
            << fmt("%+.1f", c.error_percent) << "</td></tr>\n";
     body << "</table>\n";
   }
+}
 
-  // Load plot.
+// 3. Section "Surge ice load": the load plot and the count of fracture events from the plot's numbers.
+void load_plot_section(std::ostream& body, const fs::path& run_dir, Page& pg) {
   body << "<h2>Surge ice load</h2>\n";
   if (pg.have("plots/surge_ice_load.png", "load plot"))
     body << "<figure>" << pg.img(run_dir / "plots/surge_ice_load.png", "plot", "surge ice load plot")
@@ -354,97 +359,112 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
   } else {
     pg.missing.push_back("plots/plot.json (plot numbers)");
   }
+}
 
-  // Identified load: the case's "identify" section ran the identification (config/identify.json is its settings).
-  if (fs::exists(run_dir / "config/identify.json")) {
-    body << "<h2>Ice load identified from the ship's data</h2>\n";
-    const bool round_trip = fs::exists(run_dir / "config/shipdata.json");
-    body << "<p class=\"note\">"
-         << (round_trip ? "The data are the simulated ship's, as a ship would record them (shipdata/measured.csv, "
-                          "sensor settings in config/shipdata.json), identified with the simulated ship's own "
-                          "model (shipdata/measured.json): the round trip checks the identification against the "
-                          "known simulated load."
-                        : "The data are the ship's measured data named in the case (identify.measured).")
-         << " The model is M &nu;&#775; = &tau;<sub>thr</sub> + &tau;<sub>hyd</sub> + &tau;<sub>wind</sub> + "
-            "&tau;<sub>ice</sub> in surge, sway and yaw, solved for &tau;<sub>ice</sub> (PHYSICS.md &sect;4.4).</p>\n";
-    if (pg.have("identify/identified.json", "identification numbers")) {
-      const Json ij = pg.json("identify/identified.json", "identification numbers");
-      rs.identified_kN = number_or_nan(ij, {"mean_surge_ice_resistance_n"}) / 1000;
-      const Json* w = find(ij, {"mean_window_s"});
-      const std::string window = w && w->is_array() && w->size() == 2
-                                     ? fmt("%g", (*w)[0].get<double>()) + " to " + fmt("%g", (*w)[1].get<double>()) + " s"
-                                     : std::string("?");
-      // The unit of the mean loads above (N for a tank model, kN for a ship).
-      const ForceUnit unit = force_unit_for(1000.0 * std::max(std::abs(rs.mean_kN), std::abs(rs.identified_kN)));
-      auto in_unit = [&](double x_kN) { return load_in(x_kN, unit); };
-      body << "<table id=\"identified\">\n<tr><th>quantity</th><th>" << unit.name << "</th></tr>\n"
-           << "<tr><th>identified mean surge ice resistance (" << window << ")</th><td class=\"n\" "
-           << "id=\"identified-kN\">" << in_unit(rs.identified_kN) << "</td></tr>\n";
-      if (const Json* k = find(ij, {"known_load"})) {
-        rs.identified_known_kN = number_or_nan(*k, {"mean_surge_ice_resistance_n"}) / 1000;
-        rs.identified_error_percent = -number_or_nan(*k, {"surge_error_percent"});
-        body << "<tr><th>the simulated load over the same window</th><td class=\"n\">"
-             << in_unit(rs.identified_known_kN) << "</td></tr>\n<tr><th>identified &minus; simulated</th><td "
-             << "class=\"n\">" << fmt("%+.1f", 1000.0 * (rs.identified_kN - rs.identified_known_kN) / unit.newtons)
-             << " (" << fmt("%+.2f", rs.identified_error_percent)
-             << " %)</td></tr>\n<tr><th>RMS error of the filtered series (standard deviation of the simulated "
-                "one)</th><td class=\"n\">"
-             << in_unit(number_or_nan(*k, {"output_rate_surge_rms_error_n"}) / 1000) << " ("
-             << in_unit(number_or_nan(*k, {"output_rate_surge_known_sd_n"}) / 1000) << ")</td></tr>\n";
-      } else {
-        body << "<tr><th>simulated &minus; identified</th><td class=\"n\">"
-             << fmt("%+.1f", 1000.0 * (rs.mean_kN - rs.identified_kN) / unit.newtons) << " ("
-             << fmt("%+.1f", 100 * (rs.mean_kN - rs.identified_kN) / rs.identified_kN) << " %)</td></tr>\n";
-      }
-      body << "</table>\n";
-    }
-    if (pg.have("plots/identified_load.png", "identified load plot"))
-      body << "<figure>" << pg.img(run_dir / "plots/identified_load.png", "identified", "identified load plot")
-           << "<figcaption>The identified surge ice resistance at the identification's output rate"
-           << (round_trip ? " and the simulated one averaged over the same intervals" : "")
-           << ", with their means over the identification's window.</figcaption></figure>\n";
+// 3. The table of the identification's numbers (identify/identified.json, `ij`) into rs and the page: the
+// identified mean, and against the known simulated load (round trip) or the simulated mean.
+void identified_table(std::ostream& body, const Json& ij, ReportSummary& rs) {
+  rs.identified_kN = number_or_nan(ij, {"mean_surge_ice_resistance_n"}) / 1000;
+  const Json* w = find(ij, {"mean_window_s"});
+  const std::string window = w && w->is_array() && w->size() == 2
+                                 ? fmt("%g", (*w)[0].get<double>()) + " to " + fmt("%g", (*w)[1].get<double>()) + " s"
+                                 : std::string("?");
+  // The unit of the mean loads above (N for a tank model, kN for a ship).
+  const ForceUnit unit = force_unit_for(1000.0 * std::max(std::abs(rs.mean_kN), std::abs(rs.identified_kN)));
+  auto in_unit = [&](double x_kN) { return load_in(x_kN, unit); };
+  body << "<table id=\"identified\">\n<tr><th>quantity</th><th>" << unit.name << "</th></tr>\n"
+       << "<tr><th>identified mean surge ice resistance (" << window << ")</th><td class=\"n\" "
+       << "id=\"identified-kN\">" << in_unit(rs.identified_kN) << "</td></tr>\n";
+  if (const Json* k = find(ij, {"known_load"})) {
+    rs.identified_known_kN = number_or_nan(*k, {"mean_surge_ice_resistance_n"}) / 1000;
+    rs.identified_error_percent = -number_or_nan(*k, {"surge_error_percent"});
+    body << "<tr><th>the simulated load over the same window</th><td class=\"n\">"
+         << in_unit(rs.identified_known_kN) << "</td></tr>\n<tr><th>identified &minus; simulated</th><td "
+         << "class=\"n\">" << fmt("%+.1f", 1000.0 * (rs.identified_kN - rs.identified_known_kN) / unit.newtons)
+         << " (" << fmt("%+.2f", rs.identified_error_percent)
+         << " %)</td></tr>\n<tr><th>RMS error of the filtered series (standard deviation of the simulated "
+            "one)</th><td class=\"n\">"
+         << in_unit(number_or_nan(*k, {"output_rate_surge_rms_error_n"}) / 1000) << " ("
+         << in_unit(number_or_nan(*k, {"output_rate_surge_known_sd_n"}) / 1000) << ")</td></tr>\n";
+  } else {
+    body << "<tr><th>simulated &minus; identified</th><td class=\"n\">"
+         << fmt("%+.1f", 1000.0 * (rs.mean_kN - rs.identified_kN) / unit.newtons) << " ("
+         << fmt("%+.1f", 100 * (rs.mean_kN - rs.identified_kN) / rs.identified_kN) << " %)</td></tr>\n";
   }
+  body << "</table>\n";
+}
 
-  // Input and digitised field; a case that gives its floes directly ("floes": {"file"}) has neither, and that is
-  // no gap in the run (the runner wrote no digitise settings).
+// 3. Section "Ice load identified from the ship's data", only when the case's "identify" section ran the
+// identification (config/identify.json is its settings): what the data are, the numbers, the plot.
+void identified_section(std::ostream& body, const fs::path& run_dir, Page& pg, ReportSummary& rs) {
+  if (!fs::exists(run_dir / "config/identify.json")) return;
+  body << "<h2>Ice load identified from the ship's data</h2>\n";
+  const bool round_trip = fs::exists(run_dir / "config/shipdata.json");
+  body << "<p class=\"note\">"
+       << (round_trip ? "The data are the simulated ship's, as a ship would record them (shipdata/measured.csv, "
+                        "sensor settings in config/shipdata.json), identified with the simulated ship's own "
+                        "model (shipdata/measured.json): the round trip checks the identification against the "
+                        "known simulated load."
+                      : "The data are the ship's measured data named in the case (identify.measured).")
+       << " The model is M &nu;&#775; = &tau;<sub>thr</sub> + &tau;<sub>hyd</sub> + &tau;<sub>wind</sub> + "
+          "&tau;<sub>ice</sub> in surge, sway and yaw, solved for &tau;<sub>ice</sub> (PHYSICS.md &sect;4.4).</p>\n";
+  if (pg.have("identify/identified.json", "identification numbers"))
+    identified_table(body, pg.json("identify/identified.json", "identification numbers"), rs);
+  if (pg.have("plots/identified_load.png", "identified load plot"))
+    body << "<figure>" << pg.img(run_dir / "plots/identified_load.png", "identified", "identified load plot")
+         << "<figcaption>The identified surge ice resistance at the identification's output rate"
+         << (round_trip ? " and the simulated one averaged over the same intervals" : "")
+         << ", with their means over the identification's window.</figcaption></figure>\n";
+}
+
+// 3. The digitisation's statistics (floes/stats.json) as a table, with the power-law fits.
+void floe_stats_table(std::ostream& body, Page& pg) {
+  const Json st = pg.json("floes/stats.json", "floe statistics");
+  body << "<table>\n" << scalar_rows(st);
+  if (const Json* img = find(st, {"image"})) body << scalar_rows(*img, "image.");
+  for (const char* fit : {"mle", "truncated_mle"})
+    if (const Json* a = find(st, {"power_law", fit}))
+      body << "<tr><th>power-law exponent (" << fit << ")</th><td>" << scalar_text(a->value("alpha", Json()))
+           << " &plusmn; " << scalar_text(a->value("alpha_stderr", Json())) << " (n = "
+           << scalar_text(a->value("n", Json())) << ", d_min = " << scalar_text(a->value("d_min_m", Json()))
+           << " m)</td></tr>\n";
+  body << "</table>\n";
+}
+
+// 3. Section "Ice field": input image and digitised field side by side, statistics, size distribution. A case
+// that gives its floes directly ("floes": {"file"}) has neither, and that is no gap in the run (the runner wrote
+// no digitise settings).
+void ice_field_section(std::ostream& body, const fs::path& run_dir, Page& pg) {
   body << "<h2>Ice field</h2>\n";
   if (!fs::exists(run_dir / "config/digitise.json")) {
     body << "<p>The floes were given directly (case key <code>floes.file</code>): no image was digitised.</p>\n";
-  } else {
-    body << "<div class=\"pair\">\n";
-    fs::path photo = run_dir / "image/image.png";
-    if (!fs::is_regular_file(photo) && !fs::exists(run_dir / "config/synth.json")) {
-      const fs::path p = photo_from_ninja(run_dir);
-      if (!p.empty()) photo = p;
-    }
-    if (fs::is_regular_file(photo) && photo.extension() == ".png")
-      body << "<figure>" << pg.img(photo, "image", "input image") << "<figcaption>Input image ("
-           << html_escape(photo.filename().string()) << ")</figcaption></figure>\n";
-    else
-      pg.missing.push_back((fs::is_regular_file(photo) ? photo.string() + " (input photo: not a PNG, not embedded)"
-                                                       : std::string("image/image.png (input image)")));
-    if (pg.have("floes/overlay.png", "digitised field"))
-      body << "<figure>" << pg.img(run_dir / "floes/overlay.png", "overlay", "digitised field")
-           << "<figcaption>Digitised floes (outlines and ids on the image)</figcaption></figure>\n";
-    body << "</div>\n";
-    if (pg.have("floes/stats.json", "digitisation statistics")) {
-      const Json st = pg.json("floes/stats.json", "floe statistics");
-      body << "<table>\n" << scalar_rows(st);
-      if (const Json* img = find(st, {"image"})) body << scalar_rows(*img, "image.");
-      for (const char* fit : {"mle", "truncated_mle"})
-        if (const Json* a = find(st, {"power_law", fit}))
-          body << "<tr><th>power-law exponent (" << fit << ")</th><td>" << scalar_text(a->value("alpha", Json()))
-               << " &plusmn; " << scalar_text(a->value("alpha_stderr", Json())) << " (n = "
-               << scalar_text(a->value("n", Json())) << ", d_min = " << scalar_text(a->value("d_min_m", Json()))
-               << " m)</td></tr>\n";
-      body << "</table>\n";
-    }
-    if (pg.have("floes/fsd.png", "floe size distribution plot"))
-      body << "<figure>" << pg.img(run_dir / "floes/fsd.png", "fsd", "floe size distribution")
-           << "<figcaption>Floe size distribution and power-law fit</figcaption></figure>\n";
+    return;
   }
+  body << "<div class=\"pair\">\n";
+  fs::path photo = run_dir / "image/image.png";
+  if (!fs::is_regular_file(photo) && !fs::exists(run_dir / "config/synth.json")) {
+    const fs::path p = photo_from_ninja(run_dir);
+    if (!p.empty()) photo = p;
+  }
+  if (fs::is_regular_file(photo) && photo.extension() == ".png")
+    body << "<figure>" << pg.img(photo, "image", "input image") << "<figcaption>Input image ("
+         << html_escape(photo.filename().string()) << ")</figcaption></figure>\n";
+  else
+    pg.missing.push_back((fs::is_regular_file(photo) ? photo.string() + " (input photo: not a PNG, not embedded)"
+                                                     : std::string("image/image.png (input image)")));
+  if (pg.have("floes/overlay.png", "digitised field"))
+    body << "<figure>" << pg.img(run_dir / "floes/overlay.png", "overlay", "digitised field")
+         << "<figcaption>Digitised floes (outlines and ids on the image)</figcaption></figure>\n";
+  body << "</div>\n";
+  if (pg.have("floes/stats.json", "digitisation statistics")) floe_stats_table(body, pg);
+  if (pg.have("floes/fsd.png", "floe size distribution plot"))
+    body << "<figure>" << pg.img(run_dir / "floes/fsd.png", "fsd", "floe size distribution")
+         << "<figcaption>Floe size distribution and power-law fit</figcaption></figure>\n";
+}
 
-  // Hull.
+// 3. Section "Hull": the vessel's numbers from the summary and the hull sidecar's (hydrostatics, placement,
+// waterline, particulars).
+void hull_section(std::ostream& body, const fs::path& run_dir, const Json& summary, Page& pg) {
   body << "<h2>Hull</h2>\n<table>\n";
   if (const Json* v = find(summary, {"vessel"})) body << scalar_rows(*v);
   if (fs::is_regular_file(run_dir / "hull/hull.json")) {
@@ -460,8 +480,10 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
     pg.missing.push_back("hull/hull.json (hull particulars)");
   }
   body << "</table>\n";
+}
 
-  // Fracture.
+// 3. Section "Fracture": the summary's fracture numbers (events, piece sizes).
+void fracture_section(std::ostream& body, const Json& summary) {
   body << "<h2>Fracture</h2>\n";
   if (const Json* fr = find(summary, {"fracture"})) {
     body << "<table>\n" << scalar_rows(*fr);
@@ -473,8 +495,10 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
     body << "<p class=\"note\">The summary has no fracture section (a run from before fracture was "
             "modelled).</p>\n";
   }
+}
 
-  // Video.
+// 3. Section "Video": embedded up to max_video_mb, else named beside the page; its size and embedding into rs.
+void video_section(std::ostream& body, const fs::path& run_dir, const ReportOptions& o, Page& pg, ReportSummary& rs) {
   body << "<h2>Video</h2>\n";
   const fs::path video = run_dir / "video/transit.mp4";
   if (fs::is_regular_file(video)) {
@@ -495,8 +519,10 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
     pg.missing.push_back("video/transit.mp4 (video)");
     body << "<p class=\"missing\" id=\"video-missing\">The video is missing (video/transit.mp4).</p>\n";
   }
+}
 
-  // Settings.
+// 3. Section "Settings": every stage's config/*.json in name order, and the simulation settings as resolved.
+void settings_section(std::ostream& body, const fs::path& run_dir, const Json& summary, Page& pg) {
   body << "<h2>Settings</h2>\n";
   std::vector<fs::path> configs;
   if (fs::is_directory(run_dir / "config"))
@@ -512,6 +538,37 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
   if (const Json* s = find(summary, {"settings"}))
     body << "<details><summary>simulation settings as resolved (sim/summary.json)</summary><pre>"
          << html_escape(s->dump(2)) << "</pre></details>\n";
+}
+
+}  // namespace
+
+ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, const fs::path& out,
+                           const Json& resolved_config) {
+  ReportSummary rs;
+  rs.out = out;
+  Page pg;
+  pg.run = run_dir;
+
+  // 1. The summary is the run: without it there is nothing to report.
+  const Json summary = read_run_summary(run_dir, pg);
+
+  // 2. The numbers of the mean-load table.
+  mean_load_numbers(summary, o, rs);
+
+  // 3. The sections, each from its artefact; a missing one is named in the box at the top.
+  std::ostringstream body;
+  const std::string run_name = fs::absolute(run_dir).lexically_normal().string();
+  const fs::path case_json = case_file(run_dir).lexically_normal();
+  const std::string title = report_title(o, run_name, case_json);
+  case_section(body, run_name, case_json, summary);
+  mean_loads_section(body, rs);
+  load_plot_section(body, run_dir, pg);
+  identified_section(body, run_dir, pg, rs);
+  ice_field_section(body, run_dir, pg);
+  hull_section(body, run_dir, summary, pg);
+  fracture_section(body, summary);
+  video_section(body, run_dir, o, pg, rs);
+  settings_section(body, run_dir, summary, pg);
 
   // 4. Provenance of the page, then the page: the missing box first.
   rs.missing = pg.missing;

@@ -6,9 +6,21 @@
 #include "pipeline/stage_main.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"floesim: ship transit through broken sea ice, from a helicopter image to a rendered video.\n"
-               "Stages (each also runs alone): floesim-synth, floesim-digitise, floesim-hull, floesim-simulate,\n"
-               "floesim-render, floesim-plot.",
+  CLI::App app{"floesim: ships in sea ice, from a helicopter image to ice loads, a video and a report.\n"
+               "`floesim run` runs a case's stages (only the stale ones), `floesim sweep` many variants of one.\n"
+               "The stages, each an executable that also runs alone (--help; --help-config: every setting):\n"
+               "  floesim-synth       synthetic helicopter image of known floes (a test image)\n"
+               "  floesim-digitise    photo -> floe polygons (floes.geojson), labels, size distribution\n"
+               "  floesim-score       digitised floes against hand-labelled ones (precision, recall, F1)\n"
+               "  floesim-hull        parametric icebreaker, or a CAD mesh placed and cut into convex parts\n"
+               "  floesim-simulate    the transit: floes + hull -> results.h5, summary.json\n"
+               "  floesim-render      results -> off-screen H.264 video\n"
+               "  floesim-plot        results -> surge ice load plot and CSVs\n"
+               "  floesim-report      a run folder -> one self-contained HTML page\n"
+               "  floesim-gather      a sweep's members -> sweep.csv, statistics and plots\n"
+               "  floesim-identify    measured ship data -> identified ice loads\n"
+               "  floesim-shipdata    a simulated transit -> the data a ship would have recorded\n"
+               "  floesim-resistance  Lindqvist's and Riska's level-ice resistance for a hull",
                "floesim"};
   app.require_subcommand(1);
   floesim::runner::RunOptions o;
@@ -19,6 +31,9 @@ int main(int argc, char** argv) {
   run->add_option("--bin", o.bin_dir, "folder of the stage executables (default: beside floesim)");
   run->add_option("-j,--jobs", o.jobs, "stages run in parallel (default: ninja's choice)");
   run->add_flag("-n,--dry-run", o.dry_run, "show what would run, run nothing");
+  run->add_flag("--check", o.check_only,
+                "check the case and every stage's settings (each stage checks its own), run and write nothing; "
+                "problems are named by their key in case.json");
   run->add_flag("--resume", o.resume,
                 "continue the simulation from its last checkpoint (simulate.checkpoint_interval_s) if one of the same "
                 "inputs exists; the results are byte-identical to a run never stopped");

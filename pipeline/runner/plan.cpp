@@ -101,156 +101,92 @@ void absolute_case_files(Json& c, const fs::path& case_dir) {
     if (Json* v = at(*s, "vessel")) fix(at(*v, "propulsion"), "thrust_file");
 }
 
-CasePlan plan_case(const Json& c, const std::string& where, const fs::path& case_dir, const fs::path& bin,
-                   const StageLayout& layout, bool render, bool report) {
-  const std::string& cf = where;
-  FLOESIM_REQUIRE(c.is_object(), cf, ": the top level must be an object");
-  const std::vector<std::string> known = {"description", "image", "digitise", "floes", "hull", "simulate", "identify",
-                                          "render", "plot", "report"};
-  for (auto it = c.begin(); it != c.end(); ++it) {
-    bool ok = false;
-    for (auto& k : known) ok = ok || k == it.key();
-    FLOESIM_REQUIRE(ok, cf, ": unknown key \"", it.key(),
-                    "\" (known: description, image, digitise, floes, hull, simulate, identify, render, plot, report)");
-  }
-  // Floes come from a photo (image + digitise) or directly from a floes GeoJSON the case owns ("floes": {"file"}).
-  FLOESIM_REQUIRE(c.contains("image") != c.contains("floes"), cf,
-                  ": give exactly one of \"image\" (a photo or synthetic image, digitised into floes) or \"floes\" "
-                  "({\"file\": \"floes.geojson\"}: floe polygons given directly)");
-  FLOESIM_REQUIRE(!(c.contains("floes") && c.contains("digitise")), cf,
-                  ": \"digitise\" has no effect with \"floes\" (the floes are given directly): remove it");
+namespace {
 
-  auto case_input = [&](const Json& j, const std::string& key, const std::string& where) {
-    FLOESIM_REQUIRE(j.contains(key) && j.at(key).is_string(), cf, ": ", where, ".", key, " must be a file name");
-    fs::path p = j.at(key).get<std::string>();
-    if (p.is_relative()) p = fs::absolute(case_dir) / p;
-    FLOESIM_REQUIRE(fs::exists(p), cf, ": ", where, ".", key, " names ", p.string(), ", which does not exist");
-    // A folder (".", "") was hashed as if empty, and a device (/dev/zero) was hashed forever: only a file will do.
-    std::error_code ec;
-    FLOESIM_REQUIRE(fs::is_regular_file(p, ec), cf, ": ", where, ".", key, " names ", p.string(),
-                    ", which is not a file (a folder or a device?): name the file itself");
-    return p.lexically_normal();
-  };
+// Plans a case's stages, one step per stage family (in data-flow order), each adding its stages to `plan` with the
+// content key of its settings and inputs.
+class CasePlanner {
+ public:
+  CasePlanner(const Json& c, const std::string& where, const fs::path& case_dir, const fs::path& bin,
+              const StageLayout& layout)
+      : c_(c), cf_(where), case_dir_(case_dir), bin_(bin), layout_(layout) {}
 
-  CasePlan plan;
-  // What each input file is, for the content keys: another stage's output (that stage's key and the file's name)
-  // or a file of the case (its SHA-256).
-  std::map<fs::path, std::string> identity;
-  auto identify = [&](const fs::path& p) {
-    auto it = identity.find(p);
-    if (it != identity.end()) return it->second;
-    return identity[p] = "file " + sha256_file(p);
-  };
-  // Adds a stage: its key from its name, settings and inputs; then its folder, settings file and outputs.
-  auto add = [&](const std::string& name, const std::string& description, const Json& settings,
-                 std::vector<fs::path> inputs, const std::vector<std::string>& output_names, const char* exe) {
-    PlannedStage s;
-    s.name = name;
-    s.description = description;
-    s.config_text = settings.dump(2) + "\n";
-    std::string id = name + "\n" + s.config_text;
-    for (const fs::path& p : inputs) id += identify(p) + "\n";
-    s.key = sha256_bytes(id).substr(0, 16);
-    s.dir = layout.dir(name, s.key);
-    s.config = layout.config(name, s.key);
-    inputs.push_back(s.config);
-    s.inputs = inputs;
-    for (const std::string& f : output_names) {
-      s.outputs.push_back(s.dir / f);
-      identity[s.outputs.back()] = "stage " + s.key + " " + f;
+  // 1. The case's top level: known keys only; floes from a photo or given directly.
+  void check_top_level() const {
+    FLOESIM_REQUIRE(c_.is_object(), cf_, ": the top level must be an object");
+    const std::vector<std::string> known = {"description", "image", "digitise", "floes",  "hull",
+                                            "simulate",    "identify", "render", "plot",   "report"};
+    for (auto it = c_.begin(); it != c_.end(); ++it) {
+      bool ok = false;
+      for (auto& k : known) ok = ok || k == it.key();
+      FLOESIM_REQUIRE(ok, cf_, ": unknown key \"", it.key(),
+                      "\" (known: description, image, digitise, floes, hull, simulate, identify, render, plot, "
+                      "report)");
     }
-    s.exe = bin / exe;
-    plan.stages.push_back(s);
-    return &plan.stages.back();
-  };
-  auto rel = [&](const fs::path& p, const std::string& base) { return base + "/" + p.filename().string(); };
+    // Floes come from a photo (image + digitise) or directly from a floes GeoJSON the case owns ("floes": {"file"}).
+    FLOESIM_REQUIRE(c_.contains("image") != c_.contains("floes"), cf_,
+                    ": give exactly one of \"image\" (a photo or synthetic image, digitised into floes) or \"floes\" "
+                    "({\"file\": \"floes.geojson\"}: floe polygons given directly)");
+    FLOESIM_REQUIRE(!(c_.contains("floes") && c_.contains("digitise")), cf_,
+                    ": \"digitise\" has no effect with \"floes\" (the floes are given directly): remove it");
+  }
 
-  // --- floes given directly: the case's GeoJSON goes to simulate as it is (no image, no digitise stage) ---
-  fs::path floes_file;
-  if (c.contains("floes")) {
-    const Json& fl = require_object(c, "floes", cf);
-    for (auto it = fl.begin(); it != fl.end(); ++it)
-      FLOESIM_REQUIRE(it.key() == "file", cf, ": unknown key floes.", it.key(), " (known: file)");
-    floes_file = case_input(fl, "file", "floes");
-  } else {
-    // --- image: a photo the case owns, or a synthetic one made from known floes ---
-    const Json& image = require_object(c, "image", cf);
+  // 2. The floes: the case's GeoJSON as it is, or a photo (the case's, or a synthetic one) digitised.
+  void plan_floes() {
+    if (c_.contains("floes")) {
+      const Json& fl = require_object(c_, "floes", cf_);
+      for (auto it = fl.begin(); it != fl.end(); ++it)
+        FLOESIM_REQUIRE(it.key() == "file", cf_, ": unknown key floes.", it.key(), " (known: file)");
+      floes_file_ = case_input(fl, "file", "floes");
+      return;
+    }
+    const Json& image = require_object(c_, "image", cf_);
     for (auto it = image.begin(); it != image.end(); ++it)
-      FLOESIM_REQUIRE(it.key() == "metres_per_pixel" || it.key() == "synthetic" || it.key() == "file", cf,
+      FLOESIM_REQUIRE(it.key() == "metres_per_pixel" || it.key() == "synthetic" || it.key() == "file", cf_,
                       ": unknown key image.", it.key(), " (known: metres_per_pixel, file, synthetic)");
     FLOESIM_REQUIRE(image.contains("metres_per_pixel") && image["metres_per_pixel"].is_number() &&
                         image["metres_per_pixel"].get<double>() > 0,
-                    cf, ": image.metres_per_pixel must be a number > 0 (the ground size of one pixel)");
+                    cf_, ": image.metres_per_pixel must be a number > 0 (the ground size of one pixel)");
     const double mpp = image["metres_per_pixel"].get<double>();
-    FLOESIM_REQUIRE(image.contains("synthetic") != image.contains("file"), cf,
+    FLOESIM_REQUIRE(image.contains("synthetic") != image.contains("file"), cf_,
                     ": image needs exactly one of \"file\" (a photo) or \"synthetic\" (options for floesim-synth)");
-    fs::path image_png;
-    if (image.contains("synthetic")) {
-      Json s = image["synthetic"];
-      FLOESIM_REQUIRE(s.is_object(), cf, ": image.synthetic must be an object");
-      FLOESIM_REQUIRE(!s.contains("metres_per_pixel"), cf,
-                      ": image.synthetic.metres_per_pixel: set the scale once, in image.metres_per_pixel");
-      s["metres_per_pixel"] = mpp;
-      PlannedStage* st = add("synth", "synthetic helicopter image from known floes", s, {},
-                             {"image.png", "truth.geojson", "truth_labels.png"}, "floesim-synth");
-      st->args = {"--config", st->config.string(), "--out", st->dir.string()};
-      image_png = st->outputs[0];
-      plan.artefacts.push_back({"synth", rel(image_png, "image"), "synthetic helicopter image (8-bit grey)"});
-      plan.artefacts.push_back({"synth", "image/truth.geojson", "the true floe polygons (m)"});
-    } else {
-      image_png = case_input(image, "file", "image");
-    }
-
-    // --- digitise ---
-    Json d = c.contains("digitise") ? c["digitise"] : Json::object();
-    FLOESIM_REQUIRE(d.is_object(), cf, ": digitise must be an object");
-    PlannedStage* st = add("digitise", "floe segmentation and polygons", d, {image_png},
-                           {"floes.geojson", "labels.png", "overlay.png", "stats.json", "fsd.png", "fsd.csv"},
-                           "floesim-digitise");
-    st->args = {image_png.string(), "--metres-per-pixel", number(mpp), "--config", st->config.string(), "--out",
-                st->dir.string()};
-    floes_file = st->outputs[0];
-    plan.artefacts.push_back({"digitise", "floes/floes.geojson", "floe polygons, m (GeoJSON)"});
-    plan.artefacts.push_back({"digitise", "floes/labels.png", "16-bit label image, k = floe id"});
-    plan.artefacts.push_back({"digitise", "floes/overlay.png", "outlines on the photo"});
-    plan.artefacts.push_back({"digitise", "floes/stats.json", "count, concentration, size distribution"});
-    plan.artefacts.push_back({"digitise", "floes/fsd.png", "floe size distribution and power-law fit"});
+    const fs::path image_png = image.contains("synthetic") ? plan_synth(image, mpp) : case_input(image, "file", "image");
+    plan_digitise(image_png, mpp);
   }
 
-  // --- hull: a user's mesh, or the parametric icebreaker ---
-  fs::path hull_obj;
-  {
-    const Json& h = require_object(c, "hull", cf);
-    FLOESIM_REQUIRE(h.contains("generate") != h.contains("file"), cf,
+  // 3. The hull: a user's mesh placed and cut into convex parts, or the parametric icebreaker.
+  void plan_hull() {
+    const Json& h = require_object(c_, "hull", cf_);
+    FLOESIM_REQUIRE(h.contains("generate") != h.contains("file"), cf_,
                     ": hull needs exactly one of \"file\" (an OBJ or any mesh assimp reads, with its placement "
                     "options beside it) or \"generate\" (options for floesim-hull's parametric icebreaker)");
-    FLOESIM_REQUIRE(!h.contains("generate") || h.size() == 1, cf,
+    FLOESIM_REQUIRE(!h.contains("generate") || h.size() == 1, cf_,
                     ": hull.generate takes no keys beside it (the placement options go with \"file\")");
     if (h.contains("generate")) {
-      PlannedStage* st = add("hull", "parametric icebreaker hull", h["generate"], {}, {"hull.obj"}, "floesim-hull");
-      hull_obj = st->outputs[0];
-      st->args = {"--config", st->config.string(), "--out", hull_obj.string()};
-      plan.artefacts.push_back({"hull", "hull/hull.obj", "hull as convex parts, m (OBJ)"});
-    } else {
-      // The user's mesh: floesim-hull places it (scale, up_direction, bow_direction, waterline_z_m, origin_m), cuts it into
-      // convex parts, reports what it did in hull.json and refuses a hull that does not float. Its settings are the
-      // case's hull section as it stands (the file's path made absolute), checked by the stage itself.
-      Json settings = h;
-      const fs::path mesh = case_input(h, "file", "hull");
-      settings["file"] = mesh.string();
-      PlannedStage* st = add("hull", "user's hull mesh placed and cut into convex parts", settings, {mesh},
-                             {"hull.obj"}, "floesim-hull");
-      hull_obj = st->outputs[0];
-      st->args = {"--config", st->config.string(), "--out", hull_obj.string()};
-      plan.artefacts.push_back({"hull", "hull/hull.obj", "hull as convex parts in the hull frame, m (OBJ)"});
+      PlannedStage* st =
+          add("hull", "hull.generate", "parametric icebreaker hull", h["generate"], {}, {"hull.obj"}, "floesim-hull");
+      hull_obj_ = st->outputs[0];
+      st->args = {"--config", st->config.string(), "--out", hull_obj_.string()};
+      plan_.artefacts.push_back({"hull", "hull/hull.obj", "hull as convex parts, m (OBJ)"});
+      return;
     }
+    // The user's mesh: floesim-hull places it (scale, up_direction, bow_direction, waterline_z_m, origin_m), cuts it
+    // into convex parts, reports what it did in hull.json and refuses a hull that does not float. Its settings are
+    // the case's hull section as it stands (the file's path made absolute), checked by the stage itself.
+    Json settings = h;
+    const fs::path mesh = case_input(h, "file", "hull");
+    settings["file"] = mesh.string();
+    PlannedStage* st = add("hull", "hull", "user's hull mesh placed and cut into convex parts", settings, {mesh},
+                           {"hull.obj"}, "floesim-hull");
+    hull_obj_ = st->outputs[0];
+    st->args = {"--config", st->config.string(), "--out", hull_obj_.string()};
+    plan_.artefacts.push_back({"hull", "hull/hull.obj", "hull as convex parts in the hull frame, m (OBJ)"});
   }
 
-  // --- simulate ---
-  {
-    Json s = c.contains("simulate") ? c["simulate"] : Json::object();
-    FLOESIM_REQUIRE(s.is_object(), cf, ": simulate must be an object");
-    std::vector<fs::path> inputs = {floes_file, hull_obj};
+  // 4. The simulation, with the thrust time series the case may name as one more input.
+  void plan_simulate() {
+    Json s = section("simulate");
+    std::vector<fs::path> inputs = {floes_file_, hull_obj_};
     // A thrust time series named in the case is an input too (its path made absolute for the stage).
     if (s.contains("vessel") && s["vessel"].is_object() && s["vessel"].contains("propulsion") &&
         s["vessel"]["propulsion"].is_object() && s["vessel"]["propulsion"].contains("thrust_file")) {
@@ -258,122 +194,234 @@ CasePlan plan_case(const Json& c, const std::string& where, const fs::path& case
       s["vessel"]["propulsion"]["thrust_file"] = tf.string();
       inputs.push_back(tf);
     }
-    PlannedStage* st = add("simulate", "vessel transit simulation", s, inputs, {"results.h5", "summary.json"},
-                           "floesim-simulate");
-    st->args = {"--floes", floes_file.string(), "--hull", hull_obj.string(), "--config", st->config.string(),
+    PlannedStage* st = add("simulate", "simulate", "vessel transit simulation", s, inputs,
+                           {"results.h5", "summary.json"}, "floesim-simulate");
+    st->args = {"--floes", floes_file_.string(), "--hull", hull_obj_.string(), "--config", st->config.string(),
                 "--out", st->dir.string()};
     st->resumable = true;
-    plan.results = st->outputs[0];
-    plan.summary = st->outputs[1];
-    plan.artefacts.push_back({"simulate", "sim/results.h5", "time series and floe states (HDF5)"});
-    plan.artefacts.push_back({"simulate", "sim/summary.json", "mean surge ice load and settings"});
+    plan_.results = st->outputs[0];
+    plan_.summary = st->outputs[1];
+    plan_.artefacts.push_back({"simulate", "sim/results.h5", "time series and floe states (HDF5)"});
+    plan_.artefacts.push_back({"simulate", "sim/summary.json", "mean surge ice load and settings"});
   }
 
-  // --- identify: the ice load back-calculated from a ship's data, as full-scale loads are (PHYSICS.md §4.4) ---
-  // From the case's measured data ("measured": a CSV, "config": its identify options), or, with no "measured",
-  // from the simulated ship itself (the round trip): floesim-shipdata turns the transit into the data the ship
-  // would have recorded, with the sensor noise its "shipdata" options give, and the identify config of the
-  // simulated ship, which identify then uses.
-  fs::path identify_dir;
-  if (c.contains("identify")) {
-    const Json& id = require_object(c, "identify", cf);
+  // 5. Identify: the ice load back-calculated from a ship's data, as full-scale loads are (PHYSICS.md §4.4). From
+  // the case's measured data ("measured": a CSV, "config": its identify options), or, with no "measured", from the
+  // simulated ship itself (the round trip): floesim-shipdata turns the transit into the data the ship would have
+  // recorded, with the sensor noise its "shipdata" options give, and the identify config of the simulated ship,
+  // which identify then uses.
+  void plan_identify() {
+    if (!c_.contains("identify")) return;
+    const Json& id = require_object(c_, "identify", cf_);
     for (auto it = id.begin(); it != id.end(); ++it)
-      FLOESIM_REQUIRE(it.key() == "measured" || it.key() == "config" || it.key() == "shipdata", cf,
+      FLOESIM_REQUIRE(it.key() == "measured" || it.key() == "config" || it.key() == "shipdata", cf_,
                       ": unknown key identify.", it.key(),
                       " (known: measured, config: a ship's data and its identify options; shipdata: the sensor "
                       "options of the round trip from the simulated ship)");
     for (const char* k : {"config", "shipdata"})
-      FLOESIM_REQUIRE(!id.contains(k) || id[k].is_object(), cf, ": identify.", k, " must be an object");
-    PlannedStage* st = nullptr;
-    if (id.contains("measured")) {
-      FLOESIM_REQUIRE(!id.contains("shipdata"), cf,
-                      ": identify.shipdata has no effect with identify.measured (the data are the ship's, not made "
-                      "from the simulation): remove it");
-      const fs::path measured = case_input(id, "measured", "identify");
-      st = add("identify", "ice load identified from the measured ship data",
-               id.contains("config") ? id["config"] : Json::object(), {measured},
-               {"identified.csv", "identified.json"}, "floesim-identify");
-      st->args = {"--measured", measured.string(), "--config", st->config.string(), "--out", st->dir.string()};
-    } else {
-      FLOESIM_REQUIRE(!id.contains("config"), cf,
-                      ": identify.config is for a ship's measured data (identify.measured); the round trip "
-                      "identifies with the simulated ship's own config: remove it");
-      PlannedStage* sd = add("shipdata", "the simulated ship's data as a ship would record them",
-                             id.contains("shipdata") ? id["shipdata"] : Json::object(), {plan.results, plan.summary},
-                             {"measured.csv", "measured.json"}, "floesim-shipdata");
-      sd->args = {"--results", plan.results.string(), "--summary", plan.summary.string(), "--config",
-                  sd->config.string(), "--out", sd->outputs[0].string()};
-      plan.artefacts.push_back({"shipdata", "shipdata/measured.csv",
-                                "the simulated ship's data as recorded (velocities, accelerations, thrust, wind)"});
-      const fs::path measured = sd->outputs[0], ship_config = sd->outputs[1];
-      // Its own settings file stays empty: the config is the simulated ship's, which shipdata wrote.
-      st = add("identify", "ice load identified from the simulated ship's data", Json::object(),
-               {measured, ship_config}, {"identified.csv", "identified.json"}, "floesim-identify");
-      st->args = {"--measured", measured.string(), "--config", ship_config.string(), "--out", st->dir.string()};
-    }
-    identify_dir = st->dir;
-    plan.artefacts.push_back({"identify", "identify/identified.csv", "identified ice load at 2 Hz (and the known "
-                                                                     "load when the data carried one)"});
-    plan.artefacts.push_back({"identify", "identify/identified.json", "identified mean ice loads (and their error "
-                                                                      "against the known load)"});
+      FLOESIM_REQUIRE(!id.contains(k) || id[k].is_object(), cf_, ": identify.", k, " must be an object");
+    PlannedStage* st = id.contains("measured") ? plan_identify_measured(id) : plan_identify_round_trip(id);
+    identify_dir_ = st->dir;
+    plan_.artefacts.push_back({"identify", "identify/identified.csv", "identified ice load at 2 Hz (and the known "
+                                                                      "load when the data carried one)"});
+    plan_.artefacts.push_back({"identify", "identify/identified.json", "identified mean ice loads (and their error "
+                                                                       "against the known load)"});
   }
 
-  // --- render and plot (independent of each other) ---
-  fs::path video, plot_png;
-  {
-    Json r = c.contains("render") ? c["render"] : Json::object();
-    FLOESIM_REQUIRE(r.is_object(), cf, ": render must be an object");
-    if (render) {
-      PlannedStage* st = add("render", "off-screen frames and H.264 video", r, {plan.results}, {"transit.mp4"},
-                             "floesim-render");
-      st->args = {"--results", plan.results.string(), "--config", st->config.string(), "--out",
-                  st->outputs[0].string()};
-      video = st->outputs[0];
-      plan.artefacts.push_back({"render", "video/transit.mp4", "rendered transit (H.264 MP4)"});
-    }
+  // 6. The video (when asked) and the load plots, independent of each other.
+  void plan_render(bool render) {
+    Json r = section("render");
+    if (!render) return;
+    PlannedStage* st = add("render", "render", "off-screen frames and H.264 video", r, {plan_.results},
+                           {"transit.mp4"}, "floesim-render");
+    st->args = {"--results", plan_.results.string(), "--config", st->config.string(), "--out",
+                st->outputs[0].string()};
+    video_ = st->outputs[0];
+    plan_.artefacts.push_back({"render", "video/transit.mp4", "rendered transit (H.264 MP4)"});
   }
-  {
-    Json p = c.contains("plot") ? c["plot"] : Json::object();
-    FLOESIM_REQUIRE(p.is_object(), cf, ": plot must be an object");
-    std::vector<fs::path> inputs = {plan.results};
+  void plan_plot() {
+    Json p = section("plot");
+    std::vector<fs::path> inputs = {plan_.results};
     std::vector<std::string> outputs = {"surge_ice_load.png", "surge_ice_load.svg", "fracture_events.csv"};
-    if (!identify_dir.empty()) {
-      inputs.push_back(identify_dir / "identified.csv");
-      inputs.push_back(identify_dir / "identified.json");
+    if (!identify_dir_.empty()) {
+      inputs.push_back(identify_dir_ / "identified.csv");
+      inputs.push_back(identify_dir_ / "identified.json");
       outputs.push_back("identified_load.png");
     }
-    PlannedStage* st = add("plot", "surge ice load plots", p, inputs, outputs, "floesim-plot");
-    st->args = {"--results", plan.results.string(), "--config", st->config.string(), "--out", st->dir.string()};
-    if (!identify_dir.empty()) {
+    PlannedStage* st = add("plot", "plot", "surge ice load plots", p, inputs, outputs, "floesim-plot");
+    st->args = {"--results", plan_.results.string(), "--config", st->config.string(), "--out", st->dir.string()};
+    if (!identify_dir_.empty()) {
       st->args.push_back("--identified");
-      st->args.push_back(identify_dir.string());
-      plan.artefacts.push_back(
+      st->args.push_back(identify_dir_.string());
+      plan_.artefacts.push_back(
           {"plot", "plots/identified_load.png", "identified against simulated surge ice load, same filter (PNG)"});
     }
-    plot_png = st->outputs[0];
-    plan.artefacts.push_back({"plot", "plots/surge_ice_load.png", "surge ice load, moving average and mean (PNG)"});
-    plan.artefacts.push_back({"plot", "plots/surge_ice_load.svg", "the same (SVG)"});
-    plan.artefacts.push_back(
+    plot_png_ = st->outputs[0];
+    plan_.artefacts.push_back({"plot", "plots/surge_ice_load.png", "surge ice load, moving average and mean (PNG)"});
+    plan_.artefacts.push_back({"plot", "plots/surge_ice_load.svg", "the same (SVG)"});
+    plan_.artefacts.push_back(
         {"plot", "plots/fracture_events.csv", "every fracture event: time, mode, floe, force, children"});
   }
 
-  // --- report: one self-contained page over the run folder (only a run's: it reads the folder's layout) ---
-  {
-    Json r = c.contains("report") ? c["report"] : Json::object();
-    FLOESIM_REQUIRE(r.is_object(), cf, ": report must be an object");
-    if (render && report) {
-      // It reads the whole run folder; the summary, the plot and the video are what make it stale (every other
-      // artefact it shows lies upstream of the summary).
-      std::vector<fs::path> inputs = {plan.summary, plot_png, video};
-      if (!identify_dir.empty()) inputs.push_back(identify_dir / "identified.json");
-      PlannedStage* st = add("report", "self-contained HTML report", r, inputs, {"report.html"}, "floesim-report");
-      st->args = {"--run", st->dir.parent_path().string(), "--config", st->config.string(), "--out",
-                  st->outputs[0].string()};
-      plan.artefacts.push_back({"report", "report/report.html", "the run on one page: case, loads, plots, field, "
-                                                                "hull, fracture, settings, video (HTML)"});
-    }
+  // 7. The report: one self-contained page over the run folder (only a run's: it reads the folder's layout). It
+  // reads the whole run folder; the summary, the plot and the video are what make it stale (every other artefact
+  // it shows lies upstream of the summary).
+  void plan_report(bool render, bool report) {
+    Json r = section("report");
+    if (!(render && report)) return;
+    std::vector<fs::path> inputs = {plan_.summary, plot_png_, video_};
+    if (!identify_dir_.empty()) inputs.push_back(identify_dir_ / "identified.json");
+    PlannedStage* st =
+        add("report", "report", "self-contained HTML report", r, inputs, {"report.html"}, "floesim-report");
+    st->args = {"--run", st->dir.parent_path().string(), "--config", st->config.string(), "--out",
+                st->outputs[0].string()};
+    plan_.artefacts.push_back({"report", "report/report.html", "the run on one page: case, loads, plots, field, "
+                                                               "hull, fracture, settings, video (HTML)"});
   }
-  return plan;
+
+  CasePlan take() { return std::move(plan_); }
+
+ private:
+  // A stage's section of the case: an object, or {} when absent.
+  Json section(const char* key) const {
+    Json s = c_.contains(key) ? c_[key] : Json::object();
+    FLOESIM_REQUIRE(s.is_object(), cf_, ": ", key, " must be an object");
+    return s;
+  }
+
+  // A file the case owns: a name, relative to the case folder, of a file that exists.
+  fs::path case_input(const Json& j, const std::string& key, const std::string& where) const {
+    FLOESIM_REQUIRE(j.contains(key) && j.at(key).is_string(), cf_, ": ", where, ".", key, " must be a file name");
+    fs::path p = j.at(key).get<std::string>();
+    if (p.is_relative()) p = fs::absolute(case_dir_) / p;
+    FLOESIM_REQUIRE(fs::exists(p), cf_, ": ", where, ".", key, " names ", p.string(), ", which does not exist");
+    // A folder (".", "") was hashed as if empty, and a device (/dev/zero) was hashed forever: only a file will do.
+    std::error_code ec;
+    FLOESIM_REQUIRE(fs::is_regular_file(p, ec), cf_, ": ", where, ".", key, " names ", p.string(),
+                    ", which is not a file (a folder or a device?): name the file itself");
+    return p.lexically_normal();
+  }
+
+  // What each input file is, for the content keys: another stage's output (that stage's key and the file's name)
+  // or a file of the case (its SHA-256).
+  std::string identify(const fs::path& p) {
+    auto it = identity_.find(p);
+    if (it != identity_.end()) return it->second;
+    return identity_[p] = "file " + sha256_file(p);
+  }
+
+  // Adds a stage: its key from its name, settings and inputs; then its folder, settings file and outputs.
+  // `section` is the key path of its settings in the case file.
+  PlannedStage* add(const std::string& name, const std::string& section, const std::string& description,
+                    const Json& settings, std::vector<fs::path> inputs, const std::vector<std::string>& output_names,
+                    const char* exe) {
+    PlannedStage s;
+    s.name = name;
+    s.section = section;
+    s.description = description;
+    s.config_text = settings.dump(2) + "\n";
+    std::string id = name + "\n" + s.config_text;
+    for (const fs::path& p : inputs) id += identify(p) + "\n";
+    s.key = sha256_bytes(id).substr(0, 16);
+    s.dir = layout_.dir(name, s.key);
+    s.config = layout_.config(name, s.key);
+    inputs.push_back(s.config);
+    s.inputs = inputs;
+    for (const std::string& f : output_names) {
+      s.outputs.push_back(s.dir / f);
+      identity_[s.outputs.back()] = "stage " + s.key + " " + f;
+    }
+    s.exe = bin_ / exe;
+    plan_.stages.push_back(s);
+    return &plan_.stages.back();
+  }
+
+  fs::path plan_synth(const Json& image, double mpp) {
+    Json s = image["synthetic"];
+    FLOESIM_REQUIRE(s.is_object(), cf_, ": image.synthetic must be an object");
+    FLOESIM_REQUIRE(!s.contains("metres_per_pixel"), cf_,
+                    ": image.synthetic.metres_per_pixel: set the scale once, in image.metres_per_pixel");
+    s["metres_per_pixel"] = mpp;
+    PlannedStage* st = add("synth", "image.synthetic", "synthetic helicopter image from known floes", s, {},
+                           {"image.png", "truth.geojson", "truth_labels.png"}, "floesim-synth");
+    st->args = {"--config", st->config.string(), "--out", st->dir.string()};
+    plan_.artefacts.push_back({"synth", "image/" + st->outputs[0].filename().string(),
+                               "synthetic helicopter image (8-bit grey)"});
+    plan_.artefacts.push_back({"synth", "image/truth.geojson", "the true floe polygons (m)"});
+    return st->outputs[0];
+  }
+
+  void plan_digitise(const fs::path& image_png, double mpp) {
+    Json d = c_.contains("digitise") ? c_["digitise"] : Json::object();
+    FLOESIM_REQUIRE(d.is_object(), cf_, ": digitise must be an object");
+    PlannedStage* st = add("digitise", "digitise", "floe segmentation and polygons", d, {image_png},
+                           {"floes.geojson", "labels.png", "overlay.png", "stats.json", "fsd.png", "fsd.csv"},
+                           "floesim-digitise");
+    st->args = {image_png.string(), "--metres-per-pixel", number(mpp), "--config", st->config.string(), "--out",
+                st->dir.string()};
+    floes_file_ = st->outputs[0];
+    plan_.artefacts.push_back({"digitise", "floes/floes.geojson", "floe polygons, m (GeoJSON)"});
+    plan_.artefacts.push_back({"digitise", "floes/labels.png", "16-bit label image, k = floe id"});
+    plan_.artefacts.push_back({"digitise", "floes/overlay.png", "outlines on the photo"});
+    plan_.artefacts.push_back({"digitise", "floes/stats.json", "count, concentration, size distribution"});
+    plan_.artefacts.push_back({"digitise", "floes/fsd.png", "floe size distribution and power-law fit"});
+  }
+
+  PlannedStage* plan_identify_measured(const Json& id) {
+    FLOESIM_REQUIRE(!id.contains("shipdata"), cf_,
+                    ": identify.shipdata has no effect with identify.measured (the data are the ship's, not made "
+                    "from the simulation): remove it");
+    const fs::path measured = case_input(id, "measured", "identify");
+    PlannedStage* st = add("identify", "identify.config", "ice load identified from the measured ship data",
+                           id.contains("config") ? id["config"] : Json::object(), {measured},
+                           {"identified.csv", "identified.json"}, "floesim-identify");
+    st->args = {"--measured", measured.string(), "--config", st->config.string(), "--out", st->dir.string()};
+    return st;
+  }
+
+  PlannedStage* plan_identify_round_trip(const Json& id) {
+    FLOESIM_REQUIRE(!id.contains("config"), cf_,
+                    ": identify.config is for a ship's measured data (identify.measured); the round trip "
+                    "identifies with the simulated ship's own config: remove it");
+    PlannedStage* sd = add("shipdata", "identify.shipdata", "the simulated ship's data as a ship would record them",
+                           id.contains("shipdata") ? id["shipdata"] : Json::object(), {plan_.results, plan_.summary},
+                           {"measured.csv", "measured.json"}, "floesim-shipdata");
+    sd->args = {"--results", plan_.results.string(), "--summary", plan_.summary.string(), "--config",
+                sd->config.string(), "--out", sd->outputs[0].string()};
+    plan_.artefacts.push_back({"shipdata", "shipdata/measured.csv",
+                               "the simulated ship's data as recorded (velocities, accelerations, thrust, wind)"});
+    const fs::path measured = sd->outputs[0], ship_config = sd->outputs[1];
+    // Its own settings file stays empty: the config is the simulated ship's, which shipdata wrote.
+    PlannedStage* st = add("identify", "", "ice load identified from the simulated ship's data", Json::object(),
+                           {measured, ship_config}, {"identified.csv", "identified.json"}, "floesim-identify");
+    st->args = {"--measured", measured.string(), "--config", ship_config.string(), "--out", st->dir.string()};
+    return st;
+  }
+
+  const Json& c_;
+  const std::string& cf_;
+  const fs::path& case_dir_;
+  const fs::path& bin_;
+  const StageLayout& layout_;
+  CasePlan plan_;
+  std::map<fs::path, std::string> identity_;
+  fs::path floes_file_, hull_obj_, identify_dir_, video_, plot_png_;
+};
+
+}  // namespace
+
+CasePlan plan_case(const Json& c, const std::string& where, const fs::path& case_dir, const fs::path& bin,
+                   const StageLayout& layout, bool render, bool report) {
+  CasePlanner p(c, where, case_dir, bin, layout);
+  p.check_top_level();
+  p.plan_floes();
+  p.plan_hull();
+  p.plan_simulate();
+  p.plan_identify();
+  p.plan_render(render);
+  p.plan_plot();
+  p.plan_report(render, report);
+  return p.take();
 }
 
 std::string stage_script(const std::vector<PlannedStage>& stages, size_t k, StageOutput output) {

@@ -17,6 +17,8 @@ struct Artefact {
 
 struct PlannedStage {
   std::string name, description;
+  std::string section;                  // the key path of its settings in the case file ("simulate", "hull.generate";
+                                        // "" when they are not the case's)
   // Content key: a digest of the stage's name, its settings and the keys (or, for the case's own files, the
   // contents) of everything it reads. Equal keys mean equal outputs: the stages are deterministic.
   std::string key;

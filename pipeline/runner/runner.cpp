@@ -22,6 +22,7 @@
 #include "pipeline/interrupt.h"
 #include "pipeline/options.h"
 #include "pipeline/runner/plan.h"
+#include "pipeline/runner/process.h"
 
 #ifndef FLOESIM_NINJA
 #define FLOESIM_NINJA "ninja"
@@ -43,6 +44,7 @@ CasePlan prepare_run(const RunOptions& o) {
   layout.dir = [&](const std::string& stage, const std::string&) { return run / run_folder(stage); };
   layout.config = [&](const std::string& stage, const std::string&) { return run / "config" / (stage + ".json"); };
   const CasePlan plan = plan_case(c, case_file.string(), o.case_dir, bin, layout, true, true);
+  check_case_settings(plan, case_file);
   ensure_directory(run / "config");
   std::vector<std::string> descriptions;
   for (const PlannedStage& s : plan.stages) {
@@ -217,7 +219,41 @@ int run_ninja_child(const std::vector<std::string>& args,
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
 }
 
+void check_case_settings(const CasePlan& plan, const fs::path& case_file) {
+  const fs::path tmp = fs::temp_directory_path() / ("floesim-run-check-" + std::to_string(getpid()));
+  ensure_directory(tmp);
+  std::vector<std::string> problems;
+  try {
+    for (const PlannedStage& st : plan.stages)
+      if (std::string msg = stage_settings_problems(st, tmp, ""); !msg.empty())
+        problems.push_back("stage " + st.name + ": " + msg);
+  } catch (...) {
+    fs::remove_all(tmp);
+    throw;
+  }
+  fs::remove_all(tmp);
+  if (problems.empty()) return;
+  std::string text = case_file.string() + ": the settings of " + std::to_string(problems.size()) + " stage" +
+                     (problems.size() > 1 ? "s were" : " was") + " refused, nothing was run:";
+  for (const std::string& p : problems) text += "\n" + p;
+  throw Error(text);
+}
+
 int run_case(const RunOptions& o) {
+  if (o.check_only) {  // plan and check, write nothing
+    const fs::path case_file = o.case_dir / "case.json";
+    FLOESIM_REQUIRE(fs::is_directory(o.case_dir), o.case_dir.string(),
+                    ": not a case folder (expected a folder holding case.json)");
+    const fs::path bin = o.bin_dir.empty() ? self_dir() : fs::absolute(o.bin_dir);
+    StageLayout layout;
+    layout.dir = [&](const std::string& stage, const std::string&) { return fs::path("check") / run_folder(stage); };
+    layout.config = [&](const std::string& stage, const std::string&) { return fs::path("check") / stage; };
+    const CasePlan plan = plan_case(load_json_file(case_file), case_file.string(), o.case_dir, bin, layout, true, true);
+    check_case_settings(plan, case_file);
+    std::cout << case_file.string() << ": the case and the settings of its " << plan.stages.size()
+              << " stages are valid\n";
+    return 0;
+  }
   // A stop signal is passed on to ninja and the stages, and this process reports it once they have ended.
   InterruptPolling polling;
   const fs::path run = fs::absolute(o.run_dir);

@@ -21,7 +21,12 @@ struct RunOptions {
   int jobs = 0;                     // ninja -j; 0 = ninja's default
   bool dry_run = false;             // write the Ninja file, show what would run (ninja -n)
   bool resume = false;              // the simulation continues from its last checkpoint (FLOESIM_RESUME)
+  bool check_only = false;          // plan the case and check every stage's settings; run and write nothing
 };
+
+// Every stage checks its settings (`--check-config`) before anything of the run is written; the problems of all
+// stages at once, as key paths of the case file, in one Error.
+void check_case_settings(const CasePlan& plan, const std::filesystem::path& case_file);
 
 // One writer at a time in a run folder: an exclusive lock (flock) on RUN/.floesim.lock, taken before anything is
 // written and held by the runner, ninja and every stage it starts (they inherit the descriptor), so it is free only

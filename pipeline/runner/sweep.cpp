@@ -21,6 +21,8 @@
 #include "pipeline/interrupt.h"
 #include "pipeline/options.h"
 #include "pipeline/runner/plan.h"
+#include "pipeline/runner/process.h"
+#include "pipeline/sweep/sweep_plan.h"
 #include "pipeline/runner/runner.h"
 
 #ifndef FLOESIM_NINJA
@@ -50,77 +52,6 @@ void require_known_keys(const Json& j, const std::vector<std::string>& known, co
   }
 }
 
-struct Output {
-  int code = 0;
-  std::string text;  // stdout and stderr
-};
-
-// A program running with its stdout and stderr coming back through a pipe (argv[0] searched in PATH; `env` set in
-// the child only).
-struct Child {
-  pid_t pid = -1;
-  FILE* out = nullptr;
-};
-Child spawn_piped(const std::vector<std::string>& args, const std::vector<std::pair<std::string, std::string>>& env = {}) {
-  int fd[2];
-  FLOESIM_REQUIRE(pipe(fd) == 0, "cannot create a pipe to run ", args[0]);
-  std::vector<std::string> a = args;
-  std::vector<char*> argv;
-  for (auto& s : a) argv.push_back(s.data());
-  argv.push_back(nullptr);
-  std::cout.flush();
-  const pid_t parent = getpid();
-  const pid_t pid = fork();
-  FLOESIM_REQUIRE(pid >= 0, "cannot start ", args[0], ": fork failed");
-  if (pid == 0) {
-    // If the runner is killed outright, the child is told to stop (ninja passes it on to the stages).
-    prctl(PR_SET_PDEATHSIG, SIGTERM);
-    if (getppid() != parent) _exit(128 + SIGTERM);
-    dup2(fd[1], 1);
-    dup2(fd[1], 2);
-    close(fd[0]);
-    close(fd[1]);
-    for (const auto& [k, v] : env) setenv(k.c_str(), v.c_str(), 1);
-    execvp(argv[0], argv.data());
-    std::fprintf(stderr, "floesim: cannot execute %s (is it installed?)\n", argv[0]);
-    _exit(127);
-  }
-  close(fd[1]);
-  register_child(pid);  // a stop signal is passed on to it (pipeline/interrupt.h)
-  return {pid, fdopen(fd[0], "r")};
-}
-
-// Closes the pipe and waits: the exit status (128 + the signal if killed).
-int wait_child(Child& c) {
-  std::fclose(c.out);
-  int status = 0;
-  while (waitpid(c.pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  unregister_child(c.pid);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
-}
-
-// One line from a child's pipe; false at its end. A stop signal (EINTR) does not end it: the child is told too,
-// and its last lines still come; `on_signal` (if any) runs at once, while the child's children are still stopping.
-bool read_line(FILE* in, char* line, int size, const std::function<void()>& on_signal = {}) {
-  for (;;) {
-    if (std::fgets(line, size, in)) return true;
-    if (!std::ferror(in) || errno != EINTR) return false;
-    std::clearerr(in);
-    if (on_signal) on_signal();
-  }
-}
-
-// Runs a program and collects its output.
-Output run_capture(const std::vector<std::string>& args) {
-  Child c = spawn_piped(args);
-  Output out;
-  char buf[4096];
-  while (read_line(c.out, buf, sizeof buf)) out.text += buf;
-  out.code = wait_child(c);
-  return out;
-}
-
 std::string value_text(const Json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
 
 // "simulate.vessel.propulsion.speed_mps = 2, image.synthetic.seed = 3"
@@ -132,20 +63,20 @@ std::string describe(const Member& m) {
 }
 
 // The stages of all members, each distinct instance once, in dependency order; and which members use each.
-struct SweepPlan {
+struct SweepStages {
   std::vector<PlannedStage> stages;
   std::vector<std::vector<int>> users;        // stage -> members
   std::vector<std::vector<int>> member_stages;  // member -> stages, in run order
   std::vector<CasePlan> members;
 };
 
-SweepPlan plan_members(const Sweep& s, const std::vector<Member>& members, const fs::path& run, const fs::path& bin) {
+SweepStages plan_members(const Sweep& s, const std::vector<Member>& members, const fs::path& run, const fs::path& bin) {
   StageLayout layout;
   layout.dir = [&](const std::string& stage, const std::string& key) { return run / "stages" / (stage + "-" + key); };
   layout.config = [&](const std::string& stage, const std::string& key) {
     return run / "stages" / (stage + "-" + key) / "config.json";
   };
-  SweepPlan p;
+  SweepStages p;
   std::map<std::string, int> index;  // key -> stage
   for (size_t m = 0; m < members.size(); ++m) {
     const std::string where = s.file.string() + " (member " + describe(members[m]) + ")";
@@ -167,21 +98,14 @@ SweepPlan plan_members(const Sweep& s, const std::vector<Member>& members, const
 
 // Each distinct stage instance checks its own settings (`--check-config`), from a temporary copy: nothing of the
 // run is written before the whole sweep is known to be valid. All problems are listed, one per instance.
-void check_stage_settings(const Sweep& s, const std::vector<Member>& members, const SweepPlan& p) {
+void check_stage_settings(const Sweep& s, const std::vector<Member>& members, const SweepStages& p) {
   const fs::path tmp = fs::temp_directory_path() / ("floesim-sweep-check-" + std::to_string(getpid()));
   ensure_directory(tmp);
   std::vector<std::string> problems;
   for (size_t k = 0; k < p.stages.size(); ++k) {
     const PlannedStage& st = p.stages[k];
-    const fs::path cfg = tmp / (st.name + "-" + st.key + ".json");
-    write_text_atomic(cfg, st.config_text);
-    const Output r = run_capture({st.exe.string(), "--check-config", "--config", cfg.string()});
-    if (r.code != 0) {
-      std::string msg = r.text;
-      while (!msg.empty() && msg.back() == '\n') msg.pop_back();
-      // The stage names the file it read: here a temporary copy of the member's settings.
-      for (size_t at; (at = msg.find(cfg.string())) != std::string::npos;)
-        msg.replace(at, cfg.string().size(), "(the member's " + st.name + " settings)");
+    const std::string msg = stage_settings_problems(st, tmp, "(the member's " + st.name + " settings)");
+    if (!msg.empty()) {
       problems.push_back("member " + describe(members[p.users[k][0]]) + ", stage " + st.name + ": " + msg);
     }
   }
@@ -192,65 +116,52 @@ void check_stage_settings(const Sweep& s, const std::vector<Member>& members, co
 
 // Writes what the run needs: stage settings, member folders (case.json and links to their stages' folders, named
 // as in a run folder) and plan.json for floesim-gather.
-void write_sweep_files(const Sweep& s, const std::vector<Member>& members, const SweepPlan& p, const fs::path& run) {
+void write_sweep_files(const Sweep& s, const std::vector<Member>& members, const SweepStages& p, const fs::path& run) {
   for (const PlannedStage& st : p.stages) {
     ensure_directory(st.dir);
     write_if_changed(st.config, st.config_text);
   }
-  Json plan_members = Json::array();
+  sweep::SweepPlan plan;
+  plan.name = s.name;
+  plan.sweep_file = fs::absolute(s.file).string();
+  plan.base_case = fs::absolute(s.base_dir).lexically_normal().string();
+  plan.combine = s.zip ? "zip" : "grid";
+  for (const SweepAxis& a : s.axes) plan.axes.push_back({a.key, a.paths, a.values});
+  Json vary = Json::array();
+  if (s.vary_field_seed) vary.push_back("field_seed");
+  if (s.vary_start) vary.push_back("start");
+  plan.ensemble = {{"size", s.ensemble_size}, {"vary", vary}, {"start_step_m", s.start_step_m}};
   for (size_t m = 0; m < members.size(); ++m) {
     const Member& mb = members[m];
-    const fs::path dir = run / "members" / mb.id;
-    ensure_directory(dir);
-    write_if_changed(dir / "case.json", mb.case_json.dump(2) + "\n");
-    Json stages = Json::array();
+    if (mb.ensemble_index == 0) plan.grid_points.push_back({static_cast<size_t>(mb.grid_point), mb.axes});
+    sweep::PlanMember pm;
+    pm.id = mb.id;
+    pm.grid_point = mb.grid_point;
+    pm.ensemble_index = mb.ensemble_index;
+    pm.axes = mb.axes;
+    pm.seeds = mb.seeds;
+    pm.dir = run / "members" / mb.id;
+    pm.summary = p.members[m].summary;
+    pm.results = p.members[m].results;
+    ensure_directory(pm.dir);
+    write_if_changed(pm.dir / "case.json", mb.case_json.dump(2) + "\n");
     for (int k : p.member_stages[m]) {
       const PlannedStage& st = p.stages[k];
       // A link replaced atomically: made under a temporary name, renamed over the old one.
-      const fs::path link = dir / run_folder(st.name), tmp = dir / (run_folder(st.name) + ".tmp-link");
+      const fs::path link = pm.dir / run_folder(st.name), tmp = pm.dir / (run_folder(st.name) + ".tmp-link");
       std::error_code ec;
       fs::remove(tmp, ec);
       fs::create_directory_symlink(fs::path("../../stages") / st.dir.filename(), tmp);
       fs::rename(tmp, link);
-      Json outs = Json::array();
-      for (const fs::path& o : st.outputs) outs.push_back(o.string());
-      stages.push_back({{"name", st.name},
-                        {"dir", st.dir.string()},
-                        {"outputs", outs},
-                        {"log", (st.dir / "log.txt").string()},
-                        {"wall_ms", (st.dir / "wall_ms").string()}});
+      pm.stages.push_back({st.name, st.dir, st.outputs, st.dir / "log.txt", st.dir / "wall_ms"});
     }
-    plan_members.push_back({{"id", mb.id},
-                            {"grid_point", mb.grid_point},
-                            {"ensemble_index", mb.ensemble_index},
-                            {"axes", mb.axes},
-                            {"seeds", mb.seeds},
-                            {"dir", dir.string()},
-                            {"summary", p.members[m].summary.string()},
-                            {"results", p.members[m].results.string()},
-                            {"stages", stages}});
+    plan.members.push_back(std::move(pm));
   }
-  Json axes = Json::array(), grid = Json::array();
-  for (const SweepAxis& a : s.axes) axes.push_back({{"key", a.key}, {"paths", a.paths}, {"values", a.values}});
-  for (const Member& mb : members)
-    if (mb.ensemble_index == 0) grid.push_back({{"index", mb.grid_point}, {"axes", mb.axes}});
-  Json vary = Json::array();
-  if (s.vary_field_seed) vary.push_back("field_seed");
-  if (s.vary_start) vary.push_back("start");
-  const Json plan = {{"format", "floesim-sweep-plan/1"},
-                     {"name", s.name},
-                     {"sweep_file", fs::absolute(s.file).string()},
-                     {"base_case", fs::absolute(s.base_dir).lexically_normal().string()},
-                     {"axes", axes},
-                     {"combine", s.zip ? "zip" : "grid"},
-                     {"ensemble", {{"size", s.ensemble_size}, {"vary", vary}, {"start_step_m", s.start_step_m}}},
-                     {"grid_points", grid},
-                     {"members", plan_members}};
-  write_if_changed(run / "plan.json", plan.dump(2) + "\n");
+  write_if_changed(run / "plan.json", sweep::sweep_plan_json(plan).dump(2) + "\n");
 }
 
 // Ninja, keep going past failures (-k 0), with a progress line from NINJA_STATUS and the members' final outputs.
-int run_ninja(const fs::path& run, int jobs, const std::vector<Member>& members, const SweepPlan& p,
+int run_ninja(const fs::path& run, int jobs, const std::vector<Member>& members, const SweepStages& p,
               std::vector<std::string>* interrupted_stages) {
   std::vector<std::string> args = {FLOESIM_NINJA, "-C", run.string(), "-f", "build.ninja", "-k", "0"};
   if (jobs > 0) args.push_back("-j" + std::to_string(jobs));
@@ -364,7 +275,7 @@ void write_report_config(const Sweep& s, const Json& base, const fs::path& bin, 
 // member does not stop the others; its downstream stages fail on their missing inputs), then the gather job. ---
 
 // Stages to run: an output missing or older than an input or the executable, or an input that will be remade.
-std::vector<bool> stale_stages(const SweepPlan& p) {
+std::vector<bool> stale_stages(const SweepStages& p) {
   std::vector<bool> stale(p.stages.size(), false);
   std::map<fs::path, size_t> producer;
   for (size_t k = 0; k < p.stages.size(); ++k)
@@ -384,7 +295,7 @@ std::vector<bool> stale_stages(const SweepPlan& p) {
   return stale;
 }
 
-std::vector<int> stage_levels(const SweepPlan& p) {
+std::vector<int> stage_levels(const SweepStages& p) {
   std::vector<int> level(p.stages.size(), 0);
   std::map<fs::path, size_t> producer;
   for (size_t k = 0; k < p.stages.size(); ++k) {
@@ -422,7 +333,7 @@ std::string sbatch_job(const Sweep& s, const fs::path& run, const fs::path& scri
   return id;
 }
 
-int submit_slurm(const Sweep& s, const fs::path& run, const fs::path& bin, const SweepPlan& p, bool wait) {
+int submit_slurm(const Sweep& s, const fs::path& run, const fs::path& bin, const SweepStages& p, bool wait) {
   const std::vector<bool> stale = stale_stages(p);
   const std::vector<int> level = stage_levels(p);
   ensure_directory(run / "slurm" / "logs");
@@ -470,7 +381,7 @@ int submit_slurm(const Sweep& s, const fs::path& run, const fs::path& bin, const
 }
 
 // Members whose stages are not all complete (after a local run or a cluster run).
-int report_failures(const std::vector<Member>& members, const SweepPlan& p) {
+int report_failures(const std::vector<Member>& members, const SweepStages& p) {
   int failed = 0;
   for (size_t m = 0; m < members.size(); ++m) {
     for (int k : p.member_stages[m]) {
@@ -701,7 +612,7 @@ int run_sweep(const SweepOptions& o) {
                   ": check the axes, and pass --yes to run them all");
   const fs::path run = fs::absolute(o.run_dir);
   const fs::path bin = o.bin_dir.empty() ? self_dir() : fs::absolute(o.bin_dir);
-  const SweepPlan p = plan_members(s, members, run, bin);
+  const SweepStages p = plan_members(s, members, run, bin);
   check_stage_settings(s, members, p);  // writes nothing in the run folder
   // One writer at a time in the run folder (see lock_run_folder), taken before anything is written there.
   const int lock = lock_run_folder(run);

@@ -76,12 +76,8 @@ IceHull resolve_ice_hull(const IceResistanceOptions& o, const fs::path& hull_jso
 std::string run_resistance(const IceResistanceOptions& o, const fs::path& hull_json, const fs::path& config_file,
                            const fs::path& out) {
   const std::string cfg = config_file.empty() ? std::string("the resistance options") : config_file.string();
-  {  // the options' own checks, also when the struct was filled in code rather than read from JSON
-    const Json none = Json::object();
-    OptionReader r(none, cfg, "");
-    const_cast<IceResistanceOptions&>(o).visit(r);
-    r.finish();
-  }
+  // The options' own checks, also when the struct was filled in code rather than read from JSON.
+  check_options(o, cfg);
   const std::string ext = out.extension().string();
   FLOESIM_REQUIRE(ext == ".json" || ext == ".csv", out.string(), ": --out must end in .json or .csv");
 

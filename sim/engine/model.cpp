@@ -536,23 +536,20 @@ Ittc57 ittc57_of(const VesselParticulars& v, const EngineSettings& o) {
   return c;
 }
 
-Model build_model(const FloeField& field, const HullModel* hull, const EngineSettings& o) {
-  Model model;
-  model.settings = o;
-  const double rho_w = o.water.density_kg_m3, rho_i = o.ice.density_kg_m3, g = o.water.gravity_mps2;
-  model.gravity = Vec3(0, 0, -g);
-  const double cdir = o.water.current_direction_deg * kPi / 180, wdir = o.wind.direction_deg * kPi / 180;
-  model.current = o.water.current_speed_mps * Vec3(std::cos(cdir), std::sin(cdir), 0);
-  model.wind = o.wind.speed_mps * Vec3(std::cos(wdir), std::sin(wdir), 0);
-  // Floes float at hydrostatic equilibrium; without water they are placed with their base at z = -draught anyway.
-  const double draught_ratio = rho_i / rho_w;
+namespace {
 
-  // 1. Floe geometry in the world: cleaned outline and convex pieces. The level ice sheets come as tiles (fixed
-  // floes) after the free floes.
+// 1. The floes of the model: the free floes of the field, then the level ice sheets as tiles (fixed floes).
+std::vector<Floe> model_floes(const FloeField& field, const LevelIceOptions& li) {
   std::vector<Floe> floes;
   for (const Floe& f : field.floes)
     if (!f.level_ice) floes.push_back(f);
-  for (Floe& f : level_ice_tiles(field, o.level_ice)) floes.push_back(std::move(f));
+  for (Floe& f : level_ice_tiles(field, li)) floes.push_back(std::move(f));
+  return floes;
+}
+
+// 1. Floe geometry in the world: cleaned CCW outline, convex pieces and boxes; a floe without thickness, without
+// area or whose outline intersects itself is an error. The results point into `floes`.
+std::vector<FloeGeometry> floe_geometry(const std::vector<Floe>& floes) {
   std::vector<FloeGeometry> geo(floes.size());
   for (size_t k = 0; k < floes.size(); ++k) {
     const Floe& f = floes[k];
@@ -572,180 +569,255 @@ Model build_model(const FloeField& field, const HullModel* hull, const EngineSet
     for (const Polygon& p : fg.pieces) fg.piece_box.push_back(bounds(p));
     fg.box = bounds(fg.outline);
   }
+  return geo;
+}
 
-  // 2. Floes must not overlap each other (sweep over x-sorted boxes; pairs reported by id).
-  {
-    std::vector<size_t> order(geo.size());
-    std::iota(order.begin(), order.end(), 0);
-    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-      return geo[a].box.lo.x() < geo[b].box.lo.x() || (geo[a].box.lo.x() == geo[b].box.lo.x() && a < b);
-    });
-    std::ostringstream bad;
-    int nbad = 0;
-    for (size_t i = 0; i < order.size(); ++i) {
-      const FloeGeometry& a = geo[order[i]];
-      for (size_t j = i + 1; j < order.size(); ++j) {
-        const FloeGeometry& b = geo[order[j]];
-        if (b.box.lo.x() > a.box.hi.x()) break;
-        if (!a.box.overlaps(b.box)) continue;
-        const double area = overlap_area(a, b);
-        if (area <= 1e-9) continue;
-        const double smaller = std::min(a.area, b.area);
-        if (area > o.ice.max_overlap_fraction * smaller) {
-          if (nbad < 10)
-            bad << "\n  - floes " << std::min(a.floe->id, b.floe->id) << " and " << std::max(a.floe->id, b.floe->id)
-                << " overlap by " << area << " m^2 (" << 100 * area / smaller << " % of the smaller)";
-          ++nbad;
-        } else {
-          ++model.small_overlaps;
-        }
+// 2. Floes must not overlap each other (sweep over x-sorted boxes; pairs reported by id): overlaps above
+// ice.max_overlap_fraction of the smaller floe are an error; returns the number of smaller ones (digitisation noise).
+int count_small_overlaps(const std::vector<FloeGeometry>& geo, const EngineSettings& o) {
+  std::vector<size_t> order(geo.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return geo[a].box.lo.x() < geo[b].box.lo.x() || (geo[a].box.lo.x() == geo[b].box.lo.x() && a < b);
+  });
+  std::ostringstream bad;
+  int nbad = 0, small = 0;
+  for (size_t i = 0; i < order.size(); ++i) {
+    const FloeGeometry& a = geo[order[i]];
+    for (size_t j = i + 1; j < order.size(); ++j) {
+      const FloeGeometry& b = geo[order[j]];
+      if (b.box.lo.x() > a.box.hi.x()) break;
+      if (!a.box.overlaps(b.box)) continue;
+      const double area = overlap_area(a, b);
+      if (area <= 1e-9) continue;
+      const double smaller = std::min(a.area, b.area);
+      if (area > o.ice.max_overlap_fraction * smaller) {
+        if (nbad < 10)
+          bad << "\n  - floes " << std::min(a.floe->id, b.floe->id) << " and " << std::max(a.floe->id, b.floe->id)
+              << " overlap by " << area << " m^2 (" << 100 * area / smaller << " % of the smaller)";
+        ++nbad;
+      } else {
+        ++small;
       }
     }
-    FLOESIM_REQUIRE(nbad == 0, "the floes file has ", nbad, " pair(s) of overlapping floes (above ",
-                    100 * o.ice.max_overlap_fraction, " % of the smaller floe, ice.max_overlap_fraction):", bad.str(),
-                    nbad > 10 ? "\n  - ..." : "", "\n  fix the digitisation, or raise ice.max_overlap_fraction");
   }
+  FLOESIM_REQUIRE(nbad == 0, "the floes file has ", nbad, " pair(s) of overlapping floes (above ",
+                  100 * o.ice.max_overlap_fraction, " % of the smaller floe, ice.max_overlap_fraction):", bad.str(),
+                  nbad > 10 ? "\n  - ..." : "", "\n  fix the digitisation, or raise ice.max_overlap_fraction");
+  return small;
+}
 
-  // 3. The vessel: floating position, mass, inertia, particulars, convex parts.
+// How the vessel floats: its mass and the sinkage that carries it.
+struct Flotation {
+  double mass = 0;  // kg
+  double dz = 0;    // the hull frame raised by dz, so that rho_w V_sub = mass (0 when the mass comes from the hull)
+};
+
+// 3. The vessel's mass (vessel.mass_kg, else the hull's displacement at z = 0) and the sinkage that floats it
+// (bisection); a hull without volume below z = 0, or one that cannot carry the mass, is an error.
+Flotation flotation(const TriMesh& surf, const EngineSettings& o) {
+  const double rho_w = o.water.density_kg_m3;
+  const double m0 = rho_w * submerged_part(surf.vertices, surf.triangles, 0.0).volume;
+  FLOESIM_REQUIRE(m0 > 0, "hull: no volume below the waterline z = 0 (is z up and the waterline at z = 0?)");
+  const double mass = o.vessel.mass_kg > 0 ? o.vessel.mass_kg : m0;
+  // Sinkage dz (hull frame raised by dz) so that rho_w V_sub = mass; 0 when the mass comes from the hull.
+  double dz = 0;
+  if (o.vessel.mass_kg > 0) {
+    double zmin = 1e300, zmax = -1e300;
+    for (const Vec3& v : surf.vertices) {
+      zmin = std::min(zmin, v.z());
+      zmax = std::max(zmax, v.z());
+    }
+    double lo = -zmax, hi = -zmin;  // raised by -zmax: fully submerged; by -zmin: out of the water
+    const double full = rho_w * mass_properties(surf).volume;
+    FLOESIM_REQUIRE(mass < full, "vessel.mass_kg = ", mass, " is more than the hull can carry (", full,
+                    " kg fully submerged)");
+    for (int it = 0; it < 200; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      const double mm = rho_w * submerged_part(shifted(surf, Vec3(0, 0, mid)).vertices, surf.triangles, 0).volume;
+      (mm > mass ? lo : hi) = mid;
+    }
+    dz = 0.5 * (lo + hi);
+  }
+  return {mass, dz};
+}
+
+// 3. The particulars of the floating hull into vp: waterline, wetted surface, displacement, mass, centre of mass
+// (hull frame), radii of gyration, strips about the centre of mass. Returns the submerged part.
+Submerged floating_particulars(const HullModel& hull, const Flotation& fl, const EngineSettings& o,
+                               VesselParticulars& vp) {
+  const TriMesh floating = shifted(hull.surface, Vec3(0, 0, fl.dz));
+  const Submerged sub = submerged_part(floating.vertices, floating.triangles, 0.0);
+  waterline_particulars(floating, vp);
+  // The merged surface holds the faces shared by adjacent parts: the hull module's hydrostatics excludes them
+  // from the wetted surface (they cancel in volumes, so clipping the merged surface is right for buoyancy).
+  vp.wetted_surface_m2 = hydrostatics(hull.parts, o.water.density_kg_m3, -fl.dz).wetted_surface_m2;
+  vp.displacement_m3 = sub.volume;
+  vp.waterplane_area_m2 = sub.waterplane_area;
+  vp.mass_kg = fl.mass;
+  vp.centre_of_mass_hull = Vec3(sub.centroid.x(), sub.centroid.y(), o.vessel.vcg_m);
+  const Vec3 com = vp.centre_of_mass_hull;  // hull frame
+  vp.radii_of_gyration_m = Vec3(o.vessel.kxx_m > 0 ? o.vessel.kxx_m : 0.38 * vp.beam_wl_m,
+                                o.vessel.kyy_m > 0 ? o.vessel.kyy_m : 0.25 * vp.length_oa_m,
+                                o.vessel.kzz_m > 0 ? o.vessel.kzz_m : 0.25 * vp.length_oa_m);
+  for (double& x : vp.strip_x_m) x -= com.x();
+  return sub;
+}
+
+// 3. The vessel's added mass (PHYSICS.md §3.3), only with water: surge, sway and yaw as fractions of the mass and
+// I_zz; heave and pitch by strip theory, each waterline strip a semicircular section of beam B(x) with the
+// high-frequency 2-D heave added mass (pi/8) rho_w B^2 per metre (half the circle's rho pi (B/2)^2, also the flat
+// plate's; Lewis 1929 forms of a full section of B/T ~ 3 carry a coefficient C of about 1-1.2 on it: the scale
+// option), so A33 = (pi/8) rho_w sum B^2 dx and A55 = (pi/8) rho_w sum B^2 x^2 dx about the centre of mass. Roll
+// keeps none (the roll period is not what the ice loads depend on).
+void set_vessel_added_mass(Body& b, const VesselParticulars& vp, const EngineSettings& o) {
+  if (o.water.enabled) {
+    const double rho_w = o.water.density_kg_m3, mass = b.mass_kg;
+    double a33 = 0, a55 = 0;
+    for (size_t i = 0; i < vp.strip_x_m.size(); ++i) {
+      const double x = vp.strip_x_m[i], beam = vp.strip_beam_m[i];
+      const double strip = kPi / 8 * rho_w * beam * beam * vp.strip_length_m;
+      a33 += strip;
+      a55 += strip * x * x;
+    }
+    const double s = o.vessel.heave_pitch_added_mass_scale;
+    set_added_mass(b, Vec3(o.vessel.surge_added_mass_ratio * mass, o.vessel.sway_added_mass_ratio * mass, s * a33),
+                   Vec3(0, s * a55, o.vessel.yaw_added_inertia_ratio * b.inertia(2, 2)));
+  } else {
+    set_added_mass(b, Vec3::Zero(), Vec3::Zero());
+  }
+}
+
+// 3. The vessel's rigid body (id 0): mass, inertia from the radii of gyration or given outright
+// (vessel.inertia_kg_m2, body axes about the centre of mass; the radii reported are then those of its diagonal),
+// added mass.
+Body vessel_body(double mass, VesselParticulars& vp, const EngineSettings& o) {
+  Body b;
+  b.kind = BodyKind::vessel;
+  b.id = 0;
+  b.mass_kg = mass;
+  b.inv_mass = 1 / mass;
+  const std::vector<double>& Ig = o.vessel.inertia_kg_m2;
+  if (Ig.empty()) {
+    b.inertia = mass * vp.radii_of_gyration_m.cwiseProduct(vp.radii_of_gyration_m).asDiagonal();
+  } else {
+    // Given outright (body axes about the centre of mass); the radii reported are those of its diagonal.
+    const double xy = Ig.size() == 6 ? Ig[3] : 0, xz = Ig.size() == 6 ? Ig[4] : 0, yz = Ig.size() == 6 ? Ig[5] : 0;
+    b.inertia << Ig[0], xy, xz, xy, Ig[1], yz, xz, yz, Ig[2];
+    vp.radii_of_gyration_m = (b.inertia.diagonal() / mass).cwiseSqrt();
+  }
+  b.inv_inertia = b.inertia.inverse();
+  set_vessel_added_mass(b, vp, o);
+  return b;
+}
+
+// 3. The propellers, moved from the hull frame to the body frame (about the centre of mass com).
+void add_propellers(const EngineSettings& o, const Vec3& com, Model& model) {
+  for (const PropellerOptions& po : o.vessel.propellers) {
+    Propeller p;
+    p.position = Vec3(po.position_m[0], po.position_m[1], po.position_m[2]) - com;  // hull frame to body frame
+    p.axis = Vec3(po.axis[0], po.axis[1], po.axis[2]).normalized();
+    p.diameter_m = po.diameter_m;
+    p.thrust_share = po.thrust_share;
+    model.propellers.push_back(p);
+  }
+}
+
+// 3. Places the vessel body: buoyancy mesh and convex parts about the centre of mass, afloat at the sinkage dz,
+// turned to vessel.heading_deg, at (vessel.x_m, vessel.y_m); its parts are the model's first.
+void place_vessel(Body& b, const HullModel& hull, const Vec3& com, double dz, const EngineSettings& o, Model& model) {
+  b.buoyancy_mesh = shifted(hull.surface, -com);
+  const double heading = o.vessel.heading_deg * kPi / 180;
+  b.initial_orientation = Quat(Eigen::AngleAxisd(heading, Vec3::UnitZ()));
+  b.initial_position = Vec3(o.vessel.x_m, o.vessel.y_m, com.z() + dz);
+  b.first_part = 0;
+  b.part_count = static_cast<int>(hull.parts.size());
+  model.vessel = 0;
+  for (const TriMesh& p : hull.parts) model.parts.push_back(make_convex_part(shifted(p, -com), 0));
+  mark_shared_faces(model.parts, 0, b.part_count);
+}
+
+// 3. Metacentric heights from the clipped hull (the same buoyancy the simulation applies) into vp; a vessel unstable
+// in roll is an error.
+void metacentric_heights(const Body& b, double displacement_m3, const EngineSettings& o, VesselParticulars& vp) {
+  const double rho_w = o.water.density_kg_m3, g = o.water.gravity_mps2;
+  const double rho_g = rho_w * g > 0 ? rho_w * g : rho_w * 9.81;
+  const double k44 =
+      rotational_stiffness(b.buoyancy_mesh, b.initial_position, b.initial_orientation, Vec3::UnitX(), rho_g);
+  const double k55 =
+      rotational_stiffness(b.buoyancy_mesh, b.initial_position, b.initial_orientation, Vec3::UnitY(), rho_g);
+  vp.gm_transverse_m = k44 / (rho_g * displacement_m3);
+  vp.gm_longitudinal_m = k55 / (rho_g * displacement_m3);
+  FLOESIM_REQUIRE(vp.gm_transverse_m > 0, "vessel.vcg_m = ", o.vessel.vcg_m,
+                  " m makes the vessel unstable in roll (GM_T = ", vp.gm_transverse_m,
+                  " m): lower the centre of mass");
+}
+
+// 3. Footprint of the hull parts in the band of z the floes occupy, at the vessel's initial pose: what a floe must
+// not overlap at the start.
+std::vector<Polygon> vessel_footprint(const HullModel& hull, const Body& vb, const Vec3& com,
+                                      const std::vector<Floe>& floes, const EngineSettings& o) {
+  // Floes float at hydrostatic equilibrium; without water they are placed with their base at z = -draught anyway.
+  const double draught_ratio = o.ice.density_kg_m3 / o.water.density_kg_m3;
+  double zlo = 0, zhi = 0;
+  for (const Floe& f : floes) {
+    zlo = std::min(zlo, -draught_ratio * f.thickness_m);
+    zhi = std::max(zhi, (1 - draught_ratio) * f.thickness_m);
+  }
+  const Mat3 R = vb.initial_orientation.toRotationMatrix();
   std::vector<Polygon> footprint;
-  if (hull) {
-    FLOESIM_REQUIRE(!hull->parts.empty(), "hull: no convex parts");
-    const TriMesh& surf = hull->surface;
-    const double m0 = rho_w * submerged_part(surf.vertices, surf.triangles, 0.0).volume;
-    FLOESIM_REQUIRE(m0 > 0, "hull: no volume below the waterline z = 0 (is z up and the waterline at z = 0?)");
-    const double mass = o.vessel.mass_kg > 0 ? o.vessel.mass_kg : m0;
-    // Sinkage dz (hull frame raised by dz) so that rho_w V_sub = mass; 0 when the mass comes from the hull.
-    double dz = 0;
-    if (o.vessel.mass_kg > 0) {
-      double zmin = 1e300, zmax = -1e300;
-      for (const Vec3& v : surf.vertices) {
-        zmin = std::min(zmin, v.z());
-        zmax = std::max(zmax, v.z());
-      }
-      double lo = -zmax, hi = -zmin;  // raised by -zmax: fully submerged; by -zmin: out of the water
-      const double full = rho_w * mass_properties(surf).volume;
-      FLOESIM_REQUIRE(mass < full, "vessel.mass_kg = ", mass, " is more than the hull can carry (", full,
-                      " kg fully submerged)");
-      for (int it = 0; it < 200; ++it) {
-        const double mid = 0.5 * (lo + hi);
-        const double mm = rho_w * submerged_part(shifted(surf, Vec3(0, 0, mid)).vertices, surf.triangles, 0).volume;
-        (mm > mass ? lo : hi) = mid;
-      }
-      dz = 0.5 * (lo + hi);
-    }
-    const TriMesh floating = shifted(surf, Vec3(0, 0, dz));
-    const Submerged sub = submerged_part(floating.vertices, floating.triangles, 0.0);
-    VesselParticulars& vp = model.vessel_info;
-    waterline_particulars(floating, vp);
-    // The merged surface holds the faces shared by adjacent parts: the hull module's hydrostatics excludes them
-    // from the wetted surface (they cancel in volumes, so clipping the merged surface is right for buoyancy).
-    vp.wetted_surface_m2 = hydrostatics(hull->parts, rho_w, -dz).wetted_surface_m2;
-    vp.displacement_m3 = sub.volume;
-    vp.waterplane_area_m2 = sub.waterplane_area;
-    vp.mass_kg = mass;
-    vp.centre_of_mass_hull = Vec3(sub.centroid.x(), sub.centroid.y(), o.vessel.vcg_m);
-    const Vec3 com = vp.centre_of_mass_hull;  // hull frame
-    vp.radii_of_gyration_m = Vec3(o.vessel.kxx_m > 0 ? o.vessel.kxx_m : 0.38 * vp.beam_wl_m,
-                                  o.vessel.kyy_m > 0 ? o.vessel.kyy_m : 0.25 * vp.length_oa_m,
-                                  o.vessel.kzz_m > 0 ? o.vessel.kzz_m : 0.25 * vp.length_oa_m);
-    for (double& x : vp.strip_x_m) x -= com.x();
-
-    Body b;
-    b.kind = BodyKind::vessel;
-    b.id = 0;
-    b.mass_kg = mass;
-    b.inv_mass = 1 / mass;
-    const std::vector<double>& Ig = o.vessel.inertia_kg_m2;
-    if (Ig.empty()) {
-      b.inertia = mass * vp.radii_of_gyration_m.cwiseProduct(vp.radii_of_gyration_m).asDiagonal();
-    } else {
-      // Given outright (body axes about the centre of mass); the radii reported are those of its diagonal.
-      const double xy = Ig.size() == 6 ? Ig[3] : 0, xz = Ig.size() == 6 ? Ig[4] : 0, yz = Ig.size() == 6 ? Ig[5] : 0;
-      b.inertia << Ig[0], xy, xz, xy, Ig[1], yz, xz, yz, Ig[2];
-      vp.radii_of_gyration_m = (b.inertia.diagonal() / mass).cwiseSqrt();
-    }
-    b.inv_inertia = b.inertia.inverse();
-    // Added mass (PHYSICS.md §3.3), only with water: surge, sway and yaw as fractions of the mass and I_zz; heave and
-    // pitch by strip theory, each waterline strip a semicircular section of beam B(x) with the high-frequency 2-D
-    // heave added mass (pi/8) rho_w B^2 per metre (half the circle's rho pi (B/2)^2, also the flat plate's; Lewis
-    // 1929 forms of a full section of B/T ~ 3 carry a coefficient C of about 1-1.2 on it: the scale option), so
-    // A33 = (pi/8) rho_w sum B^2 dx and A55 = (pi/8) rho_w sum B^2 x^2 dx about the centre of mass. Roll keeps none
-    // (the roll period is not what the ice loads depend on).
-    if (o.water.enabled) {
-      double a33 = 0, a55 = 0;
-      for (size_t i = 0; i < vp.strip_x_m.size(); ++i) {
-        const double x = vp.strip_x_m[i], beam = vp.strip_beam_m[i];
-        const double strip = kPi / 8 * rho_w * beam * beam * vp.strip_length_m;
-        a33 += strip;
-        a55 += strip * x * x;
-      }
-      const double s = o.vessel.heave_pitch_added_mass_scale;
-      set_added_mass(b, Vec3(o.vessel.surge_added_mass_ratio * mass, o.vessel.sway_added_mass_ratio * mass, s * a33),
-                     Vec3(0, s * a55, o.vessel.yaw_added_inertia_ratio * b.inertia(2, 2)));
-    } else {
-      set_added_mass(b, Vec3::Zero(), Vec3::Zero());
-    }
-    for (const PropellerOptions& po : o.vessel.propellers) {
-      Propeller p;
-      p.position = Vec3(po.position_m[0], po.position_m[1], po.position_m[2]) - com;  // hull frame to body frame
-      p.axis = Vec3(po.axis[0], po.axis[1], po.axis[2]).normalized();
-      p.diameter_m = po.diameter_m;
-      p.thrust_share = po.thrust_share;
-      model.propellers.push_back(p);
-    }
-    b.buoyancy_mesh = shifted(surf, -com);
-    const double heading = o.vessel.heading_deg * kPi / 180;
-    b.initial_orientation = Quat(Eigen::AngleAxisd(heading, Vec3::UnitZ()));
-    b.initial_position = Vec3(o.vessel.x_m, o.vessel.y_m, com.z() + dz);
-    b.first_part = 0;
-    b.part_count = static_cast<int>(hull->parts.size());
-    model.vessel = 0;
-    for (const TriMesh& p : hull->parts) model.parts.push_back(make_convex_part(shifted(p, -com), 0));
-    mark_shared_faces(model.parts, 0, b.part_count);
-    // Metacentric heights from the clipped hull (the same buoyancy the simulation applies).
-    const double rho_g = rho_w * g > 0 ? rho_w * g : rho_w * 9.81;
-    const double k44 =
-        rotational_stiffness(b.buoyancy_mesh, b.initial_position, b.initial_orientation, Vec3::UnitX(), rho_g);
-    const double k55 =
-        rotational_stiffness(b.buoyancy_mesh, b.initial_position, b.initial_orientation, Vec3::UnitY(), rho_g);
-    vp.gm_transverse_m = k44 / (rho_g * sub.volume);
-    vp.gm_longitudinal_m = k55 / (rho_g * sub.volume);
-    FLOESIM_REQUIRE(vp.gm_transverse_m > 0, "vessel.vcg_m = ", o.vessel.vcg_m,
-                    " m makes the vessel unstable in roll (GM_T = ", vp.gm_transverse_m,
-                    " m): lower the centre of mass");
-    if (o.water.enabled)
-      set_damping(b, o, o.water.vessel_heave_damping_ratio, o.water.vessel_roll_damping_ratio,
-                  o.water.vessel_pitch_damping_ratio);
-    model.bodies.push_back(std::move(b));
-
-    // Footprint of the hull parts in the band of z the floes occupy, at the initial pose.
-    double zlo = 0, zhi = 0;
-    for (const Floe& f : floes) {
-      zlo = std::min(zlo, -draught_ratio * f.thickness_m);
-      zhi = std::max(zhi, (1 - draught_ratio) * f.thickness_m);
-    }
-    const Body& vb = model.bodies[0];
-    const Mat3 R = vb.initial_orientation.toRotationMatrix();
-    for (int p = 0; p < vb.part_count; ++p) {
-      const TriMesh& tm = hull->parts[p];
-      std::vector<Vec3> w(tm.vertices.size());
-      for (size_t i = 0; i < w.size(); ++i) w[i] = vb.initial_position + R * (tm.vertices[i] - com);
-      Polygon fp = band_footprint(w, tm.triangles, zlo, zhi);
-      if (fp.size() >= 3) footprint.push_back(std::move(fp));
-    }
+  for (int p = 0; p < vb.part_count; ++p) {
+    const TriMesh& tm = hull.parts[p];
+    std::vector<Vec3> w(tm.vertices.size());
+    for (size_t i = 0; i < w.size(); ++i) w[i] = vb.initial_position + R * (tm.vertices[i] - com);
+    Polygon fp = band_footprint(w, tm.triangles, zlo, zhi);
+    if (fp.size() >= 3) footprint.push_back(std::move(fp));
   }
+  return footprint;
+}
 
-  // 4. Floe bodies: slab of the floe's thickness, body frame at the centre of mass, at hydrostatic equilibrium.
+// 3. The vessel, the model's first body: floating position, mass, inertia, particulars, propellers, convex parts,
+// damping. Returns its footprint among the floes.
+std::vector<Polygon> add_vessel(const HullModel& hull, const std::vector<Floe>& floes, const EngineSettings& o,
+                                Model& model) {
+  FLOESIM_REQUIRE(!hull.parts.empty(), "hull: no convex parts");
+  const Flotation fl = flotation(hull.surface, o);
+  VesselParticulars& vp = model.vessel_info;
+  const Submerged sub = floating_particulars(hull, fl, o, vp);
+  const Vec3 com = vp.centre_of_mass_hull;  // hull frame
+  Body b = vessel_body(fl.mass, vp, o);
+  add_propellers(o, com, model);
+  place_vessel(b, hull, com, fl.dz, o, model);
+  metacentric_heights(b, sub.volume, o, vp);
+  if (o.water.enabled)
+    set_damping(b, o, o.water.vessel_heave_damping_ratio, o.water.vessel_roll_damping_ratio,
+                o.water.vessel_pitch_damping_ratio);
+  model.bodies.push_back(std::move(b));
+  return vessel_footprint(hull, model.bodies[0], com, floes, o);
+}
+
+// 4. Whether a floe overlaps the vessel's footprint (boxes first, then the convex pieces).
+bool overlaps_footprint(const FloeGeometry& fg, const std::vector<Polygon>& footprint,
+                        const std::vector<Aabb2>& fp_box) {
+  bool hit = false;
+  for (size_t i = 0; i < footprint.size() && !hit; ++i) {
+    if (!fp_box[i].overlaps(fg.box)) continue;
+    for (size_t j = 0; j < fg.pieces.size() && !hit; ++j)
+      hit = fp_box[i].overlaps(fg.piece_box[j]) && convex_intersection_area(footprint[i], fg.pieces[j]) > 1e-9;
+  }
+  return hit;
+}
+
+// 4. Floe bodies: slab of the floe's thickness, body frame at the centre of mass, at hydrostatic equilibrium; level
+// ice tiles held fixed. The vessel starts in open water or in broken ice: a floe in its way is removed, level ice
+// is an error.
+void add_floe_bodies(const std::vector<FloeGeometry>& geo, const std::vector<Polygon>& footprint,
+                     const EngineSettings& o, Model& model) {
   std::vector<Aabb2> fp_box;
   for (const Polygon& p : footprint) fp_box.push_back(bounds(p));
   for (const FloeGeometry& fg : geo) {
     const Floe& f = *fg.floe;
-    bool hit = false;
-    for (size_t i = 0; i < footprint.size() && !hit; ++i) {
-      if (!fp_box[i].overlaps(fg.box)) continue;
-      for (size_t j = 0; j < fg.pieces.size() && !hit; ++j)
-        hit = fp_box[i].overlaps(fg.piece_box[j]) && convex_intersection_area(footprint[i], fg.pieces[j]) > 1e-9;
-    }
+    const bool hit = overlaps_footprint(fg, footprint, fp_box);
     // The vessel starts in open water or in broken ice: a floe in its way is removed, level ice is an error.
     FLOESIM_REQUIRE(!(hit && f.level_ice), "the level ice sheet (tile id ", f.id, " at ", fg.box.lo.x(), ", ",
                     fg.box.lo.y(), " m) overlaps the vessel's start: move vessel.x_m / vessel.y_m into open water, or "
@@ -761,62 +833,113 @@ Model build_model(const FloeField& field, const HullModel* hull, const EngineSet
                                           model.parts));
     if (f.level_ice) hold_fixed(model.bodies.back());
   }
+}
 
-  // 5. Domain walls: static boxes outside the sides of the domain rectangle, overlapping at the corners (two walls
-  // never collide with each other: both sleep). A floe or the vessel's start overlapping a wall is an error.
-  if (!o.domain.walls.empty()) {
-    const std::vector<double>& e = o.domain.extent_m;
-    FLOESIM_REQUIRE(!e.empty() || (field.width_m > 0 && field.height_m > 0),
-                    "domain.walls: the floes file gives no field extent (width_m, height_m): set domain.extent_m");
-    const double x0 = e.empty() ? 0.0 : e[0], y0 = e.empty() ? 0.0 : e[1];
-    const double x1 = e.empty() ? field.width_m : e[2], y1 = e.empty() ? field.height_m : e[3];
-    const double t = o.domain.wall_thickness_m;
-    // Tall enough for the vessel's keel and any floe: from 2 m below the deepest hull point to 10 m above water.
-    double zlo = -10, zhi = 10;
-    if (hull)
-      for (const Vec3& v : model.bodies[0].buoyancy_mesh.vertices)
-        zlo = std::min(zlo, model.bodies[0].initial_position.z() + v.z() - 2);
-    for (const std::string& side : o.domain.walls) {
-      Vec2 lo, hi;
-      if (side == "west") lo = {x0 - t, y0 - t}, hi = {x0, y1 + t};
-      else if (side == "east") lo = {x1, y0 - t}, hi = {x1 + t, y1 + t};
-      else if (side == "south") lo = {x0 - t, y0 - t}, hi = {x1 + t, y0};
-      else lo = {x0 - t, y1}, hi = {x1 + t, y1 + t};
-      const Polygon rect = {lo, Vec2(hi.x(), lo.y()), hi, Vec2(lo.x(), hi.y())};
-      const Aabb2 rbox{lo, hi};
-      std::ostringstream bad;
-      int nbad = 0;
-      for (size_t k = (hull ? 1 : 0); k < model.bodies.size(); ++k) {
-        const Body& fb = model.bodies[k];
-        if (fb.kind != BodyKind::floe) continue;
-        Polygon world;
-        for (const Vec2& v : fb.outline) world.push_back(v + fb.initial_position.head<2>());
-        if (!rbox.overlaps(bounds(world))) continue;
-        bool hit = false;
-        for (const Polygon& piece : convex_decompose(world)) hit = hit || convex_intersection_area(piece, rect) > 1e-9;
-        if (hit && nbad++ < 10) bad << " " << fb.id;
-      }
-      FLOESIM_REQUIRE(nbad == 0, "domain wall \"", side, "\" (outside the domain [", x0, ", ", y0, "] - [", x1, ", ",
-                      y1, "] m) overlaps ", nbad, " floe(s), ids", bad.str(), nbad > 10 ? " ..." : "",
-                      ": enlarge domain.extent_m or drop the wall");
-      for (const Polygon& fp : footprint)
-        FLOESIM_REQUIRE(convex_intersection_area(fp, rect) <= 1e-9, "domain wall \"", side,
-                        "\" overlaps the vessel's start (vessel.x_m, vessel.y_m): move the vessel into the domain");
-      Body b;
-      b.kind = BodyKind::wall;
-      b.id = -1 - model.wall_count;
-      const Vec2 c = 0.5 * (lo + hi);
-      b.initial_position = Vec3(c.x(), c.y(), 0.5 * (zlo + zhi));
-      Polygon local;
-      for (const Vec2& v : rect) local.push_back(v - c);
-      b.first_part = static_cast<int>(model.parts.size());
-      b.part_count = 1;
-      model.parts.push_back(make_convex_part(extrude_polygon(local, -0.5 * (zhi - zlo), zhi - zlo),
-                                             static_cast<int>(model.bodies.size())));
-      model.bodies.push_back(std::move(b));  // mass 0: inv_mass and inverse inertia stay 0 (immovable)
-      ++model.wall_count;
-    }
+// The domain rectangle the walls stand outside of, and the walls' band of z.
+struct WallFrame {
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // domain corners (m)
+  double t = 0;                           // wall thickness (m)
+  double zlo = -10, zhi = 10;
+};
+
+// 5. The walls' frame: domain.extent_m, else the floes file's field extent (an error if it has none); tall enough
+// for the vessel's keel and any floe: from 2 m below the deepest hull point to 10 m above water.
+WallFrame wall_frame(const FloeField& field, bool has_vessel, const EngineSettings& o, const Model& model) {
+  const std::vector<double>& e = o.domain.extent_m;
+  FLOESIM_REQUIRE(!e.empty() || (field.width_m > 0 && field.height_m > 0),
+                  "domain.walls: the floes file gives no field extent (width_m, height_m): set domain.extent_m");
+  WallFrame w;
+  w.x0 = e.empty() ? 0.0 : e[0], w.y0 = e.empty() ? 0.0 : e[1];
+  w.x1 = e.empty() ? field.width_m : e[2], w.y1 = e.empty() ? field.height_m : e[3];
+  w.t = o.domain.wall_thickness_m;
+  // Tall enough for the vessel's keel and any floe: from 2 m below the deepest hull point to 10 m above water.
+  if (has_vessel)
+    for (const Vec3& v : model.bodies[0].buoyancy_mesh.vertices)
+      w.zlo = std::min(w.zlo, model.bodies[0].initial_position.z() + v.z() - 2);
+  return w;
+}
+
+// 5. A wall overlapping a floe (up to 10 ids named) or the vessel's start is an error.
+void require_wall_clear(const std::string& side, const Polygon& rect, const Aabb2& rbox, const WallFrame& w,
+                        bool has_vessel, const std::vector<Polygon>& footprint, const Model& model) {
+  std::ostringstream bad;
+  int nbad = 0;
+  for (size_t k = (has_vessel ? 1 : 0); k < model.bodies.size(); ++k) {
+    const Body& fb = model.bodies[k];
+    if (fb.kind != BodyKind::floe) continue;
+    Polygon world;
+    for (const Vec2& v : fb.outline) world.push_back(v + fb.initial_position.head<2>());
+    if (!rbox.overlaps(bounds(world))) continue;
+    bool hit = false;
+    for (const Polygon& piece : convex_decompose(world)) hit = hit || convex_intersection_area(piece, rect) > 1e-9;
+    if (hit && nbad++ < 10) bad << " " << fb.id;
   }
+  FLOESIM_REQUIRE(nbad == 0, "domain wall \"", side, "\" (outside the domain [", w.x0, ", ", w.y0, "] - [", w.x1,
+                  ", ", w.y1, "] m) overlaps ", nbad, " floe(s), ids", bad.str(), nbad > 10 ? " ..." : "",
+                  ": enlarge domain.extent_m or drop the wall");
+  for (const Polygon& fp : footprint)
+    FLOESIM_REQUIRE(convex_intersection_area(fp, rect) <= 1e-9, "domain wall \"", side,
+                    "\" overlaps the vessel's start (vessel.x_m, vessel.y_m): move the vessel into the domain");
+}
+
+// 5. Domain walls: static boxes outside the sides of the domain rectangle, overlapping at the corners (two walls
+// never collide with each other: both sleep). A floe or the vessel's start overlapping a wall is an error.
+void add_walls(const FloeField& field, bool has_vessel, const std::vector<Polygon>& footprint,
+               const EngineSettings& o, Model& model) {
+  const WallFrame w = wall_frame(field, has_vessel, o, model);
+  const double x0 = w.x0, y0 = w.y0, x1 = w.x1, y1 = w.y1, t = w.t, zlo = w.zlo, zhi = w.zhi;
+  for (const std::string& side : o.domain.walls) {
+    Vec2 lo, hi;
+    if (side == "west") lo = {x0 - t, y0 - t}, hi = {x0, y1 + t};
+    else if (side == "east") lo = {x1, y0 - t}, hi = {x1 + t, y1 + t};
+    else if (side == "south") lo = {x0 - t, y0 - t}, hi = {x1 + t, y0};
+    else lo = {x0 - t, y1}, hi = {x1 + t, y1 + t};
+    const Polygon rect = {lo, Vec2(hi.x(), lo.y()), hi, Vec2(lo.x(), hi.y())};
+    require_wall_clear(side, rect, Aabb2{lo, hi}, w, has_vessel, footprint, model);
+    Body b;
+    b.kind = BodyKind::wall;
+    b.id = -1 - model.wall_count;
+    const Vec2 c = 0.5 * (lo + hi);
+    b.initial_position = Vec3(c.x(), c.y(), 0.5 * (zlo + zhi));
+    Polygon local;
+    for (const Vec2& v : rect) local.push_back(v - c);
+    b.first_part = static_cast<int>(model.parts.size());
+    b.part_count = 1;
+    model.parts.push_back(make_convex_part(extrude_polygon(local, -0.5 * (zhi - zlo), zhi - zlo),
+                                           static_cast<int>(model.bodies.size())));
+    model.bodies.push_back(std::move(b));  // mass 0: inv_mass and inverse inertia stay 0 (immovable)
+    ++model.wall_count;
+  }
+}
+
+}  // namespace
+
+Model build_model(const FloeField& field, const HullModel* hull, const EngineSettings& o) {
+  Model model;
+  model.settings = o;
+  const double g = o.water.gravity_mps2;
+  model.gravity = Vec3(0, 0, -g);
+  const double cdir = o.water.current_direction_deg * kPi / 180, wdir = o.wind.direction_deg * kPi / 180;
+  model.current = o.water.current_speed_mps * Vec3(std::cos(cdir), std::sin(cdir), 0);
+  model.wind = o.wind.speed_mps * Vec3(std::cos(wdir), std::sin(wdir), 0);
+
+  // 1. Floe geometry in the world: cleaned outline and convex pieces. The level ice sheets come as tiles (fixed
+  // floes) after the free floes.
+  const std::vector<Floe> floes = model_floes(field, o.level_ice);
+  const std::vector<FloeGeometry> geo = floe_geometry(floes);
+
+  // 2. Floes must not overlap each other.
+  model.small_overlaps += count_small_overlaps(geo, o);
+
+  // 3. The vessel: floating position, mass, inertia, particulars, convex parts; its footprint among the floes.
+  std::vector<Polygon> footprint;
+  if (hull) footprint = add_vessel(*hull, floes, o, model);
+
+  // 4. Floe bodies: slab of the floe's thickness, body frame at the centre of mass, at hydrostatic equilibrium.
+  add_floe_bodies(geo, footprint, o, model);
+
+  // 5. Domain walls outside the sides of the domain rectangle.
+  if (!o.domain.walls.empty()) add_walls(field, hull != nullptr, footprint, o, model);
 
   // 6. Thrust series (the caller resolved the path relative to the config file).
   if (hull && o.vessel.propulsion.mode == "thrust_series")

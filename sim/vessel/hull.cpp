@@ -362,12 +362,8 @@ bool strictly_inside_convex(const TriMesh& m, const Vec3& p, double margin) {
 // ---- generation and OBJ ----------------------------------------------------------------------------------------
 
 std::vector<TriMesh> generate_hull(const HullGeneratorOptions& o) {
-  {  // the options' own checks, also when the struct was filled in code rather than read from JSON
-    const Json none = Json::object();  // the reader keeps a reference: must outlive it
-    OptionReader r(none, "hull generator options", "");
-    const_cast<HullGeneratorOptions&>(o).visit(r);
-    r.finish();
-  }
+  // The options' own checks, also when the struct was filled in code rather than read from JSON.
+  check_options(o, "hull generator options");
   const IcebreakerGeometry g(o);
   const int n = o.sections;
   // Stations evenly spaced, except that the one nearest the reamers moves onto them, so the widest waterline is
@@ -778,7 +774,19 @@ HullModel hull_model_from_parts(std::vector<TriMesh> parts) {
   return h;
 }
 
-HullModel load_hull(const fs::path& file, const HullLoadOptions& o, const HullPlacement& placement) {
+namespace {
+
+// A mesh instance of the file's node tree, in world coordinates.
+struct Instance {
+  std::string name;
+  std::vector<Vec3> v;
+  std::vector<std::array<int, 3>> t;
+  int skipped_faces = 0;  // points and lines
+};
+
+// The file and the options are checked before anything is read: file present and regular, non_convex, slices,
+// scale, origin, and the placement's axis names (place_point checks up_direction and bow_direction).
+void check_load_inputs(const fs::path& file, const HullLoadOptions& o, const HullPlacement& placement) {
   const std::string where = file.string();
   FLOESIM_REQUIRE(fs::exists(file), where, ": hull file not found");
   FLOESIM_REQUIRE(fs::is_regular_file(file), where, ": not a regular file");
@@ -793,7 +801,59 @@ HullModel load_hull(const fs::path& file, const HullLoadOptions& o, const HullPl
   } catch (const Error& e) {
     throw Error(where + ": " + e.what());
   }
+}
 
+// One instance of `mesh` (index `index` of the scene) under a node with transform `world`: vertices transformed,
+// triangles kept (a mirroring transform turns outward normals inward: reversed), points and lines counted.
+Instance mesh_instance(const aiMesh* mesh, const aiNode* node, unsigned index, const Eigen::Matrix4d& world,
+                       const std::string& where) {
+  const bool mirrored = world.topLeftCorner<3, 3>().determinant() < 0;
+  Instance in;
+  in.name = mesh->mName.length > 0 ? mesh->mName.C_Str()
+                                   : (node->mName.length > 0 ? std::string(node->mName.C_Str()) : "mesh") + "#" +
+                                         std::to_string(index);
+  for (unsigned k = 0; k < mesh->mNumVertices; ++k) {
+    const aiVector3D& p = mesh->mVertices[k];
+    const Eigen::Vector4d w = world * Eigen::Vector4d(p.x, p.y, p.z, 1.0);
+    in.v.emplace_back(w.x() / w.w(), w.y() / w.w(), w.z() / w.w());
+  }
+  for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+    const aiFace& face = mesh->mFaces[f];
+    if (face.mNumIndices != 3) {
+      ++in.skipped_faces;
+      continue;
+    }
+    for (unsigned k = 0; k < 3; ++k)
+      FLOESIM_REQUIRE(face.mIndices[k] < mesh->mNumVertices, where, ": mesh '", in.name, "' face ", f,
+                      " names vertex ", face.mIndices[k], " of ", mesh->mNumVertices, " (damaged file)");
+    std::array<int, 3> t{int(face.mIndices[0]), int(face.mIndices[1]), int(face.mIndices[2])};
+    if (mirrored) std::swap(t[1], t[2]);  // a mirroring transform turns outward normals inward
+    in.t.push_back(t);
+  }
+  return in;
+}
+
+// Every mesh instance under `node` (its parent's world transform `up`), depth first, appended to `out`: node
+// transforms are applied here, so a mesh instanced twice stays two parts.
+void collect_instances(const aiScene* scene, const aiNode* node, const Eigen::Matrix4d& up, const std::string& where,
+                       std::vector<Instance>& out) {
+  Eigen::Matrix4d local;
+  const aiMatrix4x4& a = node->mTransformation;
+  local << a.a1, a.a2, a.a3, a.a4, a.b1, a.b2, a.b3, a.b4, a.c1, a.c2, a.c3, a.c4, a.d1, a.d2, a.d3, a.d4;
+  const Eigen::Matrix4d world = up * local;
+  for (unsigned i = 0; i < node->mNumMeshes; ++i) {
+    // assimp does not validate what its importers build (no aiProcess_ValidateDataStructure, which also refuses
+    // harmless files): indices are checked here before they index anything.
+    FLOESIM_REQUIRE(node->mMeshes[i] < scene->mNumMeshes && scene->mMeshes[node->mMeshes[i]] != nullptr, where,
+                    ": the file's node tree references mesh ", node->mMeshes[i], " of ", scene->mNumMeshes,
+                    " (damaged file)");
+    out.push_back(mesh_instance(scene->mMeshes[node->mMeshes[i]], node, node->mMeshes[i], world, where));
+  }
+  for (unsigned c = 0; c < node->mNumChildren; ++c) collect_instances(scene, node->mChildren[c], world, where, out);
+}
+
+// Reads the mesh file with assimp and returns every mesh instance in the node tree, in world (file) coordinates.
+std::vector<Instance> read_instances(const std::string& where) {
   Assimp::Importer importer;
   // Our world is z-up like most CAD exports. assimp would turn a Collada file declaring Z_UP into its own y-up
   // convention with a root rotation; keep the file's axes instead. (glTF is y-up by definition: such a hull must
@@ -805,73 +865,42 @@ HullModel load_hull(const fs::path& file, const HullLoadOptions& o, const HullPl
   FLOESIM_REQUIRE(scene != nullptr, where, ": cannot read as a mesh file: ", importer.GetErrorString());
   FLOESIM_REQUIRE(!(scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE), where, ": the file is incomplete or damaged");
   FLOESIM_REQUIRE(scene->mRootNode != nullptr && scene->mNumMeshes > 0, where, ": the file holds no meshes");
-
-  // Every mesh instance in the node tree, in world coordinates.
-  struct Instance {
-    std::string name;
-    std::vector<Vec3> v;
-    std::vector<std::array<int, 3>> t;
-    int skipped_faces = 0;  // points and lines
-  };
   std::vector<Instance> instances;
-  std::function<void(const aiNode*, const Eigen::Matrix4d&)> walk = [&](const aiNode* node, const Eigen::Matrix4d& up) {
-    Eigen::Matrix4d local;
-    const aiMatrix4x4& a = node->mTransformation;
-    local << a.a1, a.a2, a.a3, a.a4, a.b1, a.b2, a.b3, a.b4, a.c1, a.c2, a.c3, a.c4, a.d1, a.d2, a.d3, a.d4;
-    const Eigen::Matrix4d world = up * local;
-    const bool mirrored = world.topLeftCorner<3, 3>().determinant() < 0;
-    for (unsigned i = 0; i < node->mNumMeshes; ++i) {
-      // assimp does not validate what its importers build (no aiProcess_ValidateDataStructure, which also refuses
-      // harmless files): indices are checked here before they index anything.
-      FLOESIM_REQUIRE(node->mMeshes[i] < scene->mNumMeshes && scene->mMeshes[node->mMeshes[i]] != nullptr, where,
-                      ": the file's node tree references mesh ", node->mMeshes[i], " of ", scene->mNumMeshes,
-                      " (damaged file)");
-      const aiMesh* mesh = scene->mMeshes[node->mMeshes[i]];
-      Instance in;
-      in.name = mesh->mName.length > 0 ? mesh->mName.C_Str()
-                                       : (node->mName.length > 0 ? std::string(node->mName.C_Str()) : "mesh") +
-                                             "#" + std::to_string(node->mMeshes[i]);
-      for (unsigned k = 0; k < mesh->mNumVertices; ++k) {
-        const aiVector3D& p = mesh->mVertices[k];
-        const Eigen::Vector4d w = world * Eigen::Vector4d(p.x, p.y, p.z, 1.0);
-        in.v.emplace_back(w.x() / w.w(), w.y() / w.w(), w.z() / w.w());
-      }
-      for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
-        const aiFace& face = mesh->mFaces[f];
-        if (face.mNumIndices != 3) {
-          ++in.skipped_faces;
-          continue;
-        }
-        for (unsigned k = 0; k < 3; ++k)
-          FLOESIM_REQUIRE(face.mIndices[k] < mesh->mNumVertices, where, ": mesh '", in.name, "' face ", f,
-                          " names vertex ", face.mIndices[k], " of ", mesh->mNumVertices, " (damaged file)");
-        std::array<int, 3> t{int(face.mIndices[0]), int(face.mIndices[1]), int(face.mIndices[2])};
-        if (mirrored) std::swap(t[1], t[2]);  // a mirroring transform turns outward normals inward
-        in.t.push_back(t);
-      }
-      instances.push_back(std::move(in));
-    }
-    for (unsigned c = 0; c < node->mNumChildren; ++c) walk(node->mChildren[c], world);
-  };
-  walk(scene->mRootNode, Eigen::Matrix4d::Identity());
+  collect_instances(scene, scene->mRootNode, Eigen::Matrix4d::Identity(), where, instances);
   FLOESIM_REQUIRE(!instances.empty(), where, ": the file's node tree references no meshes");
+  return instances;
+}
 
-  // The placement, before anything else: welding, slicing along x and the hydrostatics all work in the hull frame.
-  // Equal file positions stay equal (one deterministic map), so welding is unchanged. A proper rotation keeps the
-  // triangles' orientation.
+// The placement, before anything else: welding, slicing along x and the hydrostatics all work in the hull frame.
+// Equal file positions stay equal (one deterministic map), so welding is unchanged. A proper rotation keeps the
+// triangles' orientation. Returns the largest finite file coordinate (it sets the rounding of single-precision
+// input).
+double place_instances(std::vector<Instance>& instances, const HullPlacement& placement) {
   double file_max_abs = 0;  // largest file coordinate: sets the rounding of single-precision input
   for (Instance& in : instances)
     for (Vec3& p : in.v) {
       if (p.allFinite()) file_max_abs = std::max(file_max_abs, p.cwiseAbs().maxCoeff());
       p = place_point(placement, p);
     }
+  return file_max_abs;
+}
 
-  std::ostringstream report;
-  report << "placement: " << describe_placement(placement) << "\n";
-  // Closed meshes are bodies of their own. Meshes that are open on their own (an OBJ whose hull, deck and transom
-  // are separate groups, as in the KCS and DTMB 5415 benchmark files) are welded together and accepted as one body
-  // if together they close; otherwise the file is refused: buoyancy needs a watertight hull.
-  std::vector<Body> bodies;
+// The instances as one vertex and triangle list (indices offset), in order.
+Instance joined(const std::vector<const Instance*>& parts) {
+  Instance all;
+  for (const Instance* in : parts) {
+    const int off = static_cast<int>(all.v.size());
+    all.v.insert(all.v.end(), in->v.begin(), in->v.end());
+    for (const auto& t : in->t) all.t.push_back({t[0] + off, t[1] + off, t[2] + off});
+  }
+  return all;
+}
+
+// Closed meshes are bodies of their own (welded, re-oriented consistently where that closes them): appended to
+// `bodies`. Returns the meshes that are open on their own. A non-finite vertex or a mesh without triangles is an
+// error.
+std::vector<const Instance*> closed_bodies(const std::vector<Instance>& instances, const std::string& where,
+                                           std::vector<Body>& bodies) {
   std::vector<const Instance*> open;
   for (const Instance& in : instances) {
     for (const Vec3& p : in.v)
@@ -893,105 +922,138 @@ HullModel load_hull(const fs::path& file, const HullLoadOptions& o, const HullPl
       open.push_back(&in);
     }
   }
-  if (!open.empty()) {
-    Instance all;
-    std::string names;
-    for (const Instance* in : open) {
-      const int off = static_cast<int>(all.v.size());
-      all.v.insert(all.v.end(), in->v.begin(), in->v.end());
-      for (const auto& t : in->t) all.t.push_back({t[0] + off, t[1] + off, t[2] + off});
-      names += (names.empty() ? "'" : ", '") + in->name + "'";
-    }
-    Body body{open.size() == 1 ? open[0]->name : "", weld(all.v, all.t), ""};
-    if (open.size() > 1)
-      for (const Instance* in : open) body.name += (body.name.empty() ? "" : "+") + in->name;
-    Topology top = topology(body.mesh);
-    int flipped = 0;
-    if (top.unbalanced_edges > 0 && top.even) {
-      flipped = orient_consistently(body.mesh);
-      top = topology(body.mesh);
-    }
-    FLOESIM_REQUIRE(top.unbalanced_edges == 0, where, ": mesh", open.size() > 1 ? "es " : " ", names,
-                    open.size() > 1 ? " are" : " is", " not closed (", top.unbalanced_edges,
-                    " edges without a matching opposite edge, ", top.boundary_edges, " of them boundary edges, i.e. holes",
-                    open.size() > 1 ? ", also when welded together" : "",
-                    "); a hull must be watertight for buoyancy. Close the holes (e.g. Blender: Select > All by Trait >"
-                    " Non Manifold, then F to fill) and export again.");
-    if (open.size() > 1) body.notes += "open on their own, closed when welded together: one body; ";
-    if (flipped > 0) body.notes += std::to_string(flipped) + " triangles re-oriented consistently; ";
-    if (top.non_manifold_edges > 0) body.notes += std::to_string(top.non_manifold_edges) + " non-manifold edges; ";
-    bodies.push_back(std::move(body));
-  }
+  return open;
+}
 
-  {  // where meshes meet (the KCS rudder on its hull): edges shared by more than two triangles of the whole file
-    Instance all;
-    for (const Instance& in : instances) {
-      const int off = static_cast<int>(all.v.size());
-      all.v.insert(all.v.end(), in.v.begin(), in.v.end());
-      for (const auto& t : in.t) all.t.push_back({t[0] + off, t[1] + off, t[2] + off});
-    }
-    int within = 0;
-    for (const Body& body : bodies) within += topology(body.mesh).non_manifold_edges;
-    const int total = topology(weld(all.v, all.t)).non_manifold_edges;
-    if (instances.size() > 1 && total > within)
-      report << "meshes touch each other along " << total - within
-             << " non-manifold edges (accepted: each body above is closed on its own)\n";
+// Meshes that are open on their own (an OBJ whose hull, deck and transom are separate groups, as in the KCS and
+// DTMB 5415 benchmark files) are welded together into one body if together they close; otherwise the file is
+// refused: buoyancy needs a watertight hull.
+Body welded_open_meshes(const std::vector<const Instance*>& open, const std::string& where) {
+  std::string names;
+  for (const Instance* in : open) names += (names.empty() ? "'" : ", '") + in->name + "'";
+  const Instance all = joined(open);
+  Body body{open.size() == 1 ? open[0]->name : "", weld(all.v, all.t), ""};
+  if (open.size() > 1)
+    for (const Instance* in : open) body.name += (body.name.empty() ? "" : "+") + in->name;
+  Topology top = topology(body.mesh);
+  int flipped = 0;
+  if (top.unbalanced_edges > 0 && top.even) {
+    flipped = orient_consistently(body.mesh);
+    top = topology(body.mesh);
   }
+  FLOESIM_REQUIRE(top.unbalanced_edges == 0, where, ": mesh", open.size() > 1 ? "es " : " ", names,
+                  open.size() > 1 ? " are" : " is", " not closed (", top.unbalanced_edges,
+                  " edges without a matching opposite edge, ", top.boundary_edges, " of them boundary edges, i.e. holes",
+                  open.size() > 1 ? ", also when welded together" : "",
+                  "); a hull must be watertight for buoyancy. Close the holes (e.g. Blender: Select > All by Trait >"
+                  " Non Manifold, then F to fill) and export again.");
+  if (open.size() > 1) body.notes += "open on their own, closed when welded together: one body; ";
+  if (flipped > 0) body.notes += std::to_string(flipped) + " triangles re-oriented consistently; ";
+  if (top.non_manifold_edges > 0) body.notes += std::to_string(top.non_manifold_edges) + " non-manifold edges; ";
+  return body;
+}
 
+// Where meshes meet (the KCS rudder on its hull): edges shared by more than two triangles of the whole file that
+// no body has on its own are reported (accepted: each body is closed on its own).
+void report_touching_meshes(const std::vector<Instance>& instances, const std::vector<Body>& bodies,
+                            std::ostream& report) {
+  std::vector<const Instance*> every;
+  for (const Instance& in : instances) every.push_back(&in);
+  const Instance all = joined(every);
+  int within = 0;
+  for (const Body& body : bodies) within += topology(body.mesh).non_manifold_edges;
+  const int total = topology(weld(all.v, all.t)).non_manifold_edges;
+  if (instances.size() > 1 && total > within)
+    report << "meshes touch each other along " << total - within
+           << " non-manifold edges (accepted: each body above is closed on its own)\n";
+}
+
+// A body that is not convex (by more than tol) is cut into convex sections along x (non_convex "slice", else an
+// error), whose volume must stay within max_volume_error of the body's; the parts are appended to the model and
+// described on `line`.
+void slice_into_parts(Body& body, double volume, double tol, const HullLoadOptions& o, const std::string& where,
+                      HullModel& model, std::ostream& line) {
+  FLOESIM_REQUIRE(o.non_convex == "slice", where, ": mesh '", body.name,
+                  "' is not convex (a vertex lies more than ", fmt_num(tol),
+                  " m outside the plane of a face); set \"non_convex\": \"slice\" to cut it into convex sections"
+                  " along x, or split it into convex meshes (one per object) yourself");
+  Sliced sliced;
+  try {
+    sliced = slice_convex(body.mesh, o.slices, kSectionExcessTarget, kMergeExcess);
+  } catch (const Error& e) {
+    throw Error(where + ": mesh '" + body.name + "': slicing into convex parts failed: " + e.what());
+  }
+  std::vector<TriMesh>& pieces = sliced.parts;
+  double v = 0;
+  for (const TriMesh& p : pieces) v += mass_properties(p).volume;
+  const double err = (v - volume) / volume;
+  FLOESIM_REQUIRE(std::abs(err) <= o.max_volume_error, where, ": mesh '", body.name, "' is not convex and its ",
+                  pieces.size(), " convex parts change its volume by ", percent(err), " (", fmt_num(volume),
+                  " -> ", fmt_num(v), " m^3), more than max_volume_error = ", o.max_volume_error,
+                  "; raise \"slices\" or split the mesh into convex meshes (one per object) yourself");
+  line << "not convex: cut into " << o.slices << " sections along x";
+  if (sliced.layered_sections > 0)
+    line << " (" << sliced.layered_sections << " of them also into up to " << sliced.max_layers
+         << " horizontal layers)";
+  if (sliced.merges > 0) line << ", " << sliced.merges << " neighbouring sections merged";
+  line << ", " << pieces.size() << " convex part" << (pieces.size() == 1 ? "" : "s") << ", volume " << fmt_num(v) << " m^3 (" << percent(err) << ")";
+  model.parts_volume_m3 += v;
+  for (TriMesh& p : pieces) model.parts.push_back(std::move(p));
+}
+
+// A closed body into the model: its volume (a body whose triangles face inwards is flipped; one enclosing no
+// volume is an error), the merged mesh, and its convex parts (a convex body is one part); one report line.
+void add_body(Body& body, const HullLoadOptions& o, double file_max_abs, double scale, const std::string& where,
+              HullModel& model, std::ostream& report) {
+  const Bounds bb(body.mesh.vertices);
+  const double size = bb.diagonal();
+  MassProperties mp = mass_properties(body.mesh);
+  FLOESIM_REQUIRE(body.mesh.vertices.size() >= 4 && size > 0 && std::abs(mp.volume) > 1e-9 * size * size * size,
+                  where, ": mesh '", body.name, "' is degenerate (it encloses no volume)");
+  if (mp.volume < 0) {
+    flip(body.mesh);
+    mp.volume = -mp.volume;
+    body.notes += "triangles faced inwards: flipped; ";
+  }
+  model.mesh_volume_m3 += mp.volume;
+  model.mesh = merge({model.mesh, body.mesh});
+  std::ostringstream line;
+  line << "mesh '" << body.name << "': closed, " << body.mesh.triangles.size() << " triangles, volume "
+       << fmt_num(mp.volume) << " m^3; " << body.notes;
+  // Tolerance relative to the mesh: assimp stores single-precision coordinates (relative error ~6e-8).
+  const double max_abs = std::max(bb.lo.cwiseAbs().maxCoeff(), bb.hi.cwiseAbs().maxCoeff());
+  const double tol = 1e-6 * std::max({size, max_abs, file_max_abs * scale});
+  if (is_convex(body.mesh, tol)) {
+    line << "convex: kept as 1 part";
+    model.parts.push_back(std::move(body.mesh));
+    model.parts_volume_m3 += mp.volume;
+  } else {
+    slice_into_parts(body, mp.volume, tol, o, where, model, line);
+  }
+  report << line.str() << "\n";
+}
+
+}  // namespace
+
+HullModel load_hull(const fs::path& file, const HullLoadOptions& o, const HullPlacement& placement) {
+  const std::string where = file.string();
+  check_load_inputs(file, o, placement);
+
+  // Every mesh instance in the node tree, in world coordinates, then placed in the hull frame.
+  std::vector<Instance> instances = read_instances(where);
+  const double file_max_abs = place_instances(instances, placement);
+
+  // Closed meshes are bodies of their own; the open ones together must close into one more.
+  std::ostringstream report;
+  report << "placement: " << describe_placement(placement) << "\n";
+  std::vector<Body> bodies;
+  const std::vector<const Instance*> open = closed_bodies(instances, where, bodies);
+  if (!open.empty()) bodies.push_back(welded_open_meshes(open, where));
+  report_touching_meshes(instances, bodies, report);
+
+  // Each body's volume and convex parts, then the totals.
   HullModel model;
-  for (Body& body : bodies) {
-    const Bounds bb(body.mesh.vertices);
-    const double size = bb.diagonal();
-    MassProperties mp = mass_properties(body.mesh);
-    FLOESIM_REQUIRE(body.mesh.vertices.size() >= 4 && size > 0 && std::abs(mp.volume) > 1e-9 * size * size * size,
-                    where, ": mesh '", body.name, "' is degenerate (it encloses no volume)");
-    if (mp.volume < 0) {
-      flip(body.mesh);
-      mp.volume = -mp.volume;
-      body.notes += "triangles faced inwards: flipped; ";
-    }
-    model.mesh_volume_m3 += mp.volume;
-    model.mesh = merge({model.mesh, body.mesh});
-    std::ostringstream line;
-    line << "mesh '" << body.name << "': closed, " << body.mesh.triangles.size() << " triangles, volume "
-         << fmt_num(mp.volume) << " m^3; " << body.notes;
-    // Tolerance relative to the mesh: assimp stores single-precision coordinates (relative error ~6e-8).
-    const double max_abs = std::max(bb.lo.cwiseAbs().maxCoeff(), bb.hi.cwiseAbs().maxCoeff());
-    const double tol = 1e-6 * std::max({size, max_abs, file_max_abs * placement.scale});
-    if (is_convex(body.mesh, tol)) {
-      line << "convex: kept as 1 part";
-      model.parts.push_back(std::move(body.mesh));
-      model.parts_volume_m3 += mp.volume;
-    } else {
-      FLOESIM_REQUIRE(o.non_convex == "slice", where, ": mesh '", body.name,
-                      "' is not convex (a vertex lies more than ", fmt_num(tol),
-                      " m outside the plane of a face); set \"non_convex\": \"slice\" to cut it into convex sections"
-                      " along x, or split it into convex meshes (one per object) yourself");
-      Sliced sliced;
-      try {
-        sliced = slice_convex(body.mesh, o.slices, kSectionExcessTarget, kMergeExcess);
-      } catch (const Error& e) {
-        throw Error(where + ": mesh '" + body.name + "': slicing into convex parts failed: " + e.what());
-      }
-      std::vector<TriMesh>& pieces = sliced.parts;
-      double v = 0;
-      for (const TriMesh& p : pieces) v += mass_properties(p).volume;
-      const double err = (v - mp.volume) / mp.volume;
-      FLOESIM_REQUIRE(std::abs(err) <= o.max_volume_error, where, ": mesh '", body.name, "' is not convex and its ",
-                      pieces.size(), " convex parts change its volume by ", percent(err), " (", fmt_num(mp.volume),
-                      " -> ", fmt_num(v), " m^3), more than max_volume_error = ", o.max_volume_error,
-                      "; raise \"slices\" or split the mesh into convex meshes (one per object) yourself");
-      line << "not convex: cut into " << o.slices << " sections along x";
-      if (sliced.layered_sections > 0)
-        line << " (" << sliced.layered_sections << " of them also into up to " << sliced.max_layers
-             << " horizontal layers)";
-      if (sliced.merges > 0) line << ", " << sliced.merges << " neighbouring sections merged";
-      line << ", " << pieces.size() << " convex part" << (pieces.size() == 1 ? "" : "s") << ", volume " << fmt_num(v) << " m^3 (" << percent(err) << ")";
-      model.parts_volume_m3 += v;
-      for (TriMesh& p : pieces) model.parts.push_back(std::move(p));
-    }
-    report << line.str() << "\n";
-  }
+  for (Body& body : bodies) add_body(body, o, file_max_abs, placement.scale, where, model, report);
   model.surface = merge(model.parts);
   model.placement = placement;
   report << "total: " << model.parts.size() << " convex part" << (model.parts.size() == 1 ? "" : "s")
@@ -1126,12 +1188,8 @@ std::string mass_text(double kg) { return kg < 1e4 ? fmt_num(kg, 4) + " kg" : fm
 
 std::string write_imported_hull(const HullImportOptions& o, const fs::path& out_obj, const fs::path& config_file) {
   const std::string where = config_file.empty() ? std::string("hull options") : config_file.string();
-  {  // the options' own checks, also when the struct was filled in code rather than read from JSON
-    const Json none = Json::object();
-    OptionReader r(none, where, "");
-    const_cast<HullImportOptions&>(o).visit(r);
-    r.finish();
-  }
+  // The options' own checks, also when the struct was filled in code rather than read from JSON.
+  check_options(o, where);
   fs::path mesh_file = o.file;
   if (mesh_file.is_relative() && !config_file.empty()) mesh_file = config_file.parent_path() / mesh_file;
   FLOESIM_REQUIRE(fs::exists(mesh_file), where, ": file names ", mesh_file.string(), ", which does not exist");

@@ -12,7 +12,7 @@
 #include "pipeline/error.h"
 #include "pipeline/geometry2d.h"
 #include "pipeline/ice_resistance.h"
-#include "tests/error_of.h"
+#include "tests/test_util.h"
 
 using namespace floesim;
 

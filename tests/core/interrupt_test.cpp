@@ -14,7 +14,7 @@
 #include "pipeline/error.h"
 #include "pipeline/interrupt.h"
 #include "pipeline/runner/plan.h"
-#include "tests/error_of.h"
+#include "tests/test_util.h"
 
 using namespace floesim;
 namespace fs = std::filesystem;

@@ -11,7 +11,7 @@
 #include "pipeline/provenance.h"
 #include "pipeline/results_io.h"
 #include "pipeline/options.h"
-#include "tests/error_of.h"
+#include "tests/test_util.h"
 
 using namespace floesim;
 namespace fs = std::filesystem;

@@ -256,8 +256,31 @@ TEST_F(TinyCase, ChangedSimulateParameterRerunsSimulateAndEverythingDownstream) 
   EXPECT_NE(mtime(run_ / "video" / "transit.mp4"), t_video);
 }
 
+// A stage that fails while it runs (settings it accepts, a run it cannot finish: here a health limit below the
+// vessel's own speed) stops the run and leaves nothing downstream that looks complete.
 TEST_F(TinyCase, FailedStageStopsAndLeavesNothingThatLooksComplete) {
   ASSERT_EQ(first_.code, 0) << first_.text;
+  Json c = case_json();
+  const Json good = c;
+  c["simulate"]["health"]["max_speed_mps"] = 0.01;
+  write_case(c);
+  const RunOutput bad = run_case(case_, run_);
+  write_case(good);
+  EXPECT_NE(bad.code, 0) << bad.text;
+  EXPECT_NE(bad.text.find("max_speed_mps"), std::string::npos) << "the message names the key\n" << bad.text;
+  EXPECT_TRUE(fs::exists(run_ / "floes" / "floes.geojson")) << "upstream artefacts stay";
+  for (const char* f : {"sim/results.h5", "sim/summary.json", "video/transit.mp4", "plots/surge_ice_load.png"})
+    EXPECT_FALSE(fs::exists(run_ / f)) << f << " survived a failed simulate stage";
+  for (auto& e : fs::recursive_directory_iterator(run_))
+    EXPECT_EQ(e.path().filename().string().rfind(".tmp-", 0), std::string::npos) << e.path() << " left behind";
+}
+
+// A setting a stage refuses stops the run before anything is written: the message names the key by its path in
+// case.json, and the run folder keeps what it held (the last good run's artefacts, untouched).
+TEST_F(TinyCase, RefusedSettingStopsTheRunBeforeItWritesAnything) {
+  ASSERT_EQ(first_.code, 0) << first_.text;
+  ASSERT_EQ(run_case(case_, run_).code, 0);  // complete again (a test before may have removed artefacts)
+  const auto t_results = mtime(run_ / "sim" / "results.h5"), t_config = mtime(run_ / "config" / "simulate.json");
   Json c = case_json();
   const Json good = c;
   c["simulate"]["duration_s"] = -1.0;
@@ -265,12 +288,9 @@ TEST_F(TinyCase, FailedStageStopsAndLeavesNothingThatLooksComplete) {
   const RunOutput bad = run_case(case_, run_);
   write_case(good);
   EXPECT_NE(bad.code, 0) << bad.text;
-  EXPECT_NE(bad.text.find("duration_s"), std::string::npos) << "the message names the key\n" << bad.text;
-  EXPECT_TRUE(fs::exists(run_ / "floes" / "floes.geojson")) << "upstream artefacts stay";
-  for (const char* f : {"sim/results.h5", "sim/summary.json", "video/transit.mp4", "plots/surge_ice_load.png"})
-    EXPECT_FALSE(fs::exists(run_ / f)) << f << " survived a failed simulate stage";
-  for (auto& e : fs::recursive_directory_iterator(run_))
-    EXPECT_EQ(e.path().filename().string().rfind(".tmp-", 0), std::string::npos) << e.path() << " left behind";
+  EXPECT_NE(bad.text.find("simulate.duration_s must be"), std::string::npos) << bad.text;
+  EXPECT_EQ(mtime(run_ / "sim" / "results.h5"), t_results);
+  EXPECT_EQ(mtime(run_ / "config" / "simulate.json"), t_config) << "the refused settings were written";
 }
 
 // The round trip as stages of a run (case key "identify" without "measured"): the transit becomes the data the

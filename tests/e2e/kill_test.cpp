@@ -37,8 +37,10 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "pipeline/results_io.h"
+#include "tests/test_util.h"
 
 namespace fs = std::filesystem;
+using floesim::tests::read_text;
 using Clock = std::chrono::steady_clock;
 
 namespace {
@@ -57,13 +59,6 @@ const char* kill_name(Kill k) {
     case Kill::sigkill_runner: return "SIGKILL to the runner alone";
     default: return "SIGKILL to every process of the run";
   }
-}
-
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 // Starts `args` in a new session (so that every process of the run can be found), output into `log`.

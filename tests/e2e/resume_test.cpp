@@ -19,20 +19,15 @@
 
 #include "pipeline/options.h"
 #include "pipeline/results_io.h"
+#include "tests/test_util.h"
 
 namespace fs = std::filesystem;
+using floesim::tests::read_text;
 using namespace floesim;
 
 namespace {
 
 const fs::path kBin = FLOESIM_BIN_DIR;
-
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 // A checkpoint's time as the stage prints it: step x time step, in the stream's default format.
 std::string time_text(long step) {

@@ -16,8 +16,10 @@
 #include <vector>
 
 #include "pipeline/options.h"
+#include "tests/test_util.h"
 
 namespace fs = std::filesystem;
+using floesim::tests::read_text;
 using namespace floesim;
 
 namespace {
@@ -29,13 +31,6 @@ struct RunOutput {
   int code;
   std::string text;
 };
-
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 RunOutput shell(const std::string& cmd, const fs::path& log) {
   const int status = std::system((cmd + " > '" + log.string() + "' 2>&1").c_str());

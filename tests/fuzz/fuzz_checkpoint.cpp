@@ -34,8 +34,10 @@
 #include "sim/engine/model.h"
 #include "sim/simulate/simulate.h"
 #include "tests/sim/small_breaking_run.h"
+#include "tests/test_util.h"
 
 namespace fs = std::filesystem;
+using floesim::tests::read_text;
 using namespace floesim;
 using namespace floesim::sim;
 
@@ -59,13 +61,6 @@ const Model& the_model() {
 const nlohmann::json& the_provenance() {
   static const nlohmann::json p = {{"program", "fuzz_checkpoint"}, {"config", {{"duration_s", 0.4}}}};
   return p;
-}
-
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 // Splits the container (after the mode byte) into its parts.
@@ -141,8 +136,8 @@ void write_seeds(const fs::path& dir) {
   plan.provenance = the_provenance();
   RunStats stats;
   const Results r = simulate(small_breaking_run_options(), the_model(), stats, nullptr, &plan);
-  std::vector<std::string> files = {read_file(plan.dir / "checkpoint.bin")};
-  for (size_t k = 1; fs::exists(records_file(plan.dir, k)); ++k) files.push_back(read_file(records_file(plan.dir, k)));
+  std::vector<std::string> files = {read_text(plan.dir / "checkpoint.bin")};
+  for (size_t k = 1; fs::exists(records_file(plan.dir, k)); ++k) files.push_back(read_text(records_file(plan.dir, k)));
   std::string raw(1, '\0'), sealed(1, '\2');
   for (size_t i = 0; i < files.size(); ++i) {
     const size_t magic = std::strlen(i == 0 ? kCheckpointMagic : kRecordsMagic);

@@ -14,28 +14,24 @@
 #include "pipeline/error.h"
 #include "pipeline/geometry2d.h"
 #include "pipeline/results_io.h"
-#include "render/gather.h"
+#include "render/sweep_plots.h"
 #include "pipeline/signal.h"
 #include "synthetic_results.h"
+#include "tests/test_util.h"
 
 using namespace floesim;
 using namespace floesim::render;
+using namespace floesim::sweep;
 using namespace floesim::render::testing;
 namespace fs = std::filesystem;
+using floesim::tests::read_text;
 
 namespace {
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 // RFC 4180 rows: quoted fields may hold commas and doubled quotes (no line breaks in these files).
 std::vector<std::vector<std::string>> read_csv(const fs::path& p) {
   std::vector<std::vector<std::string>> rows;
-  std::istringstream in(slurp(p));
+  std::istringstream in(read_text(p));
   for (std::string line; std::getline(in, line);) {
     std::vector<std::string> row(1);
     bool quoted = false;
@@ -317,7 +313,7 @@ TEST(Gather, SyntheticSweepGathersKnownNumbersAndListsFailedMembers) {
   // 1. The CSV: header, then one row per member in plan order.
   const auto rows = read_csv(dir / "out" / "sweep.csv");
   ASSERT_EQ(rows.size(), 6u);
-  EXPECT_EQ(slurp(dir / "out" / "sweep.csv").substr(0, slurp(dir / "out" / "sweep.csv").find('\n')),
+  EXPECT_EQ(read_text(dir / "out" / "sweep.csv").substr(0, read_text(dir / "out" / "sweep.csv").find('\n')),
             "member,grid_point,ensemble_index,simulate.vessel.propulsion.speed_mps,image.synthetic.seed,"
             "simulate.vessel.y_m,mean_surge_ice_resistance_kN,batch_means_se_kN,mean_speed_mps,"
             "peak_0.5s_resistance_kN,fracture_bending,fracture_radial,fracture_splitting,wall_s,status,error");
@@ -371,7 +367,7 @@ TEST(Gather, SyntheticSweepGathersKnownNumbersAndListsFailedMembers) {
   EXPECT_EQ(col(5, "status"), "failed");
   EXPECT_EQ(col(5, "error"), "not run");
   // The error cell is quoted as CSV (commas and quotes inside).
-  EXPECT_NE(slurp(dir / "out" / "sweep.csv").find(",failed,\"step 100 of 2000 | "), std::string::npos);
+  EXPECT_NE(read_text(dir / "out" / "sweep.csv").find(",failed,\"step 100 of 2000 | "), std::string::npos);
 
   // 2. The series statistics: the mean of the steady series is the summary's (here by construction) to round-off,
   // and the remainder is counted.
@@ -387,7 +383,7 @@ TEST(Gather, SyntheticSweepGathersKnownNumbersAndListsFailedMembers) {
   EXPECT_EQ(g.members[3].failed_stage, "simulate");
 
   // 3. sweep.json: the rows, the grid points' intervals by the hand formula, the failed list.
-  const Json j = Json::parse(slurp(dir / "out" / "sweep.json"));
+  const Json j = Json::parse(read_text(dir / "out" / "sweep.json"));
   ASSERT_EQ(j["members"].size(), 5u);
   EXPECT_EQ(j["members"][0][kSpeed], 1);
   EXPECT_EQ(j["members"][0]["mean_surge_ice_resistance_kN"].get<double>(), 300.0);
@@ -422,7 +418,7 @@ TEST(Gather, SyntheticSweepGathersKnownNumbersAndListsFailedMembers) {
                                       "resistance_vs_simulate_vessel_propulsion_speed_mps.svg", "running_mean.png",
                                       "running_mean.svg", "sweep.csv", "sweep.json"}));
   for (const auto& f : listing(dir / "out")) EXPECT_GT(fs::file_size(dir / "out" / f), 300u) << f;
-  const std::string svg = slurp(dir / "out" / "running_mean.svg");
+  const std::string svg = read_text(dir / "out" / "running_mean.svg");
   EXPECT_NE(svg.find("g000-e00"), std::string::npos) << "titled with the first ok member";
 
   // 5. The table names each grid point and the failed members.
@@ -533,9 +529,9 @@ TEST(Gather, TwoAxesWithCategoriesAndAPureEnsembleArePlotted) {
                           "resistance_vs_image_synthetic_thickness_m.svg", "running_mean.png", "running_mean.svg"})
       EXPECT_GT(fs::file_size(dir / "out2" / f), 1000u) << f;
     // One line per value of the other axis, labelled with it; the categories as tics.
-    const std::string svg = slurp(dir / "out2" / "resistance_vs_image_synthetic_thickness_m.svg");
+    const std::string svg = read_text(dir / "out2" / "resistance_vs_image_synthetic_thickness_m.svg");
     EXPECT_NE(svg.find("simulate.contact.ice_structure = compliant"), std::string::npos);
-    const std::string cat = slurp(dir / "out2" / "resistance_vs_simulate_contact_ice_structure.svg");
+    const std::string cat = read_text(dir / "out2" / "resistance_vs_simulate_contact_ice_structure.svg");
     EXPECT_NE(cat.find(">rigid<"), std::string::npos);
     EXPECT_NE(cat.find("image.synthetic.thickness_m = 0.5"), std::string::npos);
   }
@@ -566,7 +562,7 @@ TEST(Gather, TwoAxesWithCategoriesAndAPureEnsembleArePlotted) {
 TEST(Gather, BadPlanNamesTheFileAndKeyAndWritesNothing) {
   const fs::path dir = fresh_dir("gather_bad");
   const fs::path good = write_sweep(dir);
-  const Json plan = Json::parse(slurp(good));
+  const Json plan = Json::parse(read_text(good));
   auto expect_error = [&](const Json* j, const std::vector<std::string>& needles) {
     const fs::path p = dir / "bad_plan.json";
     fs::remove(p);
@@ -601,7 +597,7 @@ TEST(Gather, BadPlanNamesTheFileAndKeyAndWritesNothing) {
 int run(const std::string& cmd, std::string& out) {
   const fs::path log = fs::temp_directory_path() / ("floesim_gather_cli_" + std::to_string(::getpid()) + ".log");
   const int status = std::system((cmd + " > '" + log.string() + "' 2>&1").c_str());
-  out = slurp(log);
+  out = read_text(log);
   fs::remove(log);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }

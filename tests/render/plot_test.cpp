@@ -10,20 +10,15 @@
 #include "pipeline/results_io.h"
 #include "render/plot.h"
 #include "synthetic_results.h"
+#include "tests/test_util.h"
 
 using namespace floesim;
 using namespace floesim::render;
 using namespace floesim::render::testing;
 namespace fs = std::filesystem;
+using floesim::tests::read_text;
 
 namespace {
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 fs::path write_config(const fs::path& dir, const std::string& text) {
   const fs::path p = dir / "plot.config.json";
   std::ofstream(p) << text;
@@ -62,12 +57,12 @@ TEST(Plot, WritesPngSvgCsvAndTheSteadyMean) {
   cv::Scalar mean, sd;
   cv::meanStdDev(png, mean, sd);
   EXPECT_GT(sd[0], 10.0) << "the PNG is blank";
-  const std::string svg = slurp(dir / "plots" / "surge_ice_load.svg");
+  const std::string svg = read_text(dir / "plots" / "surge_ice_load.svg");
   EXPECT_GT(svg.size(), 5000u);
   EXPECT_NE(svg.find("<svg"), std::string::npos);
   EXPECT_NE(svg.find("1000 kN"), std::string::npos) << "the legend states the mean";
 
-  const std::string csv = slurp(dir / "plots" / "surge_ice_load.csv");
+  const std::string csv = read_text(dir / "plots" / "surge_ice_load.csv");
   EXPECT_EQ(csv.rfind("time_s,ice_resistance_kN,moving_average_kN\n", 0), 0u);
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 401);
   // The average is left empty where its window is cut (5 samples at each end for N = 10).
@@ -79,7 +74,7 @@ TEST(Plot, WritesPngSvgCsvAndTheSteadyMean) {
   EXPECT_EQ(empty, 10u);
   EXPECT_EQ(filled, 390u);
 
-  const auto j = nlohmann::json::parse(slurp(dir / "plots" / "plot.json"));
+  const auto j = nlohmann::json::parse(read_text(dir / "plots" / "plot.json"));
   EXPECT_NEAR(j["mean_kN"].get<double>(), 1000.0, 1e-9);
   EXPECT_EQ(j["moving_average"]["window_samples"], 10);
   EXPECT_EQ(j["provenance"]["program"], "floesim-plot");
@@ -89,7 +84,7 @@ TEST(Plot, WritesPngSvgCsvAndTheSteadyMean) {
                                                                "surge_ice_load.svg"}));
   // No fracture: no markers, and a header-only event table.
   EXPECT_EQ(svg.find("at the vessel"), std::string::npos);
-  EXPECT_EQ(slurp(dir / "plots" / "fracture_events.csv"),
+  EXPECT_EQ(read_text(dir / "plots" / "fracture_events.csv"),
             "time_s,mode,parent_id,at_structure,force_x_n,force_y_n,force_z_n,threshold_n,children\n");
   fs::remove_all(dir);
 }
@@ -144,12 +139,12 @@ TEST(Plot, FractureEventsAtTheVesselAreMarkedAndAllEventsListed) {
   EXPECT_EQ(s.vessel_bending_radial_events, 1u) << "the radial event between floes is not at the vessel";
 
   // The legend counts what is marked: one of each style (the floe-floe event is not marked).
-  const std::string svg = slurp(dir / "plots" / "surge_ice_load.svg");
+  const std::string svg = read_text(dir / "plots" / "surge_ice_load.svg");
   EXPECT_NE(svg.find("fracture by splitting at the vessel: 1 event"), std::string::npos);
   EXPECT_NE(svg.find("fracture by bending or radial cracking at the vessel: 1 event"), std::string::npos);
 
   // One CSV row per event, equal to the events.
-  std::istringstream rows(slurp(dir / "plots" / "fracture_events.csv"));
+  std::istringstream rows(read_text(dir / "plots" / "fracture_events.csv"));
   std::string row;
   std::getline(rows, row);
   EXPECT_EQ(row, "time_s,mode,parent_id,at_structure,force_x_n,force_y_n,force_z_n,threshold_n,children");
@@ -160,7 +155,7 @@ TEST(Plot, FractureEventsAtTheVesselAreMarkedAndAllEventsListed) {
                                            "9,radial,5,0,20000,-10000,-250000,240000,6"}));
   ASSERT_EQ(got.size(), syn.events.size());
 
-  const auto j = nlohmann::json::parse(slurp(dir / "plots" / "plot.json"));
+  const auto j = nlohmann::json::parse(read_text(dir / "plots" / "plot.json"));
   EXPECT_EQ(j["fracture"]["events"], 3);
   EXPECT_EQ(j["fracture"]["at_vessel"]["splitting"], 1);
   EXPECT_EQ(j["fracture"]["at_vessel"]["bending_or_radial"], 1);

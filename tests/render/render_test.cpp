@@ -13,11 +13,13 @@
 #include "render/scene.h"
 #include "render/video.h"
 #include "synthetic_results.h"
+#include "tests/test_util.h"
 
 using namespace floesim;
 using namespace floesim::render;
 using namespace floesim::render::testing;
 namespace fs = std::filesystem;
+using floesim::tests::read_text;
 
 namespace {
 
@@ -45,13 +47,6 @@ cv::Vec3d patch(const cv::Mat& img, cv::Point2d c) {
 }
 bool bright(const cv::Vec3d& c) { return c[0] > 170 && c[1] > 170 && c[2] > 170; }
 bool dark(const cv::Vec3d& c) { return c[0] < 90 && c[1] < 90 && c[2] < 90; }
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 }  // namespace
 
@@ -192,7 +187,7 @@ TEST(Render, VideoHasOneFramePerResultsFrameAndShowsTheScene) {
   cv::absdiff(frames[0], frames[1], diff);
   EXPECT_GT(cv::norm(diff, cv::NORM_L1), 0.0) << "consecutive frames are identical although the vessel moves";
 
-  const auto side = nlohmann::json::parse(slurp(dir / "out" / "transit.json"));
+  const auto side = nlohmann::json::parse(read_text(dir / "out" / "transit.json"));
   EXPECT_EQ(side["frames"], 12);
   EXPECT_EQ(side["provenance"]["program"], "floesim-render");
   EXPECT_EQ(listing(dir / "out"), (std::vector<std::string>{"transit.json", "transit.mp4"}));

@@ -17,8 +17,10 @@
 #include "pipeline/error.h"
 #include "pipeline/options.h"
 #include "render/report.h"
+#include "tests/test_util.h"
 
 namespace fs = std::filesystem;
+using floesim::tests::read_text;
 using namespace floesim;
 using namespace floesim::render;
 
@@ -27,20 +29,13 @@ namespace {
 const fs::path kBin = FLOESIM_BIN_DIR;
 const fs::path kSource = FLOESIM_SOURCE_DIR;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 struct Cmd {
   int code;
   std::string text;
 };
 Cmd sh(const std::string& cmd, const fs::path& log) {
   const int status = std::system((cmd + " > '" + log.string() + "' 2>&1").c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : 1, slurp(log)};
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : 1, read_text(log)};
 }
 
 // RFC 4648 base64, written here independently of the library's encoder (OpenSSL).
@@ -191,7 +186,7 @@ TEST_F(TinyRun, ReportIsSelfContainedAndEmbedsTheArtefacts) {
   EXPECT_NE(c.text.find("video embedded"), std::string::npos) << c.text;
   EXPECT_EQ(c.text.find("missing"), std::string::npos) << c.text;
   ASSERT_TRUE(fs::exists(out));
-  const std::string html = slurp(out);
+  const std::string html = read_text(out);
 
   // No network reference in any src or href attribute (nor anywhere: the page names none).
   EXPECT_FALSE(has_network_attribute(html));
@@ -202,11 +197,11 @@ TEST_F(TinyRun, ReportIsSelfContainedAndEmbedsTheArtefacts) {
 
   // Every image and the video: a data: URI decoding to the bytes of one artefact, each artefact once.
   std::map<std::string, std::string> expected = {
-      {"image/image.png", slurp(run_ / "image/image.png")},
-      {"floes/overlay.png", slurp(run_ / "floes/overlay.png")},
-      {"floes/fsd.png", slurp(run_ / "floes/fsd.png")},
-      {"plots/surge_ice_load.png", slurp(run_ / "plots/surge_ice_load.png")},
-      {"video/transit.mp4", slurp(run_ / "video/transit.mp4")}};
+      {"image/image.png", read_text(run_ / "image/image.png")},
+      {"floes/overlay.png", read_text(run_ / "floes/overlay.png")},
+      {"floes/fsd.png", read_text(run_ / "floes/fsd.png")},
+      {"plots/surge_ice_load.png", read_text(run_ / "plots/surge_ice_load.png")},
+      {"video/transit.mp4", read_text(run_ / "video/transit.mp4")}};
   const auto sources = media_sources(html);
   EXPECT_EQ(sources.size(), expected.size());
   for (const auto& [tag, src] : sources) {
@@ -249,7 +244,7 @@ TEST_F(TinyRun, ReferenceErrorOnThePageAgainstAHandValue) {
   const auto r = write_report(run, o, root_ / "hand.html", Json::object());
   ASSERT_EQ(r.references.size(), 2u);
   EXPECT_NEAR(r.references[0].error_percent, 5.97303, 1e-5);
-  const std::string html = slurp(root_ / "hand.html");
+  const std::string html = read_text(root_ / "hand.html");
   // 1100 - 1038 = +62.0 kN, +6.0 %; 1100 - 974 = +126.0 kN, +12.9 %.
   EXPECT_NE(html.find("<th>full scale</th><td class=\"n\">1038</td><td class=\"n\">+62.0</td><td class=\"n\">+6.0"),
             std::string::npos);
@@ -268,7 +263,7 @@ TEST_F(TinyRun, MissingVideoIsSaidOnThePageAndInStdout) {
   ASSERT_EQ(c.code, 0) << c.text;
   EXPECT_NE(c.text.find("missing from the run (1)"), std::string::npos) << c.text;
   EXPECT_NE(c.text.find("video/transit.mp4"), std::string::npos) << c.text;
-  const std::string html = slurp(out);
+  const std::string html = read_text(out);
   EXPECT_NE(html.find("id=\"missing\""), std::string::npos);
   EXPECT_NE(html.find("The video is missing (video/transit.mp4)"), std::string::npos);
   EXPECT_EQ(html.find("<video"), std::string::npos);
@@ -280,7 +275,7 @@ TEST_F(TinyRun, VideoLargerThanTheLimitIsNamedNotEmbedded) {
   o.max_video_mb = 1e-6;  // 1 byte
   const auto r = write_report(run_, o, root_ / "big.html", Json::object());
   EXPECT_FALSE(r.video_embedded);
-  const std::string html = slurp(root_ / "big.html");
+  const std::string html = read_text(root_ / "big.html");
   EXPECT_EQ(html.find("<video"), std::string::npos);
   EXPECT_NE(html.find("id=\"video-not-embedded\""), std::string::npos);
 }

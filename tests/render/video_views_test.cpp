@@ -14,7 +14,7 @@
 #include "render/strip_chart.h"
 #include "render/video.h"
 #include "synthetic_results.h"
-#include "tests/error_of.h"
+#include "tests/test_util.h"
 
 using namespace floesim;
 using namespace floesim::render;

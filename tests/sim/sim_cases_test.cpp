@@ -18,11 +18,13 @@
 #include "sim/vessel/hull.h"
 #include "sim/simulate/simulate.h"
 #include "sim/engine/world.h"
+#include "tests/test_util.h"
 
 namespace floesim::sim {
 namespace {
 
 namespace fs = std::filesystem;
+using floesim::tests::read_text;
 const fs::path kSource = FLOESIM_SOURCE_DIR;
 const fs::path kBin = FLOESIM_BIN_DIR;
 
@@ -40,13 +42,6 @@ RunOutput dry_run(const fs::path& case_dir, const fs::path& run_dir) {
   std::stringstream ss;
   ss << in.rdbuf();
   return {WIFEXITED(status) ? WEXITSTATUS(status) : 1, ss.str()};
-}
-
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 fs::path temp_root() {

@@ -14,21 +14,16 @@
 #include "sim/simulate/simulate.h"
 #include "tests/sim/sim_fixtures.h"
 #include "tests/sim/small_breaking_run.h"
+#include "tests/test_util.h"
 
 namespace floesim::sim {
 namespace {
 
 namespace fs = std::filesystem;
+using floesim::tests::read_text;
 
 using testing::fresh_results;
 using testing::small_breaking_run;
-
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 // A checkpoint file's payload (between its magic line and its SHA-256), and the file written back sealed.
 std::string payload_of(const std::string& file_text, const std::string& magic) {

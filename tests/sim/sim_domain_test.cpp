@@ -10,7 +10,7 @@
 #include "sim/simulate/simulate.h"
 #include "sim/engine/world.h"
 #include "sim_fixtures.h"
-#include "tests/error_of.h"
+#include "tests/test_util.h"
 
 namespace floesim::sim {
 namespace {

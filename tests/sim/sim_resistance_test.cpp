@@ -18,22 +18,17 @@
 #include "sim/vessel/hull.h"
 #include "sim/analysis/resistance.h"
 #include "tests/sim/sim_fixtures.h"
+#include "tests/test_util.h"
 
 namespace floesim::sim {
 namespace {
 
 namespace fs = std::filesystem;
+using floesim::tests::read_text;
 using testing::expect_error;
 using testing::temp_dir;
 
 const fs::path kBin = FLOESIM_BIN_DIR;
-
-std::string slurp(const fs::path& f) {
-  std::ifstream in(f);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // PHYSICS.md §6.1-6.2's example hull and ice, as a config.
 IceResistanceOptions example_options() {
@@ -99,9 +94,9 @@ TEST(Resistance, WorkedExamplesThroughTheStageAndItsArtefacts) {
   EXPECT_EQ(j["hull"]["source"]["stem_angle_deg"], "config");
   EXPECT_EQ(j["provenance"]["program"], "floesim-resistance");
   // Deterministic: a second run writes the same bytes.
-  const std::string first = slurp(dir / "ref.csv") + slurp(dir / "ref.json");
+  const std::string first = read_text(dir / "ref.csv") + read_text(dir / "ref.json");
   run_resistance(example_options(), "", "", dir / "ref.csv");
-  EXPECT_EQ(slurp(dir / "ref.csv") + slurp(dir / "ref.json"), first);
+  EXPECT_EQ(read_text(dir / "ref.csv") + read_text(dir / "ref.json"), first);
   fs::remove_all(dir);
 }
 
@@ -209,16 +204,16 @@ TEST(Resistance, ExecutableEndToEnd) {
             0);
   const NumericCsv csv = read_numeric_csv(dir / "ref.csv", {"thickness_m", "speed_mps", "lindqvist_total_kN"});
   EXPECT_EQ(csv.column("thickness_m").size(), 9u);
-  EXPECT_NE(slurp(dir / "out.txt").find("| 1.5 | 3 |"), std::string::npos) << slurp(dir / "out.txt");
+  EXPECT_NE(read_text(dir / "out.txt").find("| 1.5 | 3 |"), std::string::npos) << read_text(dir / "out.txt");
   // --help-config lists the keys; --check-config refuses a typo, naming it, and writes nothing.
   ASSERT_EQ(std::system((res + " --help-config > " + (dir / "help.txt").string()).c_str()), 0);
-  EXPECT_NE(slurp(dir / "help.txt").find("ice.mu_ice_structure"), std::string::npos);
+  EXPECT_NE(read_text(dir / "help.txt").find("ice.mu_ice_structure"), std::string::npos);
   std::ofstream(dir / "bad.json") << R"({"ice": {"mu": 0.1}})";
   const int rc = std::system((base + " --config " + (dir / "bad.json").string() + " --check-config 2> " +
                               (dir / "err.txt").string())
                                  .c_str());
   EXPECT_NE(rc, 0);
-  EXPECT_NE(slurp(dir / "err.txt").find("ice.mu"), std::string::npos) << slurp(dir / "err.txt");
+  EXPECT_NE(read_text(dir / "err.txt").find("ice.mu"), std::string::npos) << read_text(dir / "err.txt");
   fs::remove_all(dir);
 }
 

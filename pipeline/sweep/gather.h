@@ -1,10 +1,9 @@
-// The sweep gather stage: after `floesim sweep` has run the members of a sweep (the points of a grid of case
-// values, each run as an ensemble of seeds), it reads the sweep's plan (RUN/plan.json), gathers every member's
-// summary and results into one table (sweep.csv, sweep.json) with ensemble statistics per grid point, and plots
-// the mean ice resistance against each axis with 95 % confidence intervals, and the running mean of one member
-// (was the run long enough?). Members that failed are listed with the tail of their failed stage's log; they do
-// not stop the gather.
-// floesim-gather is a thin main over gather_sweep().
+// The statistics of a sweep: after `floesim sweep` has run the members of a sweep (the points of a grid of case
+// values, each run as an ensemble of seeds), the gather reads the sweep's plan (pipeline/sweep/sweep_plan.h),
+// every member's summary and results, and makes one table (sweep.csv, sweep.json) with each member's steady mean,
+// its batch-means standard error and peak, and a Student t interval per grid point; for level ice, Lindqvist's and
+// Riska's resistance beside the simulated mean. Members that failed are listed with the tail of their failed
+// stage's log; they do not stop the gather. The plots of a sweep are render/'s (render/sweep_plots.h).
 #pragma once
 #include <cstdint>
 #include <filesystem>
@@ -14,10 +13,11 @@
 #include "pipeline/options.h"
 #include "pipeline/results_io.h"
 #include "pipeline/signal.h"
+#include "pipeline/sweep/sweep_plan.h"
 
-namespace floesim::render {
+namespace floesim::sweep {
 
-inline constexpr const char* kSweepPlanFormat = "floesim-sweep-plan/1";
+inline constexpr double kConfidence = 0.95;
 
 // Batches for the batch-means standard error of a member's mean. Schmeiser (1982, "Batch size effects in the
 // analysis of simulation output", Oper. Res. 30(3)) finds 10 to 30 batches a good choice: fewer leave the error
@@ -28,50 +28,6 @@ inline constexpr size_t kBatchMeansBatches = 20;
 inline constexpr double kPeakWindowS = 0.5;
 // Non-empty log lines quoted for a failed member.
 inline constexpr size_t kErrorLogLines = 3;
-
-// ---- The plan (written by floesim sweep) ----
-
-struct PlanAxis {
-  std::string key;           // a case key path, e.g. "simulate.vessel.propulsion.speed_mps"
-  std::vector<Json> values;  // numbers, strings or booleans, in sweep order
-};
-
-struct PlanStage {
-  std::string name;                             // "synth", "digitise", ... (the member's stages are in run order)
-  std::vector<std::filesystem::path> outputs;   // the artefacts it makes
-  std::filesystem::path log;                    // its stdout and stderr ("" if the plan gives none)
-  std::filesystem::path wall_ms;                // one integer: milliseconds it took ("" if the plan gives none)
-};
-
-struct PlanMember {
-  std::string id;               // e.g. "g000-e00"
-  size_t grid_point = 0;        // index into SweepPlan::grid_points
-  size_t ensemble_index = 0;
-  Json axes = Json::object();   // axis key -> value (those of its grid point)
-  Json seeds = Json::object();  // key the ensemble set -> value (may be empty)
-  std::filesystem::path dir, summary, results;
-  std::vector<PlanStage> stages;
-};
-
-struct PlanGridPoint {
-  size_t index = 0;
-  Json axes = Json::object();  // axis key -> value
-};
-
-struct SweepPlan {
-  std::string name;
-  std::string sweep_file;      // informational ("" if absent)
-  std::vector<PlanAxis> axes;  // empty: a pure ensemble
-  Json ensemble = nullptr;     // informational, copied into sweep.json
-  std::vector<PlanGridPoint> grid_points;
-  std::vector<PlanMember> members;
-};
-
-// Reads a plan: format "floesim-sweep-plan/1" (any other is an error), then every problem at once, each naming the
-// file and the key path ("plan.json: members[2].summary is missing"). Keys the reader does not know are ignored:
-// the plan is written by a program, not by hand, and an incompatible change bumps the format. Relative paths are
-// taken from the plan's folder.
-SweepPlan read_sweep_plan(const std::filesystem::path& file);
 
 // ---- One member's resistance series ----
 
@@ -136,18 +92,29 @@ struct GatherResult {
   std::vector<std::string> columns;  // of sweep.csv
   std::vector<MemberResult> members;  // in plan order
   std::vector<GridPointResult> grid_points;
-  std::vector<std::string> files;  // written into the output directory
+  std::vector<std::string> seed_keys;  // what the ensembles seeded (union over members, sorted)
+  bool level_ice = false;              // a member ran in level ice: the formulas' columns are in the table
+  int first_ok = -1;                   // the first ok member (-1: none), and its steady series (running-mean plot)
+  SteadyResistance first_series;
+  std::vector<std::string> files;  // written into the output directory (sweep.csv, sweep.json and the plots)
 };
 
-// Writes OUT/sweep.csv, OUT/sweep.json and the plots (PNG and SVG): resistance_vs_<axis>.* per axis (or
-// ensemble.* for a pure ensemble) and running_mean.* for the first ok member; plots need at least one ok member.
-// Each file appears only when all are complete. Failed members do not make it fail; a broken plan or a plotting
-// failure does. `plan_file` is hashed into the provenance.
-GatherResult gather_sweep(const SweepPlan& plan, const std::filesystem::path& plan_file,
-                          const std::filesystem::path& out_dir);
-GatherResult gather_sweep(const std::filesystem::path& plan_file, const std::filesystem::path& out_dir);
+// The members' results and the statistics per grid point: reads every member's summary.json and results.h5 (a
+// member that failed is listed with why, from its failed stage's log; it does not stop the gather).
+GatherResult gather_members(const SweepPlan& plan);
+
+// sweep.csv and sweep.json of the gathered members: every member's row (its axes, seeds and results), the grid
+// points' statistics, the failed members, and the provenance (`plan_file` and every gathered member's files
+// hashed). sweep.json lists g.files.
+struct SweepTables {
+  std::string csv, json;
+};
+SweepTables sweep_tables(const SweepPlan& plan, const std::filesystem::path& plan_file, const GatherResult& g);
 
 // The short report floesim-gather prints: per grid point mean +- 95 % CI and ok/n, then the failed members.
 std::string gather_table(const SweepPlan& plan, const GatherResult& g);
 
-}  // namespace floesim::render
+// "mean ± 95 % half width" as gather_table and the plots print it.
+std::string ci_text(const ConfidenceInterval& ci, double scale = 1.0);
+
+}  // namespace floesim::sweep

@@ -1,0 +1,24 @@
+// The surge ice load series as every stage that reports it reads it from results.h5 (the plot, the video's strip
+// chart, a sweep's statistics), so that all of them average the same samples alike: the resistance signal, the
+// contact law the simulation recorded and its moving-average window (PHYSICS.md §5), the steady start.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "pipeline/results_io.h"
+
+namespace floesim {
+
+// The signal the plot stage averages, shared with the sweep statistics so that both report the same mean: ice
+// resistance = -Fx (ice_load column 0, body x, surge) in kN, one sample per step. Error naming `source` if the
+// series is malformed or not finite (the simulation blew up).
+std::vector<double> surge_ice_resistance_kN(const Results& r, const std::string& source);
+// The contact model the simulation recorded (results attribute contact_model: rigid, compliant or mixed; "rigid" if
+// absent), and the moving-average window "auto" means for it (PHYSICS.md §5): 20 s for rigid, else 0.5 s. The plot
+// and the video's strip chart use both, so that they average alike.
+std::string recorded_contact_model(const Results& r, const std::string& source);
+double auto_moving_average_window_s(const Results& r, const std::string& source);
+// The steady start the simulation recorded (results attribute steady_start_s), 0 if absent.
+double recorded_steady_start_s(const Results& r, const std::string& source);
+
+}  // namespace floesim
