@@ -1,6 +1,10 @@
 #pragma once
-// Helpers every test folder shares: the message of the Error a call throws, and a file's whole content.
+// Helpers every test folder shares: the message of the Error a call throws, a file's whole content, a command's
+// exit code and output.
 
+#include <sys/wait.h>
+
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -30,6 +34,18 @@ inline std::string read_text(const std::filesystem::path& p) {
   std::ostringstream ss;
   ss << in.rdbuf();
   return ss.str();
+}
+
+// A command's exit code and everything it printed (stdout and stderr).
+struct CommandOutput {
+  int code = 0;
+  std::string text;
+};
+
+// Runs `command` in a POSIX shell with its stdout and stderr into `log` (kept for a failing test's message).
+inline CommandOutput run_logged(const std::string& command, const std::filesystem::path& log) {
+  const int status = std::system((command + " > '" + log.string() + "' 2>&1").c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : 1, read_text(log)};
 }
 
 }  // namespace floesim::tests

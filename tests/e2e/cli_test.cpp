@@ -11,7 +11,6 @@
 #include <string>
 #include <vector>
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include "pipeline/options.h"
@@ -26,15 +25,11 @@ namespace {
 const fs::path kBin = FLOESIM_BIN_DIR;
 const fs::path kSource = FLOESIM_SOURCE_DIR;
 
-struct RunOutput {
-  int code;
-  std::string text;
-};
+using RunOutput = floesim::tests::CommandOutput;
 
+// floesim with `args` (shell words), its output into `log`.
 RunOutput run(const std::string& args, const fs::path& log) {
-  const std::string cmd = "'" + (kBin / "floesim").string() + "' " + args + " > '" + log.string() + "' 2>&1";
-  const int status = std::system(cmd.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : 1, read_text(log)};
+  return floesim::tests::run_logged("'" + (kBin / "floesim").string() + "' " + args, log);
 }
 
 fs::path scratch(const std::string& name) {

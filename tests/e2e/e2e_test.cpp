@@ -20,6 +20,7 @@
 #include "pipeline/floes_io.h"
 #include "pipeline/options.h"
 #include "pipeline/results_io.h"
+#include "tests/test_util.h"
 
 namespace fs = std::filesystem;
 using namespace floesim;
@@ -29,20 +30,12 @@ namespace {
 const fs::path kBin = FLOESIM_BIN_DIR;
 const fs::path kSource = FLOESIM_SOURCE_DIR;
 
-struct RunOutput {
-  int code;
-  std::string text;
-};
+using RunOutput = floesim::tests::CommandOutput;
 
 RunOutput run_case(const fs::path& case_dir, const fs::path& run_dir) {
-  const fs::path log = run_dir.string() + ".log";
-  const std::string cmd = "'" + (kBin / "floesim").string() + "' run '" + case_dir.string() + "' --out '" +
-                          run_dir.string() + "' > '" + log.string() + "' 2>&1";
-  const int status = std::system(cmd.c_str());
-  std::ifstream in(log);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : 1, ss.str()};
+  return floesim::tests::run_logged(
+      "'" + (kBin / "floesim").string() + "' run '" + case_dir.string() + "' --out '" + run_dir.string() + "'",
+      run_dir.string() + ".log");
 }
 
 fs::file_time_type mtime(const fs::path& p) { return fs::last_write_time(p); }

@@ -27,15 +27,9 @@ namespace {
 const fs::path kBin = FLOESIM_BIN_DIR;
 const fs::path kSource = FLOESIM_SOURCE_DIR;
 
-struct RunOutput {
-  int code;
-  std::string text;
-};
+using RunOutput = floesim::tests::CommandOutput;
 
-RunOutput shell(const std::string& cmd, const fs::path& log) {
-  const int status = std::system((cmd + " > '" + log.string() + "' 2>&1").c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : 1, read_text(log)};
-}
+RunOutput shell(const std::string& cmd, const fs::path& log) { return floesim::tests::run_logged(cmd, log); }
 
 RunOutput floesim(const std::string& args, const fs::path& log) {
   return shell("'" + (kBin / "floesim").string() + "' " + args, log);

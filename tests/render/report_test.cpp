@@ -29,14 +29,8 @@ namespace {
 const fs::path kBin = FLOESIM_BIN_DIR;
 const fs::path kSource = FLOESIM_SOURCE_DIR;
 
-struct Cmd {
-  int code;
-  std::string text;
-};
-Cmd sh(const std::string& cmd, const fs::path& log) {
-  const int status = std::system((cmd + " > '" + log.string() + "' 2>&1").c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : 1, read_text(log)};
-}
+using Cmd = floesim::tests::CommandOutput;
+Cmd sh(const std::string& cmd, const fs::path& log) { return floesim::tests::run_logged(cmd, log); }
 
 // RFC 4648 base64, written here independently of the library's encoder (OpenSSL).
 std::string decode_base64(const std::string& s) {

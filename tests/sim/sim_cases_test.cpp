@@ -28,20 +28,12 @@ using floesim::tests::read_text;
 const fs::path kSource = FLOESIM_SOURCE_DIR;
 const fs::path kBin = FLOESIM_BIN_DIR;
 
-struct RunOutput {
-  int code;
-  std::string text;
-};
+using RunOutput = floesim::tests::CommandOutput;
 
 RunOutput dry_run(const fs::path& case_dir, const fs::path& run_dir) {
-  const fs::path log = run_dir.string() + ".log";
-  const std::string cmd = "'" + (kBin / "floesim").string() + "' run '" + case_dir.string() + "' --out '" +
-                          run_dir.string() + "' --dry-run > '" + log.string() + "' 2>&1";
-  const int status = std::system(cmd.c_str());
-  std::ifstream in(log);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : 1, ss.str()};
+  return floesim::tests::run_logged("'" + (kBin / "floesim").string() + "' run '" + case_dir.string() + "' --out '" +
+                                        run_dir.string() + "' --dry-run",
+                                    run_dir.string() + ".log");
 }
 
 fs::path temp_root() {
