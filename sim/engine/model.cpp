@@ -944,6 +944,7 @@ Model build_model(const FloeField& field, const HullModel* hull, const EngineSet
   // 6. Thrust series (the caller resolved the path relative to the config file).
   if (hull && o.vessel.propulsion.mode == "thrust_series")
     read_thrust_series(o.vessel.propulsion.thrust_file, model.thrust_time_s, model.thrust_n);
+  model.built_bodies = model.bodies.size();
   return model;
 }
 

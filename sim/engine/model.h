@@ -135,10 +135,18 @@ struct Model {
   std::vector<double> thrust_time_s, thrust_n;  // thrust_series mode
   std::vector<Propeller> propellers;            // their jets wash the floes (forces.h, PropellerJet)
 
-  int wall_count = 0;                 // domain walls, the last bodies
+  int wall_count = 0;                 // domain walls, the last bodies of the model as built
+  // The bodies build_model made: the vessel, the input floes (and level ice tiles) and the walls. A world appends
+  // the pieces of broken ice after them and never changes these entries, so the first built_bodies of a world's
+  // table are the model as built.
+  size_t built_bodies = 0;
   // Floe bodies in the table: the input floes of a built model; in a world's grown table, every piece too (dead or
   // alive).
   int floe_count() const { return static_cast<int>(bodies.size()) - (vessel >= 0 ? 1 : 0) - wall_count; }
+  // The input floes (and level ice tiles) alone, in a built model or a world's grown table alike.
+  int built_floe_count() const {
+    return static_cast<int>(built_bodies) - (vessel >= 0 ? 1 : 0) - wall_count;
+  }
 };
 
 // Builds the model. `hull` may be null (floes only). Checks the inputs (thickness, overlaps) and throws

@@ -51,7 +51,8 @@ std::shared_ptr<const Model> branch_base(const Model& model) {
 
 }  // namespace
 
-World::World(const Model& model) : model_(model), pool_(model.settings.threads) {
+World::World(Model built) : model_(std::move(built)), pool_(model_.settings.threads) {
+  const Model& model = model_;
   const size_t n = model.bodies.size();
   base_bodies_ = n;
   const EngineSettings& o = model.settings;

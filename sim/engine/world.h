@@ -57,8 +57,9 @@ struct StepReport {
 
 class World {
  public:
-  // Copies the model: the world's body table grows as ice breaks; the caller's model stays as built.
-  explicit World(const Model& model);
+  // The world owns its model (move it in, or pass a copy to keep one as built): its body table grows as ice breaks,
+  // pieces appended after the model's built bodies (Model::built_bodies), which never change.
+  explicit World(Model model);
   ~World();
 
   // Advances one time step. Throws floesim::Error with a diagnosis (step, time, body) on numerical failure.

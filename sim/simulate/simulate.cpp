@@ -60,8 +60,8 @@ void fill_run_stats(const World& w, const RecorderSums& sums, long steps, double
 
 }  // namespace
 
-Results simulate(const SimulateOptions& o, const Model& model, RunStats& stats, std::ostream* progress,
-                 const CheckpointPlan* checkpoints) {
+Results simulate(const SimulateOptions& o, Model model, RunStats& stats, std::ostream* progress,
+                 const CheckpointPlan* checkpoints, std::unique_ptr<World>* world_out) {
   FLOESIM_REQUIRE(model.vessel >= 0, "simulate: the model has no vessel");
   const long steps = o.steps(), checkpoint_every = o.checkpoint_every();
   const bool spill = checkpoints && checkpoints->spill_series && checkpoint_every > 0;
@@ -78,7 +78,8 @@ Results simulate(const SimulateOptions& o, const Model& model, RunStats& stats, 
     if (checkpoints->resume) world = cp->resume(o, model, r, sums, progress);
     else cp->start_fresh(r, progress);
   }
-  if (!world) world = std::make_unique<World>(model);
+  if (!world) world = std::make_unique<World>(std::move(model));
+  model = Model();  // the world holds the one model of the run (a resumed world rebuilt its own)
   if (cp) r.series_first_step = static_cast<size_t>(cp->series_steps_on_disk());
   recorder.attach(*world);
   const long first = world->state().step + 1;
@@ -115,6 +116,7 @@ Results simulate(const SimulateOptions& o, const Model& model, RunStats& stats, 
   // 3. The geometry, the fracture table and the attributes; the run's statistics.
   recorder.finish(*world);
   fill_run_stats(*world, sums, steps, wall_now(), stats);
+  if (world_out) *world_out = std::move(world);
   return r;
 }
 
@@ -139,7 +141,7 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
                 "waterline z = 0): place a CAD mesh with the hull options (case \"hull\": {\"file\", \"waterline_z_m\", "
                 "\"up_direction\", \"bow_direction\", \"scale\"}, or floesim-hull) first");
   }
-  const Model model = build_model(field, &hull, o);
+  Model model = build_model(field, &hull, o);
 
   std::ostringstream out;
   out << "floesim-simulate: " << model.floe_count() << " floes in " << model.parts.size() << " convex parts ("
@@ -163,11 +165,12 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   checkpoints.resume = resume;
   checkpoints.spill_series = true;
   RunStats stats;
-  Results results = simulate(o, model, stats, &std::cout, &checkpoints);
+  std::unique_ptr<World> world;
+  Results results = simulate(o, std::move(model), stats, &std::cout, &checkpoints, &world);
   results.attributes["provenance"] = prov;
   // The series before the last checkpoint are read back from its chunks, one at a time.
   const CheckpointSeries series(checkpoints.dir, prov, static_cast<long>(results.series_first_step), results);
-  nlohmann::json summary = summarize(o, model, results, series);
+  nlohmann::json summary = summarize(o, world->model(), results, series);
   summary["settings"] = options_to_json(o);
   summary["provenance"] = prov;
 
@@ -180,7 +183,7 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   std::ostringstream rep;
   const double ms = 1e3 * stats.wall_s / stats.steps;
   rep << std::fixed << std::setprecision(2);
-  rep << "floes " << model.floe_count() << ", steps " << stats.steps << ", wall " << stats.wall_s << " s, "
+  rep << "floes " << world->model().built_floe_count() << ", steps " << stats.steps << ", wall " << stats.wall_s << " s, "
       << ms << " ms/step, " << o.duration_s / stats.wall_s << " simulated s per wall s\n";
   if (stats.resumed_at_step > 0)
     rep << "resumed at step " << stats.resumed_at_step << " (t = " << stats.resumed_at_step * o.time_step_s

@@ -3,6 +3,7 @@
 // (summary.h), checkpoints the Checkpointer's (checkpoint.h).
 #pragma once
 #include <filesystem>
+#include <memory>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -13,6 +14,8 @@
 #include "sim/simulate/summary.h"
 
 namespace floesim::sim {
+
+class World;  // sim/engine/world.h
 
 // Run statistics that are not artefacts (wall time is not deterministic): printed by the stage.
 struct RunStats {
@@ -38,15 +41,16 @@ struct CheckpointPlan {
   bool spill_series = false;
 };
 
-// Simulates the model for o.duration_s: a world stepped from it (or continued from a checkpoint) and a Recorder
-// (sim/simulate/recorder.h) that records every series per step, the body states at t = k * output_interval_s
-// (k = 1..N, exactly duration / output_interval frames) and the geometry. `model` is the model build_model made with
-// `o`; the world steps its own copy, which grows as ice breaks. `progress` (may be null) receives a line every 10 %
-// of the run. Needs a vessel in the model. With `checkpoints`, writes a checkpoint every o.checkpoint_interval_s of
-// simulated time (if > 0) and when stopped by a signal, and resumes from one if asked: the results are the same to
-// the bit either way. SIGINT/SIGTERM stop it between two steps with Interrupted (pipeline/interrupt.h).
-Results simulate(const SimulateOptions& o, const Model& model, RunStats& stats, std::ostream* progress = nullptr,
-                 const CheckpointPlan* checkpoints = nullptr);
+// Simulates the model for o.duration_s: a world that owns the model (moved in; pass a copy to keep one) steps it,
+// or continues it from a checkpoint, and a Recorder (sim/simulate/recorder.h) records every series per step, the
+// body states at t = k * output_interval_s (k = 1..N, exactly duration / output_interval frames) and the geometry.
+// `model` is the model build_model made with `o`. `progress` (may be null) receives a line every 10 % of the run.
+// Needs a vessel in the model. With `checkpoints`, writes a checkpoint every o.checkpoint_interval_s of simulated
+// time (if > 0) and when stopped by a signal, and resumes from one if asked: the results are the same to the bit
+// either way. SIGINT/SIGTERM stop it between two steps with Interrupted (pipeline/interrupt.h). `world` (may be
+// null) receives the world at the end, with its model (the summary's).
+Results simulate(const SimulateOptions& o, Model model, RunStats& stats, std::ostream* progress = nullptr,
+                 const CheckpointPlan* checkpoints = nullptr, std::unique_ptr<World>* world = nullptr);
 
 // The stage: reads the inputs, builds the model, simulates, writes out_dir/results.h5 and out_dir/summary.json
 // atomically (nothing is written on error) and returns the report printed on stdout. Checkpoints go to

@@ -161,7 +161,7 @@ nlohmann::json level_ice_summary(const SimulateOptions& o, const Model& model, c
   nlohmann::json j;
   const int v = model.vessel;
   std::vector<int> tiles;
-  for (size_t b = 0; b < model.bodies.size(); ++b)
+  for (size_t b = 0; b < model.built_bodies; ++b)  // the sheet as built (what fracture left of a tile is a piece)
     if (model.bodies[b].fixed) tiles.push_back(static_cast<int>(b));
   j["tiles_start"] = tiles.size();
   if (tiles.empty() || v < 0 || r.frames() == 0) return j;
@@ -389,7 +389,7 @@ nlohmann::json summarize(const SimulateOptions& o, const Model& model, const Res
   }
   s["steps"] = steps;
   s["frames"] = r.frames();
-  s["floes"] = model.floe_count();
+  s["floes"] = model.built_floe_count();
   s["removed_floes"] = model.removed_floe_ids.size();
   s["removed_floe_ids"] = model.removed_floe_ids;
   s["small_floe_overlaps"] = model.small_overlaps;

@@ -11,7 +11,8 @@
 namespace floesim::sim {
 
 // Summary statistics of the results (steady part from o.steady_start_s); the series from `series` (one at a time)
-// or from results.series. `model` is the model as built (its input floes, vessel and sheet).
+// or from results.series. `model` is the model as built or the world's that ran it: only its built bodies are read
+// (the input floes, the vessel and the sheet; Model::built_bodies).
 nlohmann::json summarize(const SimulateOptions& o, const Model& model, const Results& results,
                          const SeriesSource& series);
 nlohmann::json summarize(const SimulateOptions& o, const Model& model, const Results& results);

@@ -1,4 +1,6 @@
 // The vessel's hull: a parametric icebreaker generator (written as OBJ) and the loader any user hull goes through.
+// Defined in generate.cpp (the parametric icebreaker, write_obj), import.cpp (loading and placing a CAD mesh,
+// write_imported_hull) and hull.cpp (hydrostatics); hull_internal.h holds the helpers they share.
 #pragma once
 #include <cmath>
 #include <filesystem>

@@ -73,8 +73,8 @@ TEST(HullParticulars, BoxBargeIsSquareEverywhere) {
   EXPECT_NEAR(p.bow_length_m, 0.0, 1e-9);
 }
 
-// Tolerance on the generated hull's angles. Its coordinates lie on a 2^-10 m grid (hull.cpp, grid()): each is off by
-// at most 2^-11 m = 0.49 mm. The stem angle is fitted over T/4 = 2 m of height, the entrance angle over B/20 =
+// Tolerance on the generated hull's angles. Its coordinates lie on a 2^-10 m grid (generate.cpp, grid()): each is
+// off by at most 2^-11 m = 0.49 mm. The stem angle is fitted over T/4 = 2 m of height, the entrance angle over B/20 =
 // 1.55 m of breadth; an error of 2 x 0.49 mm across such a base turns a line by at most 1e-3 / 1.55 rad = 0.037 deg.
 // Between stations the surfaces fitted are planes (the spoon, the wedge), which the convex parts reproduce exactly.
 constexpr double kAngleTolDeg = 0.05;
@@ -112,7 +112,7 @@ TEST(HullParticulars, OdenLikeHullIsSquareAcrossAtQuarterBeam) {
   EXPECT_NEAR(p.normal_flare_deg, 22.0, kAngleTolDeg);
   EXPECT_NEAR(p.normal_flare_b4_deg, 22.0, kAngleTolDeg);
 
-  // Parallel midbody and bow, bracketed by the generator's waterline in closed form (hull.cpp's HullShape: the
+  // Parallel midbody and bow, bracketed by the generator's waterline in closed form (generate.cpp's HullShape: the
   // half-breadth rises from beam/2 to reamer_beam/2 as 0.5 - 0.5 cos(pi s) over the shoulder, 0.12 L long, and
   // falls ahead of the reamers as the ellipse tip + (r - tip) sqrt(1 - u^2), tip = 0.30 r, to the stem head). Both
   // curves are concave near the reamers and the mesh joins stations (spaced L/30) by straight lines, which lie
