@@ -58,6 +58,18 @@ TEST(Options, UnknownKeyIsAnErrorNamingFileAndPath) {
   EXPECT_NE(e.find("2 problems"), std::string::npos) << e;
 }
 
+// A typo names the key it most likely meant: one deletion ("sped_mps": 1 from speed_mps), a transposition (2
+// substitutions), and nothing for a key that is no typo of any (over a third of its letters differ).
+TEST(Options, UnknownKeyNamesTheKeyItMostLikelyMeant) {
+  const std::string e = error_of(Json::parse(R"({"thickness": 0.5, "inner": {"sped_mps": 1}, "mdoe": "slice"})"));
+  EXPECT_NE(e.find("sim.inner.sped_mps is not a known key; did you mean speed_mps?"), std::string::npos) << e;
+  EXPECT_NE(e.find("sim.mdoe is not a known key; did you mean mode?"), std::string::npos) << e;
+  EXPECT_NE(e.find("sim.thickness is not a known key; did you mean thickness_m?"), std::string::npos) << e;
+  EXPECT_EQ(closest_key("duraton_s", {"time_step_s", "duration_s", "output_interval_s"}), "duration_s");
+  EXPECT_EQ(closest_key("lenght_m", {"length_m", "beam_m"}), "length_m");
+  EXPECT_EQ(closest_key("colour", {"length_m", "beam_m", "sections"}), "");
+}
+
 TEST(Options, ReportsEveryViolationWithTheValue) {
   const std::string e = error_of(Json::parse(R"({"thickness_m": -2, "sections": 100, "mode": "hull"})"));
   EXPECT_NE(e.find("sim.thickness_m must be > 0, got -2"), std::string::npos) << e;
