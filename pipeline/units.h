@@ -8,6 +8,14 @@
 
 namespace floesim {
 
+// A number as printf's `format` writes one double ("%.4g", "%.1f"): the text people read in plots, videos, reports
+// and printed tables.
+inline std::string fmt(const char* format, double x) {
+  char b[64];
+  std::snprintf(b, sizeof b, format, x);
+  return b;
+}
+
 struct ForceUnit {
   const char* name;  // "N", "kN" or "MN"
   double newtons;    // size of one unit in N

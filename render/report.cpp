@@ -78,12 +78,6 @@ std::string read_bytes(const fs::path& p) {
   return ss.str();
 }
 
-std::string fmt(const char* f, double a) {
-  char b[64];
-  std::snprintf(b, sizeof b, f, a);
-  return b;
-}
-
 // A load given in kN, as text in the display unit u (pipeline/units.h: N for a tank model, kN for a ship).
 std::string load_in(double x_kN, const ForceUnit& u) {
   if (!std::isfinite(x_kN)) return "&ndash;";

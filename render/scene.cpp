@@ -11,6 +11,7 @@
 
 #include "pipeline/error.h"
 #include "pipeline/geometry2d.h"
+#include "pipeline/units.h"
 #include "render/gl_context.h"
 #include "render/strip_chart.h"
 
@@ -152,12 +153,6 @@ std::vector<SubView> sub_views(const RenderOptions& o) {
   if (o.split_layout == "stacked")
     return {{o.split_views[0], {0, 0, w, h / 2}}, {o.split_views[1], {0, h / 2, w, h - h / 2}}};
   return {{o.split_views[0], {0, 0, w / 2, h}}, {o.split_views[1], {w / 2, 0, w - w / 2, h}}};
-}
-
-std::string fmt(const char* f, double a) {
-  char b[64];
-  std::snprintf(b, sizeof b, f, a);
-  return b;
 }
 
 }  // namespace

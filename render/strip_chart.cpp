@@ -15,12 +15,6 @@ namespace floesim::render {
 
 namespace {
 
-std::string fmt(const char* f, double a) {
-  char b[64];
-  std::snprintf(b, sizeof b, f, a);
-  return b;
-}
-
 // A round tick step (1, 2, 2.5 or 5 x 10^k) giving about `ticks` intervals over `range`.
 double nice_step(double range, int ticks) {
   const double raw = range / ticks;

@@ -19,12 +19,6 @@ using namespace floesim::sweep;
 
 namespace {
 
-std::string fmt(const char* f, double a) {
-  char b[64];
-  std::snprintf(b, sizeof b, f, a);
-  return b;
-}
-
 // A file name part from a key: "simulate.vessel.y_m" -> "simulate_vessel_y_m".
 std::string file_part(const std::string& key) {
   std::string s = key;

@@ -77,7 +77,10 @@ Output run_capture(const std::vector<std::string>& args) {
   return out;
 }
 
-std::string stage_settings_problems(const PlannedStage& st, const fs::path& tmp_dir, const std::string& origin) {
+namespace {
+
+// One stage's check (see stage_settings_problems), its copy written into `tmp_dir`.
+std::string settings_problems(const PlannedStage& st, const fs::path& tmp_dir) {
   const fs::path cfg = tmp_dir / (st.name + "-" + st.key + ".json");
   write_text_atomic(cfg, st.config_text);
   const Output r = run_capture({st.exe.string(), "--check-config", "--config", cfg.string()});
@@ -87,8 +90,8 @@ std::string stage_settings_problems(const PlannedStage& st, const fs::path& tmp_
   // The stage's own prefix ("floesim-simulate: error: ") and the copy's name give way to the case's.
   const std::string prefix = st.exe.filename().string() + ": error: ";
   if (msg.rfind(prefix, 0) == 0) msg.erase(0, prefix.size());
-  const std::string copy = origin.empty() ? cfg.string() + ": " : cfg.string();
-  for (size_t at; (at = msg.find(copy)) != std::string::npos;) msg.replace(at, copy.size(), origin);
+  const std::string copy = cfg.string() + ": ";
+  for (size_t at; (at = msg.find(copy)) != std::string::npos;) msg.erase(at, copy.size());
   // Each listed problem ("\n  - key ...") names its key from the stage's settings: prefixed with their section.
   if (!st.section.empty()) {
     const std::string item = "\n  - ";
@@ -96,6 +99,22 @@ std::string stage_settings_problems(const PlannedStage& st, const fs::path& tmp_
       msg.insert(at + item.size(), st.section + ".");
   }
   return msg;
+}
+
+}  // namespace
+
+std::vector<std::string> stage_settings_problems(const std::vector<PlannedStage>& stages) {
+  const fs::path tmp = fs::temp_directory_path() / ("floesim-check-" + std::to_string(getpid()));
+  ensure_directory(tmp);
+  std::vector<std::string> problems;
+  try {
+    for (const PlannedStage& st : stages) problems.push_back(settings_problems(st, tmp));
+  } catch (...) {
+    fs::remove_all(tmp);
+    throw;
+  }
+  fs::remove_all(tmp);
+  return problems;
 }
 
 }  // namespace floesim::runner

@@ -38,11 +38,10 @@ bool read_line(FILE* in, char* line, int size, const std::function<void()>& on_s
 // Runs a program and collects its output.
 Output run_capture(const std::vector<std::string>& args);
 
-// The stage checks its own settings (`--check-config`) from a copy written into `tmp_dir`: "" when they are
-// valid, else its problems as key paths of the case file: the copy's name is replaced by `origin` (a sweep's
-// member; "" drops it) and each key by its path in the case (`simulate.duraton_s is not a known key; did you mean
-// duration_s?`), without the stage's own prefix.
-std::string stage_settings_problems(const PlannedStage& st, const std::filesystem::path& tmp_dir,
-                                    const std::string& origin);
+// Each stage checks its own settings (`--check-config`), from a copy in a temporary folder removed afterwards:
+// per stage, "" when they are valid, else its problems with each key named by its path in the case
+// (`simulate.duraton_s is not a known key; did you mean duration_s?`), without the stage's own prefix and the
+// copy's name. Nothing else is written.
+std::vector<std::string> stage_settings_problems(const std::vector<PlannedStage>& stages);
 
 }  // namespace floesim::runner

@@ -220,18 +220,10 @@ int run_ninja_child(const std::vector<std::string>& args,
 }
 
 void check_case_settings(const CasePlan& plan, const fs::path& case_file) {
-  const fs::path tmp = fs::temp_directory_path() / ("floesim-run-check-" + std::to_string(getpid()));
-  ensure_directory(tmp);
+  const std::vector<std::string> found = stage_settings_problems(plan.stages);
   std::vector<std::string> problems;
-  try {
-    for (const PlannedStage& st : plan.stages)
-      if (std::string msg = stage_settings_problems(st, tmp, ""); !msg.empty())
-        problems.push_back("stage " + st.name + ": " + msg);
-  } catch (...) {
-    fs::remove_all(tmp);
-    throw;
-  }
-  fs::remove_all(tmp);
+  for (size_t k = 0; k < found.size(); ++k)
+    if (!found[k].empty()) problems.push_back("stage " + plan.stages[k].name + ": " + found[k]);
   if (problems.empty()) return;
   std::string text = case_file.string() + ": the settings of " + std::to_string(problems.size()) + " stage" +
                      (problems.size() > 1 ? "s were" : " was") + " refused, nothing was run:";

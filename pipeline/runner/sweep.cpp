@@ -99,17 +99,12 @@ SweepStages plan_members(const Sweep& s, const std::vector<Member>& members, con
 // Each distinct stage instance checks its own settings (`--check-config`), from a temporary copy: nothing of the
 // run is written before the whole sweep is known to be valid. All problems are listed, one per instance.
 void check_stage_settings(const Sweep& s, const std::vector<Member>& members, const SweepStages& p) {
-  const fs::path tmp = fs::temp_directory_path() / ("floesim-sweep-check-" + std::to_string(getpid()));
-  ensure_directory(tmp);
+  const std::vector<std::string> found = stage_settings_problems(p.stages);
   std::vector<std::string> problems;
-  for (size_t k = 0; k < p.stages.size(); ++k) {
-    const PlannedStage& st = p.stages[k];
-    const std::string msg = stage_settings_problems(st, tmp, "(the member's " + st.name + " settings)");
-    if (!msg.empty()) {
-      problems.push_back("member " + describe(members[p.users[k][0]]) + ", stage " + st.name + ": " + msg);
-    }
-  }
-  fs::remove_all(tmp);
+  for (size_t k = 0; k < found.size(); ++k)
+    if (!found[k].empty())
+      problems.push_back("member " + describe(members[p.users[k][0]]) + ", stage " + p.stages[k].name + ": " +
+                         found[k]);
   FLOESIM_REQUIRE(problems.empty(), s.file.string(), ": ", problems.size(),
                   " stage setting(s) refused, nothing was run:\n  ", join(problems, "\n  "));
 }

@@ -12,6 +12,7 @@
 #include "pipeline/ice_resistance.h"
 #include "pipeline/load_series.h"
 #include "pipeline/provenance.h"
+#include "pipeline/units.h"
 
 namespace floesim::sweep {
 
@@ -229,12 +230,6 @@ const std::vector<std::string> kResultColumns = {
 // Level ice sweeps (a member's summary has level_ice.ice): PHYSICS.md §6's formulas at the member's mean speed.
 const std::vector<std::string> kLevelIceColumns = {"lindqvist_kN",  "riska_kN", "ratio_to_lindqvist",
                                                    "ratio_to_riska", "channel_width_over_beam", "reference_error"};
-
-std::string fmt(const char* f, double a) {
-  char b[64];
-  std::snprintf(b, sizeof b, f, a);
-  return b;
-}
 
 }  // namespace
 

@@ -165,7 +165,9 @@ Recorder::Recorder(const SimulateOptions& o, Results& r, long rows_held) : o_(o)
   r.frame_time_s.reserve(static_cast<size_t>(o.steps() / every_));
 }
 
-void Recorder::attach(const World& w) { stored_ = std::make_shared<StoredStates>(w, r_); }
+Recorder::~Recorder() = default;
+
+void Recorder::attach(const World& w) { stored_ = std::make_unique<StoredStates>(w, r_); }
 
 void Recorder::record_step(const World& w, long k) {
   const auto t0 = std::chrono::steady_clock::now();

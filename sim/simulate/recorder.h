@@ -4,6 +4,7 @@
 // table and the run's attributes. It reads the world and writes the results: nothing of the world changes.
 #pragma once
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,7 @@ class Recorder {
  public:
   // Reserves the series columns of `r` for `rows_held` steps and its frames for the whole run.
   Recorder(const SimulateOptions& o, Results& r, long rows_held);
+  ~Recorder();
 
   // Takes up the bodies' last stored states from the results (none for a fresh run; every row up to the checkpoint
   // when resumed, so that a resumed run stores exactly what an uninterrupted one does).
@@ -49,7 +51,7 @@ class Recorder {
   std::vector<std::vector<double>*> c_loads_;   // the wrench series, in the order of kLoadSeries
   std::vector<std::vector<double>*> c_scalar_;  // the scalar series, in the order of kScalarSeries
   std::vector<int8_t> pressed_;                 // per body: pressed against the vessel in this step (frames only)
-  std::shared_ptr<StoredStates> stored_;
+  std::unique_ptr<StoredStates> stored_;  // from attach()
   RecorderSums sums_;
 };
 
