@@ -14,10 +14,20 @@ namespace floesim {
 // series is malformed or not finite (the simulation blew up).
 std::vector<double> surge_ice_resistance_kN(const Results& r, const std::string& source);
 // The contact model the simulation recorded (results attribute contact_model: rigid, compliant or mixed; "rigid" if
-// absent), and the moving-average window "auto" means for it (PHYSICS.md §5): 20 s for rigid, else 0.5 s. The plot
-// and the video's strip chart use both, so that they average alike.
+// absent).
 std::string recorded_contact_model(const Results& r, const std::string& source);
-double auto_moving_average_window_s(const Results& r, const std::string& source);
+// The centred moving average "auto" means (PHYSICS.md §5; the seed's windows): the rigid part of the surge ice
+// resistance (results series ice_load_rigid) averaged over 20 s plus the compliant part (ice_load_compliant) over
+// 0.5 s, each filtered and then summed, in kN; `window_s` the longest window in use (20 s if any rigid load was
+// recorded, else 0.5 s: whole windows start and end that far from the run's ends) and `text` what was done, for
+// labels. A run of one contact law is its one window over the whole load.
+struct FilteredLoad {
+  std::vector<double> kN;
+  double window_s = 0;
+  std::string text;
+};
+FilteredLoad auto_filtered_surge_ice_resistance_kN(const Results& r, const std::string& source);
+
 // The steady start the simulation recorded (results attribute steady_start_s), 0 if absent.
 double recorded_steady_start_s(const Results& r, const std::string& source);
 

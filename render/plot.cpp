@@ -68,11 +68,19 @@ struct MovingAverage {
 MovingAverage centred_moving_average(const Results& r, const PlotOptions& o, const std::vector<double>& res,
                                      const std::string& source, SurgeLoadSummary& s) {
   s.contact_model = recorded_contact_model(r, source);
-  s.window_s = o.moving_average_window_s.is_string() ? auto_moving_average_window_s(r, source)
-                                                     : o.moving_average_window_s.get<double>();
-  s.window_samples = window_samples(s.window_s, s.time_step_s);
   MovingAverage m;
-  m.ma = moving_average_centred(res, s.window_samples);
+  if (o.moving_average_window_s.is_string()) {
+    FilteredLoad f = auto_filtered_surge_ice_resistance_kN(r, source);
+    s.window_s = f.window_s;
+    s.filter = f.text;
+    m.ma = std::move(f.kN);
+    s.window_samples = window_samples(s.window_s, s.time_step_s);
+  } else {
+    s.window_s = o.moving_average_window_s.get<double>();
+    s.window_samples = window_samples(s.window_s, s.time_step_s);
+    s.filter = fmt("%g", s.window_s) + " s centred moving average";
+    m.ma = moving_average_centred(res, s.window_samples);
+  }
   auto [f0, f1] = full_window_range(res.size(), s.window_samples);
   s.moving_average_complete = f0 < f1;
   if (!s.moving_average_complete) f0 = 0, f1 = res.size();
@@ -270,8 +278,7 @@ void script_plot_command(std::ostream& gp, const AtomicFile& data, const SurgeLo
      << " index 0 using 1:2 with lines lc rgb '#a9b8c6' lw 0.8 title "
      << quoted("ice resistance, every time step (Δt = " + fmt("%g", s.time_step_s) + " s)") << " noenhanced, \\\n"
      << "  '' index 1 using 1:2 with lines lc rgb '#101010' lw 2 title "
-     << quoted("centred moving average, " + fmt("%g", s.window_s) + " s window" +
-               (s.moving_average_complete ? "" : " (longer than the run: cut windows)")) << " noenhanced, \\\n"
+     << quoted(s.filter + (s.moving_average_complete ? "" : " (longer than the run: cut windows)")) << " noenhanced, \\\n"
      << "  '' index 2 using 1:2 with lines lc rgb '#d1232a' lw 2.5 dt (8,4) title " << quoted(mean_title)
      << " noenhanced";
   const std::string y_mark = fmt("%.9g", y_lo_u + 0.012 * (y_hi_u - y_lo_u));
@@ -318,6 +325,7 @@ nlohmann::json plot_numbers(const SurgeLoadSummary& s, const VesselEvents& ev, c
       {"moving_average",
        {{"kind", "centred"},
         {"window_s", s.window_s},
+        {"filter", s.filter},
         {"window_samples", s.window_samples},
         {"complete_windows", s.moving_average_complete}}},
       {"steady_start_s", s.steady_start_s},

@@ -30,8 +30,8 @@ struct PlotOptions {
   template <class V>
   void visit(V& v) {
     v.field("moving_average_window_s", moving_average_window_s, "s",
-            "centred moving-average window, or \"auto\": 20 s for rigid-contact runs, 0.5 s otherwise "
-            "(results attribute contact_model)",
+            "centred moving-average window, or \"auto\" (PHYSICS.md 5): the rigid part of the load over 20 s plus "
+            "the compliant part over 0.5 s, each filtered and then summed",
             auto_or_number(true));
     v.field("steady_start_s", steady_start_s, "s",
             "start of the steady part averaged for the mean, or \"auto\": results attribute steady_start_s (else 0)",
@@ -48,7 +48,8 @@ PlotOptions read_plot_options(const std::filesystem::path& config);
 struct SurgeLoadSummary {
   std::string contact_model;       // from the results attributes ("rigid" if absent)
   double time_step_s = 0;          // sample step of the series
-  double window_s = 0;             // moving-average window used
+  double window_s = 0;             // moving-average window used (the longest, with "auto" on a mixed run)
+  std::string filter;              // what the moving average is, for labels
   size_t window_samples = 0;       // N = round(window_s / time_step_s)
   double steady_start_s = 0;
   size_t steady_samples = 0;

@@ -49,9 +49,15 @@ LoadStripChart::LoadStripChart(const Results& r, const RenderOptions& o, const s
   FLOESIM_REQUIRE(t.size() >= 2, source, ": the strip chart needs at least 2 steps of series, the results hold ",
                   t.size(), " (set the render option strip_chart to false)");
   const double dt = uniform_step(t, (source + ": series time_s").c_str());
-  scale_.window_s = o.strip_average_window_s.is_string() ? auto_moving_average_window_s(r, source)
-                                                          : o.strip_average_window_s.get<double>();
-  const std::vector<double> average = moving_average_centred(load, window_samples(scale_.window_s, dt));
+  std::vector<double> average;
+  if (o.strip_average_window_s.is_string()) {
+    FilteredLoad f = auto_filtered_surge_ice_resistance_kN(r, source);
+    scale_.window_s = f.window_s;
+    average = std::move(f.kN);
+  } else {
+    scale_.window_s = o.strip_average_window_s.get<double>();
+    average = moving_average_centred(load, window_samples(scale_.window_s, dt));
+  }
 
   // 2. Time: the series and the frames (the first frame may be at t = 0, before the first step ends).
   scale_.t_first = std::min(t.front(), r.frames() ? r.frame_time_s.front() : t.front());

@@ -7,7 +7,10 @@
 // with the field. Fracture (PHYSICS.md §2) is on as in the cases; the Oden-size field runs first without it, in the
 // same process, so that its cost is a ratio of one run: events per simulated second, floe bodies at the start and
 // the end, the fracture stage's time, who presses on the hull (input floes, pieces), and
-// `fracture_speed_ratio <with / without>`. The last line is
+// `fracture_speed_ratio <with / without>`. It also runs the Oden-size field with fracture at the hull only and with
+// brash removed (the model before issue #33), so that the cost of ice-ice failure and of keeping brash as rigid
+// bodies is a ratio of the same run (`rigid_brash_speed_ratio <brash kept / removed, simulated s per wall s, ice-ice failure on>`). The last
+// line is
 // `realtime_factor <simulated s per wall s on the Oden-size field, fracture on>`.
 //
 //   floesim-bench [--duration 200] [--threads 2] [--scales 1,4,9] [--seed 1] [--keep DIR] [--no-compare]
@@ -236,8 +239,24 @@ struct BenchOptions {
   bool compare = true;   // the Oden-size field without fracture first
 };
 
+// The ice model a field runs with: fracture off, or on with (or without) failure at ice-ice contacts and brash
+// kept as rigid bodies (or removed, the model before issue #33).
+struct Variant {
+  const char* name;
+  bool fracture, ice_ice;
+  const char* brash;
+};
+constexpr Variant kDefaults{"fracture on (ice-ice failure, rigid brash)", true, true, "rigid"};
+constexpr Variant kCompared[] = {
+    {"fracture off", false, false, "rigid"},
+    {"fracture at the hull only, brash removed", true, false, "removed"},
+    {"fracture at the hull only, rigid brash", true, false, "rigid"},
+    {"fracture with ice-ice failure, brash removed", true, true, "removed"},
+};
+
 // One field: generate, build, simulate (with the recorder), write the results; returns simulated s per wall s.
-double run_field(int scale, const BenchOptions& bo, const HullModel& hull, bool fracture) {
+double run_field(int scale, const BenchOptions& bo, const HullModel& hull, const Variant& v) {
+  const bool fracture = v.fracture;
   FieldSpec spec;
   const double s = std::sqrt(static_cast<double>(scale));
   spec.width_m *= s;
@@ -260,15 +279,17 @@ double run_field(int scale, const BenchOptions& bo, const HullModel& hull, bool 
   o.vessel.propulsion.mode = "speed";
   o.vessel.propulsion.speed_mps = 2.0;
   o.fracture.enabled = fracture;
+  o.fracture.ice_ice = v.ice_ice;
+  o.fracture.brash = v.brash;
   const Model model = build_model(field, &hull, o);
   const double build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - g0).count();
   size_t floe_parts = 0;
   for (const Body& b : model.bodies)
     if (b.kind == BodyKind::floe) floe_parts += b.part_count;
 
-  std::printf("field %dx, fracture %s: %.0f m x %.0f m, %d floes (%zu convex parts), concentration %.3f, "
+  std::printf("field %dx, %s: %.0f m x %.0f m, %d floes (%zu convex parts), concentration %.3f, "
               "h = %.1f m (generated and built in %.2f s)\n",
-              scale, fracture ? "on" : "off", spec.width_m, spec.height_m, model.floe_count(), floe_parts,
+              scale, v.name, spec.width_m, spec.height_m, model.floe_count(), floe_parts,
               floe_area / (spec.width_m * spec.height_m), spec.thickness_m, build_s);
   std::fflush(stdout);
 
@@ -318,6 +339,14 @@ double run_field(int scale, const BenchOptions& bo, const HullModel& hull, bool 
                 "%d at the start, %.0f at the end; fracture stage %.3f ms/step\n",
                 r.fracture_mode.size(), mode[1], mode[2], mode[3], r.fracture_mode.size() / bo.duration_s,
                 model.floe_count(), bodies.empty() ? 0.0 : bodies.back(), 1e3 * st.stage_s[kFracture] / st.steps);
+    double removed = 0;
+    for (double b : r.fracture_brash_mass_kg) removed += b;
+    const auto& ice = r.get("ice_load");
+    const auto& rigid = r.get("ice_load_rigid");
+    double total = 0, from_rigid = 0;
+    for (size_t k = 0; k < ice.size(); k += 6) total += ice[k], from_rigid += rigid[k];
+    std::printf("  brash: %.1f t removed; rigid contacts carry %.1f %% of the mean surge ice load\n", removed / 1e3,
+                total != 0 ? 100 * from_rigid / total : 0.0);
   }
   const HullPressers hp = hull_pressers(r);
   std::printf("  pressing on the hull (mean per frame): input floes %.1f, pieces %.1f; longest a piece stayed "
@@ -357,13 +386,22 @@ int main(int argc, char** argv) {
     write_obj(tmp / "hull.obj", generate_hull(HullGeneratorOptions{}), "floesim-bench hull");
     const HullModel hull = load_hull(tmp / "hull.obj");
     bo.compare = !no_compare;
-    const double rtf_off = bo.compare ? run_field(1, bo, hull, false) : 0.0;
+    std::vector<double> compared;
+    if (bo.compare)
+      for (const Variant& v : kCompared) compared.push_back(run_field(1, bo, hull, v));
     double rtf1 = 0;
     for (size_t i = 0; i < bo.scales.size(); ++i) {
-      const double rtf = run_field(bo.scales[i], bo, hull, true);
+      const double rtf = run_field(bo.scales[i], bo, hull, kDefaults);
       if (i == 0) rtf1 = rtf;
     }
-    if (bo.compare) std::printf("fracture_speed_ratio %.3f\n", rtf1 / rtf_off);
+    if (bo.compare) {
+      // Speed of the defaults against each other model on the Oden-size field, in this one run (> 1: faster).
+      for (size_t i = 1; i < compared.size(); ++i)
+        std::printf("speed ratio against %s: %.3f\n", kCompared[i].name, rtf1 / compared[i]);
+      // Brash kept as rigid bodies against brash removed, with ice-ice failure on (>= 1: keeping it costs nothing).
+      std::printf("rigid_brash_speed_ratio %.3f\n", rtf1 / compared[3]);
+      std::printf("fracture_speed_ratio %.3f\n", rtf1 / compared[0]);
+    }
     std::printf("realtime_factor %.2f\n", rtf1);
   });
 }

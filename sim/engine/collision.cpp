@@ -481,6 +481,8 @@ struct CollisionWorld::Impl {
     // Domain walls are boundaries, not ice or a structure under test: always rigid.
     if (model.bodies[pc.body_a].kind == BodyKind::wall || model.bodies[pc.body_b].kind == BodyKind::wall)
       return false;
+    // Brash is a block, not a plate: rigid contacts, cheap (one manifold, no crushing rows; PHYSICS.md §1.7).
+    if (model.bodies[pc.body_a].brash || model.bodies[pc.body_b].brash) return false;
     return is_structure_pair(pc) ? compliant_structure : compliant_ice;
   }
 
@@ -855,6 +857,20 @@ struct CollisionWorld::Impl {
     return f;
   }
 
+  // The rigid points of a part pair with brash (out[first, end)) share the brash's crushing force as a ceiling on
+  // their normal impulses (Body::brash_crush_force_n; the smaller of two brash bodies').
+  void cap_brash(const PairCandidate& pc, std::vector<Contact>& out, size_t first) const {
+    const Body& a = model.bodies[pc.body_a];
+    const Body& b = model.bodies[pc.body_b];
+    if (!a.brash && !b.brash) return;
+    const double f = !a.brash ? b.brash_crush_force_n
+                              : !b.brash ? a.brash_crush_force_n
+                                         : std::min(a.brash_crush_force_n, b.brash_crush_force_n);
+    const size_t n = out.size() - first;
+    for (size_t i = first; i < out.size(); ++i)
+      out[i].max_normal_impulse = model.settings.time_step_s * f / static_cast<double>(n);
+  }
+
   bool manifold(const PairCandidate& pc, const FaceAxes& axes, const fcl::Contactd& hint, Scratch& sc,
                 std::vector<Contact>& out) {
     const ConvexPart& A = model.parts[pc.part_a];
@@ -1133,7 +1149,9 @@ void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out
         if (!res.isCollision() || res.numContacts() == 0) continue;
         ++sc.hits;
         // FCL's normal points from its first object to its second: part_a to part_b here.
+        const size_t made = sc.contacts.size();
         if (m.manifold(pc, axes, res.getContact(0), sc, sc.contacts)) ++sc.edges;
+        m.cap_brash(pc, sc.contacts, made);
       }
     }
     m.chunk_ranges[chunk] = {w, first, static_cast<int>(sc.contacts.size())};

@@ -56,20 +56,17 @@ struct FractureCut {
 // The fractures of this step from the contacts after the relax pass (impulses over dt are forces). Floes that
 // are not alive are not tested (pieces made this step have no contacts yet). Deterministic: contacts are
 // sorted, wedge angles come from a hash of (fracture.seed, floe id, step), never from a shared generator.
+// `history` is the pair loads' recent forces (State::pair_loads), advanced here by this step's loads.
 std::vector<FractureCut> find_fractures(const Model& model, const State& state, const std::vector<Contact>& contacts,
-                                        double dt);
-
-// Whether a piece is brash (removed, its mass counted) rather than a floe: smaller than min_area_m2, or narrower
-// than the ice is thick (plan width 4 A / perimeter below h: a sliver is a block, not a plate, and its tiny
-// inertia about its long axis would only destabilise the contacts it sits in).
-bool is_brash(const Polygon& piece, double thickness_m, double min_area_m2);
+                                        double dt, std::vector<PairLoadHistory>* history);
 
 // The broken wedge's static extent R_b beyond the load point (PHYSICS.md §2.1 step 3), m: Nevel's
 // (xi* - alpha) l_c (rb_nevel_over_lc, from wedge_failure) with fracture.piece_size "nevel", C_l l_c with
 // "empirical". The speed correction (1 + C_v v_n) multiplies it where the approach speed is known (the fracture step).
 double static_piece_rb_m(const FractureOptions& o, double rb_nevel_over_lc, double lc_m);
 
-// The wedge angle drawn for a floe at a step: uniform in fracture.wedge_angle_deg (radians), from a hash.
-double wedge_angle_rad(const FractureOptions& o, int floe_id, long step);
+// The wedge angle drawn for a floe at a step: uniform in fracture.wedge_angle_deg (radians), from a hash of the seed,
+// the floe, the step and the attempt (a cut that would leave a chip is drawn again; attempt 0 is the first draw).
+double wedge_angle_rad(const FractureOptions& o, int floe_id, long step, int attempt = 0);
 
 }  // namespace floesim::sim

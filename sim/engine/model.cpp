@@ -5,6 +5,7 @@
 #include <fstream>
 #include <numeric>
 #include <sstream>
+#include <Eigen/Eigenvalues>
 
 #include "pipeline/error.h"
 #include "sim/engine/forces.h"
@@ -281,8 +282,17 @@ void set_added_mass(Body& b, const Vec3& added_mass, const Vec3& added_inertia) 
 
 }  // namespace
 
+bool is_brash(const Polygon& outline, double thickness_m, double min_area_m2) {
+  const double area = signed_area(outline);
+  if (area < min_area_m2) return true;
+  double perimeter = 0;
+  for (size_t i = 0; i < outline.size(); ++i) perimeter += (outline[(i + 1) % outline.size()] - outline[i]).norm();
+  return 4 * area / perimeter < thickness_m;
+}
+
 void hold_fixed(Body& b) {
   b.fixed = true;
+  b.brash = false;
   b.inv_mass = 0;
   b.inv_inertia = Mat3::Zero();
   b.inv_mass_added = Vec3::Zero();
@@ -298,6 +308,12 @@ Body make_floe_body(const Polygon& outline, double h, int id, int body_index, co
   b.kind = BodyKind::floe;
   b.id = id;
   b.thickness_m = h;
+  b.brash = o.fracture.brash == "rigid" && is_brash(outline, h, o.fracture.min_piece_area_m2);
+  if (b.brash) {
+    double perimeter = 0;
+    for (size_t i = 0; i < outline.size(); ++i) perimeter += (outline[(i + 1) % outline.size()] - outline[i]).norm();
+    b.brash_crush_force_n = o.ice.crushing_strength_pa * h * 4 * signed_area(outline) / perimeter;
+  }
   b.outline = outline;
   b.buoyancy_mesh = extrude_polygon(b.outline, -h / 2, h);
   // Second moments of the section (Green's theorem over the CCW outline, which is centred on its centroid).
@@ -316,6 +332,13 @@ Body make_floe_body(const Polygon& outline, double h, int id, int body_index, co
   b.mass_kg = rho_i * mp.volume;
   b.inv_mass = 1 / b.mass_kg;
   b.inertia = rho_i * mp.inertia;
+  if (b.brash) {
+    // A block is at least as hard to turn as a cube of side h (m h^2 / 6 about any axis): a needle cut beside an
+    // earlier crack would otherwise spin up on the smallest impulse (its inertia about z goes as its width^2).
+    Eigen::SelfAdjointEigenSolver<Mat3> eig(b.inertia);
+    const Vec3 l = eig.eigenvalues().cwiseMax(b.mass_kg * h * h / 6);
+    b.inertia = eig.eigenvectors() * l.asDiagonal() * eig.eigenvectors().transpose();
+  }
   b.inv_inertia = b.inertia.inverse();
   // Added mass of the floating thin plate (PHYSICS.md §3.3), only with water: heave along the floe's normal (body z),
   // roll and pitch about the body x and y axes; surge, sway and yaw none (a thin plate moving in its own plane).

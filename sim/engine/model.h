@@ -98,6 +98,14 @@ struct Body {
   // breaks wedges off it (bending and radial cracking; a sheet does not split in-plane). What is left of a tile
   // stays fixed; the wedges are free floes.
   bool fixed = false;
+  // Brash (fracture.brash "rigid"): a floe smaller than fracture.min_piece_area_m2 or narrower than it is thick
+  // (is_brash). A block, not a plate: its contacts are rigid (one manifold per part pair, no crushing rows; the seed's
+  // cheap small fragments, PHYSICS.md §1.7) and it never breaks; pressed on a plate it loads it as any piece does.
+  bool brash = false;
+  // Its rigid contacts' ceiling (brash only): the force that crushes the block's face, p_c h w, w its mean plan
+  // width 4 A / perimeter (Metrikin's rigid contact with an ice crushing constraint, PHYSICS.md §1.7). Without it a
+  // block squeezed between the hull and the sheet would take whatever impulse keeps them apart and spin off.
+  double brash_crush_force_n = 0;
 };
 
 // What the vessel model needs of the hull, computed from the mesh at the design waterline (z = 0).
@@ -168,10 +176,15 @@ Ittc57 ittc57_of(const VesselParticulars& v, const EngineSettings& o);
 Body make_floe_body(const Polygon& outline, double thickness_m, int id, int body_index, const Vec2& centre,
                     const EngineSettings& o, std::vector<ConvexPart>& parts);
 
+// Whether a floe's outline is brash rather than a plate: smaller than min_area_m2, or narrower than the ice is thick
+// (plan width 4 A / perimeter below h: a block, whose tiny inertia about its long axis the crushing rows of a plate
+// would only destabilise).
+bool is_brash(const Polygon& outline, double thickness_m, double min_area_m2);
+
 // A body the solver and the integrator never move: a domain wall or a tile of level ice.
 inline bool is_fixed_body(const Body& b) { return b.kind == BodyKind::wall || b.fixed; }
 
-// Makes a floe body a fixed tile of level ice: inverse masses and inertias 0 (Body::fixed).
+// Makes a floe body a fixed tile of level ice: inverse masses and inertias 0 (Body::fixed); a tile is never brash.
 void hold_fixed(Body& b);
 
 // Convex part from a closed convex triangle mesh (body frame): merges coplanar triangles into faces.

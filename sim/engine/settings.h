@@ -450,12 +450,15 @@ struct DomainOptions {
 // Material defaults are the seed's Table 1 (E = 5 GPa, nu = 0.3, K_IC = 150 kPa sqrt(m), sigma_f = 500 kPa).
 struct FractureOptions {
   bool enabled = true;
-  bool ice_ice = false;                      // also at floe-floe contacts (a floe jammed between bow and ice)
+  // Also at floe-floe contacts, level-ice tiles included: a piece pushed against or under the sheet's edge breaks it
+  // (PHYSICS.md §10.3 a), a floe jammed between bow and ice breaks.
+  bool ice_ice = true;
   double flexural_strength_pa = 5e5;         // sigma_f
   double youngs_modulus_pa = 5e9;            // E (effective, of the floating plate)
   double poisson_ratio = 0.3;                // nu
   double fracture_toughness_pa_sqrtm = 1.5e5;  // K_IC
   double splitting_coefficient = 2.0;        // C_s of F_split = C_s K_IC h sqrt(L) (§2.2: 2-3; §2.4's example: 2)
+  double splitting_coefficient_free = 2.5;   // C_s of the part reacted by the floe's inertia and drag (§2.2: higher)
   std::vector<double> wedge_angle_deg = {45.0, 90.0};  // theta drawn uniformly in [min, max] per event (§2.1)
   int seed = 1;                              // of the theta draws (a hash of seed, floe id and step: reproducible)
   // The broken piece's extent R_b beyond the load point (§2.1 step 3): "nevel", the static wedge's
@@ -465,14 +468,22 @@ struct FractureOptions {
   double piece_c_l = 1.0 / 6;                // C_l of the empirical R_b = C_l l_c (§2.1: ~1/6)
   bool speed_correction = false;             // R_b x (1 + C_v v_n) (§2.1, velocity effects), either piece size
   double speed_coefficient_spm = -0.1;       // C_v, s/m
-  double min_piece_area_m2 = 1.0;            // smaller pieces become brash: removed, their mass counted
-  // A bending wedge that would be brash: "brash" (removed, its mass counted) or "enlarge" (its R_b grown until it
-  // is the smallest piece the simulation keeps: no ice is deleted, and the ice it stands for is still pushed under).
+  // The load a failure test reads: the pair's contact force averaged over the last load_window_s of contact (a box
+  // mean of whole steps; §2.5), so that it does not depend on where the relax pass stopped. 0: this step's force.
+  double load_window_s = 0.05;
+  double min_piece_area_m2 = 1.0;            // smaller pieces (and slivers) are brash
+  // Brash: "rigid" (kept: bodies with rigid contacts, no crushing rows and no fracture; SAMS's small fragments,
+  // §1.7) or "removed" (deleted, its mass counted: the model before issue #33, kept for comparison).
+  std::string brash = "rigid";
+  // A bending wedge that would be brash: "brash" (cut as is: a brash piece) or "enlarge" (its R_b grown until it
+  // is the smallest piece that is not brash).
   std::string small_wedge = "brash";
   template <class V>
   void visit(V& v) {
     v.field("enabled", enabled, "-", "floes break (bending, radial cracking, splitting); false: they only crush");
-    v.field("ice_ice", ice_ice, "-", "fracture at floe-floe contacts too (default: only at the vessel)");
+    v.field("ice_ice", ice_ice, "-",
+            "fracture at floe-floe contacts too: floes break against floes and pieces pushed against or under a level "
+            "ice sheet break its edge (false: only at the vessel)");
     v.field("flexural_strength_pa", flexural_strength_pa, "Pa", "flexural strength sigma_f (bending, radial cracks)",
             positive());
     v.field("youngs_modulus_pa", youngs_modulus_pa, "Pa", "effective Young's modulus E of the ice plate (l_c)",
@@ -481,7 +492,11 @@ struct FractureOptions {
     v.field("fracture_toughness_pa_sqrtm", fracture_toughness_pa_sqrtm, "Pa m^0.5",
             "apparent fracture toughness K_IC (splitting)", positive());
     v.field("splitting_coefficient", splitting_coefficient, "-",
-            "C_s of the splitting load C_s K_IC h sqrt(L), L the chord along the force line", positive());
+            "C_s of the splitting load C_s K_IC h sqrt(L), L the chord along the force line, for the part of the push "
+            "the floe's other contacts press back (diametral)", positive());
+    v.field("splitting_coefficient_free", splitting_coefficient_free, "-",
+            "C_s for the part of the push the floe's inertia and the water's drag take (a free floe: lower tension, a "
+            "higher C_s; PHYSICS.md 2.2)", positive());
     v.field("wedge_angle_deg", wedge_angle_deg, "deg",
             "[min, max] of the wedge angle theta between the two radial cracks, drawn per event; inside (0, 180)",
             Check<std::vector<double>>([](const std::vector<double>& a) -> std::string {
@@ -504,13 +519,20 @@ struct FractureOptions {
             "piece_size");
     v.field("speed_coefficient_spm", speed_coefficient_spm, "s/m", "C_v of the speed correction (< 0: smaller pieces)",
             in_range(-10, 0));
+    v.field("load_window_s", load_window_s, "s",
+            "the failure tests read the contact force of a body pair averaged over this much of its contact (whole "
+            "steps; 0: the step's own force), so that fracture does not depend on where the solver stopped",
+            in_range(0, 1));
     v.field("min_piece_area_m2", min_piece_area_m2, "m^2",
-            "pieces smaller than this are brash: removed from the simulation, their mass counted in the summary",
-            non_negative());
+            "pieces smaller than this, or narrower than the ice is thick, are brash (see brash)", non_negative());
+    v.field("brash", brash, "-",
+            "what becomes of brash: \"rigid\" (kept as bodies with rigid contacts: no crushing rows, never broken; "
+            "their load on the vessel is the rigid part) or \"removed\" (deleted, its mass counted in the summary)",
+            one_of({"rigid", "removed"}));
     v.field("small_wedge", small_wedge, "-",
             "a bending wedge that would be brash (below min_piece_area_m2 or narrower than the ice is thick): "
-            "\"brash\" (removed, its mass counted) or \"enlarge\" (R_b grown to the smallest wedge that is not brash, "
-            "so that no broken ice is deleted)",
+            "\"brash\" (cut as it is: a brash piece) or \"enlarge\" (R_b grown to the smallest wedge that is not "
+            "brash)",
             one_of({"brash", "enlarge"}));
   }
 };

@@ -84,6 +84,15 @@ struct CachedContact {
   Vec3 crush_normal_a, crush_point_a, crush_point_b;
 };
 
+// The recent contact force of one body pair on a floe, for the failure tests (fracture.load_window_s): the last
+// steps' forces in a ring (zero for a step without contact), where the load acted last (world; a level-ice tile
+// has one load per patch of contact, told apart by this point).
+struct PairLoadHistory {
+  int floe = -1, other = -1;
+  Vec3 point = Vec3::Zero();
+  std::vector<Vec3> force;  // ring of the window's steps, force[step % size] this step's
+};
+
 struct State {
   double time_s = 0;
   long step = 0;
@@ -99,6 +108,7 @@ struct State {
   std::vector<double> heave_lowpass_mps;  // forces: heave velocity through the radiation filter's low pass
                                           // (heave_radiation_force); 0 while asleep, a piece takes its parent's
   std::vector<CachedContact> contact_cache;  // sorted by (body_a, body_b, part_a, part_b)
+  std::vector<PairLoadHistory> pair_loads;   // the fracture stage's, sorted by (floe, other), then as made
   // Vessel controllers.
   double speed_error_integral = 0;      // m, integral of the speed error (PI thrust controller)
   double heading_ref_rad = 0;           // course held by the autopilot

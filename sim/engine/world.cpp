@@ -367,7 +367,7 @@ int World::vessel_ice_load(const std::vector<Contact>& contacts, Wrench* rigid, 
 }
 
 void World::stage_fracture() {
-  std::vector<FractureCut> cuts = find_fractures(model_, state_, contacts_, model_.settings.time_step_s);
+  std::vector<FractureCut> cuts = find_fractures(model_, state_, contacts_, model_.settings.time_step_s, &state_.pair_loads);
   for (FractureCut& c : cuts) apply_fracture(c);
   report_.fracture_events = static_cast<int>(cuts.size());
 }
@@ -397,7 +397,7 @@ void World::apply_fracture(FractureCut& cut) {
   const Vec3 x = state_.position[parent], v = state_.velocity[parent], w = state_.angular_velocity[parent];
   const Quat q = state_.orientation[parent];
   const Mat3 R = q.toRotationMatrix();
-  const double min_area = model_.settings.fracture.min_piece_area_m2;
+  const FractureOptions& fo = model_.settings.fracture;
   const double rho_i = model_.settings.ice.density_kg_m3, h = parent_body.thickness_m;
   FractureEvent& e = cut.event;
   // The floe leaves: no longer alive, awake or in the broad phase. Its contacts of this step stay in contacts_
@@ -410,11 +410,14 @@ void World::apply_fracture(FractureCut& cut) {
   const int first_new = static_cast<int>(model_.bodies.size());
   for (size_t k = 0; k < cut.pieces.size(); ++k) {
     const Polygon& piece = cut.pieces[k];
-    // Level ice: the wedge breaks free; what is left of the tile is still held by the sheet around it.
-    const bool fixed = parent_body.fixed && static_cast<int>(k) >= cut.wedge_pieces;
-    if (is_brash(piece, h, min_area)) {
-      // Brash (below the minimum area, or a sliver narrower than the ice is thick): a block, not a plate, that
-      // would only add tiny masses and inertias to the solver's chains under the hull. Removed; its mass counted.
+    // Level ice: the wedge breaks free; what is left of the tile is still held by the sheet around it, unless it is
+    // brash (a block left between cracks is loose ice, not sheet: held, it would stand in the hull's way as an
+    // immovable block that no crack can cut any smaller).
+    const bool fixed = parent_body.fixed && static_cast<int>(k) >= cut.wedge_pieces &&
+                       !is_brash(piece, h, fo.min_piece_area_m2);
+    if (fo.brash == "removed" && is_brash(piece, h, fo.min_piece_area_m2)) {
+      // fracture.brash "removed": brash leaves the simulation, its mass counted. (With "rigid" it stays: a body
+      // with rigid contacts, make_floe_body's Body::brash.)
       e.brash_mass_kg += rho_i * signed_area(piece) * h;
       continue;
     }
@@ -442,6 +445,13 @@ void World::apply_fracture(FractureCut& cut) {
     state_.orientation[index] = q;
     state_.velocity[index] = v + w.cross(r);
     state_.angular_velocity[index] = w;
+    const Body& made = model_.bodies[index];
+    if (made.brash) {
+      // Brash turns as a block (its inertia floored, make_floe_body): its spin is set so that it carries the
+      // angular momentum of the ice it is, I_true w (the event keeps angular momentum exactly).
+      const Mat3 true_inertia = rho_i * mass_properties(made.buoyancy_mesh).inertia;
+      state_.angular_velocity[index] = R * made.inertia.inverse() * true_inertia * R.transpose() * w;
+    }
     // The water under the piece has the parent's heave history: the radiation filter carries on from the parent's
     // (starting it at 0 would give the piece a jolt of -G v_z at its birth).
     state_.heave_lowpass_mps[index] = state_.heave_lowpass_mps[parent];
@@ -627,6 +637,13 @@ void World::save(ByteWriter& w) const {
     w.mat(c.crush_point_a);
     w.mat(c.crush_point_b);
   }
+  w.size(s.pair_loads.size());
+  for (const PairLoadHistory& l : s.pair_loads) {
+    w.pod<int32_t>(l.floe);
+    w.pod<int32_t>(l.other);
+    w.mat(l.point);
+    put_vec3s(w, l.force);
+  }
   w.pod(s.speed_error_integral);
   w.pod(s.heading_ref_rad);
   // 3. What else carries over: mass matrices as the solver saw them, jets, the fracture record, moved bodies.
@@ -762,6 +779,16 @@ std::unique_ptr<World> World::restore(const Model& base, ByteReader& r) {
                         static_cast<size_t>(c.body_b) < n && c.part_a >= 0 && c.part_b >= 0 &&
                         static_cast<size_t>(c.part_a) < parts && static_cast<size_t>(c.part_b) < parts,
                     r.what(), ": damaged (a cached contact names a body or part that does not exist)");
+  }
+  s.pair_loads.resize(r.size(1));
+  for (PairLoadHistory& l : s.pair_loads) {
+    l.floe = r.pod<int32_t>();
+    l.other = r.pod<int32_t>();
+    r.mat(l.point);
+    get_vec3s(r, l.force);
+    FLOESIM_REQUIRE(l.floe >= 0 && l.other >= 0 && static_cast<size_t>(l.floe) < n &&
+                        static_cast<size_t>(l.other) < n && !l.force.empty(),
+                    r.what(), ": damaged (a fracture load history names a body that does not exist)");
   }
   s.speed_error_integral = r.pod<double>();
   s.heading_ref_rad = r.pod<double>();

@@ -46,8 +46,11 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
                  {"splitting", count[kFractureSplitting]}, {"total", r.fracture_mode.size()},
                  {"at_vessel", at_vessel}};
   std::map<int32_t, double> area, thickness;  // by floe id
-  double start = 0, end = 0, brash = 0;
-  std::vector<double> piece_area, piece_diameter;
+  std::map<int32_t, bool> tile;                // by floe id: a level ice tile
+  double start = 0, end = 0, brash = 0, brash_kept = 0;
+  int brash_bodies = 0;
+  std::vector<double> piece_area, piece_diameter, piece_over_lc;
+  const double rho_w_g_pieces = o.water.density_kg_m3 * o.water.gravity_mps2;
   for (size_t k = 0; k < r.floe_id.size(); ++k) {
     Polygon p;
     for (int64_t i = r.floe_vertex_offset[k]; i < r.floe_vertex_offset[k + 1]; ++i)
@@ -56,14 +59,30 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
     area[r.floe_id[k]] = a;
     thickness[r.floe_id[k]] = r.floe_thickness_m[k];
     if (r.floe_parent_id[k] < 0) start += m;
-    if (std::isinf(r.floe_ended_s[k])) end += m;
-    // Pieces: the floes fracture made (a wedge off a level ice tile is one; what the tile keeps is still sheet).
     const bool sheet = !r.floe_level_ice.empty() && r.floe_level_ice[k];
+    tile[r.floe_id[k]] = sheet;
+    if (std::isinf(r.floe_ended_s[k])) {
+      end += m;
+      if (!sheet && o.fracture.brash == "rigid" && is_brash(p, r.floe_thickness_m[k], o.fracture.min_piece_area_m2)) {
+        ++brash_bodies;
+        brash_kept += m;
+      }
+    }
+    // Pieces: the floes fracture made (a wedge off a level ice tile is one; what the tile keeps is still sheet).
     if (r.floe_parent_id[k] >= 0 && !sheet) {
       piece_area.push_back(a);
       piece_diameter.push_back(std::sqrt(4 * a / kPi));
+      if (rho_w_g_pieces > 0)
+        piece_over_lc.push_back(std::sqrt(a) / characteristic_length_m(o.fracture.youngs_modulus_pa,
+                                                                      o.fracture.poisson_ratio,
+                                                                      r.floe_thickness_m[k], rho_w_g_pieces));
     }
   }
+  // Events on the sheet not at the vessel: its edge yielding to the ice pressed against or under it (§10).
+  int sheet_edge = 0;
+  for (size_t e = 0; e < r.fracture_mode.size(); ++e)
+    if (!r.fracture_at_structure[e] && tile[r.fracture_parent_id[e]]) ++sheet_edge;
+  f["events"]["sheet_edge_by_ice"] = sheet_edge;
   for (double b : r.fracture_brash_mass_kg) brash += b;
   f["pieces_created"] = piece_area.size();
   f["ice_mass_start_kg"] = start;
@@ -71,8 +90,11 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
   f["ice_mass_in_bodies_end_kg"] = end;
   f["brash_removed_kg"] = brash;
   f["min_piece_area_m2"] = o.fracture.min_piece_area_m2;
+  f["brash"] = {{"mode", o.fracture.brash}, {"bodies_at_end", brash_bodies}, {"mass_at_end_kg", brash_kept}};
   f["piece_area_m2"] = distribution(piece_area);
   f["piece_equivalent_diameter_m"] = distribution(piece_diameter);
+  // sqrt(area) / l_c of the pieces, against the cusps icebreakers leave (0.1-0.3 l_c, PHYSICS.md §2.1).
+  f["piece_size_over_lc"] = distribution(piece_over_lc);
   // Wedges: R_b of fracture.piece_size for each event's theta and width (static: without the speed correction),
   // against the smallest child of the event (the wedge: the floe it broke from is longer than the wedge by the
   // finite-floe rule, so the remainder is the larger piece). An event with one child and brash removed lost its
@@ -334,6 +356,44 @@ nlohmann::json summarize(const SimulateOptions& o, const Model& model, const Res
       m /= static_cast<double>(ma.size());
       for (double x : ma) v2 += (x - m) * (x - m);
       j["std_N"] = std::sqrt(v2 / static_cast<double>(ma.size()));  // spread of the filtered signal
+    }
+    windows.push_back(j);
+  }
+  {
+    // §5 for a run of both laws: each part over its own window (rigid 20 s, compliant 0.5 s), then summed; whole
+    // 20 s windows only.
+    std::vector<double> rigid, compliant;
+    {
+      const std::vector<double> x = series.get("ice_load_rigid");
+      for (size_t i = first; i < steps; ++i) rigid.push_back(x[6 * i]);
+    }
+    {
+      const std::vector<double> x = series.get("ice_load_compliant");
+      for (size_t i = first; i < steps; ++i) compliant.push_back(x[6 * i]);
+    }
+    const size_t nr = static_cast<size_t>(std::lround(kRigidWindowS / o.time_step_s));
+    const size_t nc = static_cast<size_t>(std::lround(kCompliantWindowS / o.time_step_s));
+    const std::vector<double> a = moving_average_centred(rigid, nr), b = moving_average_centred(compliant, nc);
+    const auto [f0, f1] = full_window_range(rigid.size(), nr);
+    nlohmann::json j = {{"window_s", kRigidWindowS},
+                        {"compliant_window_s", kCompliantWindowS},
+                        {"kind", "rigid part over 20 s + compliant part over 0.5 s, summed"},
+                        {"applies", model_kind == "mixed"}};
+    if (f0 >= f1) {
+      j["note"] = "the steady part is shorter than the window";
+      for (const char* k : {"max_N", "min_N", "max_resistance_N", "std_N"}) j[k] = nullptr;
+    } else {
+      double lo = 1e300, hi = -1e300, m = 0, v2 = 0;
+      for (size_t i = f0; i < f1; ++i) {
+        const double y = a[i] + b[i];
+        lo = std::min(lo, y), hi = std::max(hi, y), m += y;
+      }
+      m /= static_cast<double>(f1 - f0);
+      for (size_t i = f0; i < f1; ++i) v2 += (a[i] + b[i] - m) * (a[i] + b[i] - m);
+      j["max_N"] = hi;
+      j["min_N"] = lo;
+      j["max_resistance_N"] = -lo;
+      j["std_N"] = std::sqrt(v2 / static_cast<double>(f1 - f0));
     }
     windows.push_back(j);
   }

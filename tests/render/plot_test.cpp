@@ -89,6 +89,35 @@ TEST(Plot, WritesPngSvgCsvAndTheSteadyMean) {
   fs::remove_all(dir);
 }
 
+TEST(Plot, AutoFiltersTheRigidPartOverTwentySecondsAndTheCompliantPartOverHalfASecond) {
+  // PHYSICS.md §5 for a run of both laws: each part filtered over its own window, then summed. A 60 s run (1200
+  // steps of 0.05 s): the compliant part a constant 300 kN, the rigid part one spike of 2000 kN every 100th step
+  // (impulses of brash). A 20 s window holds exactly 4 spikes wherever it lies, so the filtered load is
+  // 300 + 4 x 2000 / 400 = 320 kN at every sample of a whole window; a 0.5 s window of the whole load would show
+  // the spikes as 300 + 2000 / 10 = 500 kN.
+  Synthetic syn = default_synthetic();
+  syn.steps = 1200;
+  Results r = make_results(syn);
+  r.attributes["contact_model"] = "mixed";
+  std::vector<double>& load = r.series["ice_load"];
+  std::vector<double>& rigid = r.series["ice_load_rigid"];
+  std::vector<double>& compliant = r.series["ice_load_compliant"];
+  for (size_t k = 0; k < load.size() / 6; ++k) {
+    rigid[6 * k] = k % 100 == 50 ? -2000e3 : 0.0;
+    compliant[6 * k] = -300e3;
+    load[6 * k] = rigid[6 * k] + compliant[6 * k];
+  }
+  const fs::path dir = fresh_dir("plot_mixed");
+  write_results(dir / "results.h5", r);
+  const SurgeLoadSummary s = plot_surge_load(dir / "results.h5", write_config(dir, "{}"), dir / "a");
+  EXPECT_DOUBLE_EQ(s.window_s, 20.0);
+  EXPECT_TRUE(s.moving_average_complete);
+  EXPECT_NEAR(s.moving_average_max_kN, 320.0, 1e-6);
+  EXPECT_NEAR(s.moving_average_std_kN, 0.0, 1e-6);
+  EXPECT_NE(s.filter.find("rigid part over 20 s + compliant part over 0.5 s"), std::string::npos) << s.filter;
+  fs::remove_all(dir);
+}
+
 TEST(Plot, AutoWindowIsTwentySecondsForRigidOrUnknownContactsAndOptionsOverride) {
   const fs::path dir = fresh_dir("plot_auto");
   write_results(dir / "results.h5", make_results(default_synthetic()));  // no contact_model, no steady_start_s

@@ -34,6 +34,7 @@ struct Rig {
       : Rig(floes, theta_deg, testing::floe_options()) {}
   Rig(const std::vector<Floe>& floes, double theta_deg, SimulateOptions o) {
     o.fracture.wedge_angle_deg = {theta_deg, theta_deg};
+    o.fracture.load_window_s = 0;  // the criteria on one step's hand-made force
     o.vessel.x_m = -5000;  // the hull is only a structure body for hand-made contacts
     FloeField f;
     f.floes = floes;
@@ -41,6 +42,12 @@ struct Rig {
     model = build_model(f, &hull, o);
   }
 };
+
+// The fractures one step of hand-made contacts decides, from no load history.
+std::vector<FractureCut> decide(const World& world, const std::vector<Contact>& contacts, double dt) {
+  std::vector<PairLoadHistory> history;
+  return find_fractures(world.model(), world.state(), contacts, dt, &history);
+}
 
 // A contact of the structure (body 0) on floe body 1 at `point`, pushing along `normal` (into the floe) with force
 // `force_n` (normal impulse x dt), over a width `width` across the normal.
@@ -55,6 +62,13 @@ Contact pushing_contact(const Vec3& point, const Vec3& normal, double force_n, d
   c.span_lo = point - 0.5 * width * t;
   c.span_hi = point + 0.5 * width * t;
   c.type = ContactType::crushing;
+  return c;
+}
+
+// The reaction of floe body 2 on floe body 1 at `point`: `force_n` along -x (pressing floe 1 back), over `width`.
+Contact reaction_contact(const Vec3& point, double force_n, double width, double dt) {
+  Contact c = pushing_contact(point, -Vec3::UnitX(), force_n, width, dt);
+  c.body_a = 2;
   return c;
 }
 
@@ -80,8 +94,8 @@ TEST(Fracture, WedgeBreaksAtTheTableLoadAndExtendsRbIntoTheIce) {
   const Vec3 p(0.05, 0, 0);  // just inside the west edge (body 1's centre is at (100, 0))
   // F_V = F cos(30): below the table load by 5 %: nothing; above it by 5 %: a wedge breaks off.
   const double f_below = 0.95 * fail / std::cos(kPi / 6), f_above = 1.05 * fail / std::cos(kPi / 6);
-  EXPECT_TRUE(find_fractures(world.model(), world.state(), {pushing_contact(p, n, f_below, w, dt)}, dt).empty());
-  const auto cuts = find_fractures(world.model(), world.state(), {pushing_contact(p, n, f_above, w, dt)}, dt);
+  EXPECT_TRUE(decide(world, {pushing_contact(p, n, f_below, w, dt)}, dt).empty());
+  const auto cuts = decide(world, {pushing_contact(p, n, f_above, w, dt)}, dt);
   ASSERT_EQ(cuts.size(), 1u);
   const FractureEvent& e = cuts[0].event;
   EXPECT_EQ(e.mode, kFractureBending);
@@ -126,8 +140,7 @@ TEST(Fracture, EmpiricalPieceReachesClLcTimesTheSpeedFactorBeyondTheLoad) {
     world.mutable_state().velocity[0] = Vec3(speed, 0, 0);
     const double vn = speed * std::sin(kPi / 6);
     const double rb = lc / 6 * (1 - 0.1 * vn);
-    const auto cuts = find_fractures(
-        world.model(), world.state(), {pushing_contact(p, sloped_normal(30), 1.05 * fail / std::cos(kPi / 6), w, dt)},
+    const auto cuts = decide(world, {pushing_contact(p, sloped_normal(30), 1.05 * fail / std::cos(kPi / 6), w, dt)},
         dt);
     ASSERT_EQ(cuts.size(), 1u) << speed;
     const FractureEvent& e = cuts[0].event;
@@ -169,8 +182,7 @@ TEST(Fracture, ASmallWedgeIsBrashOrEnlargedToTheSmallestPieceKept) {
     const double dt = rig.model.settings.time_step_s;
     // 50 kN through the 30 deg face: F_V = 43 kN, above the wedge's ~10 kN; F_H = 25 kN, far below splitting the
     // 200 m floe (2 K_IC h sqrt(200 m) = 1.3 MN).
-    const auto cuts = find_fractures(world.model(), world.state(),
-                                     {pushing_contact(Vec3(0.05, 0, 0), sloped_normal(30), 5e4, w, dt)}, dt);
+    const auto cuts = decide(world, {pushing_contact(Vec3(0.05, 0, 0), sloped_normal(30), 5e4, w, dt)}, dt);
     ASSERT_EQ(cuts.size(), 1u) << mode;
     ASSERT_EQ(cuts[0].wedge_pieces, 1) << mode;
     ASSERT_EQ(cuts[0].pieces.size(), 2u) << mode;
@@ -189,16 +201,17 @@ TEST(Fracture, SplittingLoadScalesAsKicHSqrtL) {
   // along the force is L, so F_split = C_s K_IC h sqrt(L) (C_s = 2, K_IC = 150 kPa sqrt(m)).
   for (double h : {0.5, 1.5})
     for (double L : {10.0, 40.0, 160.0}) {
-      Rig rig({rect_floe(1, 0, -L / 2, L, L, h)});
+      // Floe 2 east of it (1 km long: it does not split itself) holds it: the push is pressed against a reaction (PHYSICS.md §2.2).
+      Rig rig({rect_floe(1, 0, -L / 2, L, L, h), rect_floe(2, L, -L / 2, 1000, L, h)});
       World world(rig.model);
       const double dt = rig.model.settings.time_step_s;
       const double expected = 2.0 * 1.5e5 * h * std::sqrt(L);
-      const Vec3 p(0.01, 0, 0);
-      const auto none = find_fractures(world.model(), world.state(),
-                                       {pushing_contact(p, Vec3::UnitX(), 0.95 * expected, h, dt)}, dt);
+      const Vec3 p(0.01, 0, 0), q(L - 0.01, 0, 0);
+      const auto none = decide(world, {pushing_contact(p, Vec3::UnitX(), 0.95 * expected, h, dt),
+                                       reaction_contact(q, 0.95 * expected, h, dt)}, dt);
       EXPECT_TRUE(none.empty()) << "L " << L << " h " << h;
-      const auto cuts = find_fractures(world.model(), world.state(),
-                                       {pushing_contact(p, Vec3::UnitX(), 1.05 * expected, h, dt)}, dt);
+      const auto cuts = decide(world, {pushing_contact(p, Vec3::UnitX(), 1.05 * expected, h, dt),
+                                       reaction_contact(q, 1.05 * expected, h, dt)}, dt);
       ASSERT_EQ(cuts.size(), 1u) << "L " << L << " h " << h;
       EXPECT_EQ(cuts[0].event.mode, kFractureSplitting);
       EXPECT_NEAR(cuts[0].event.threshold_n, expected, 0.05 * expected) << "L " << L << " h " << h;
@@ -208,12 +221,42 @@ TEST(Fracture, SplittingLoadScalesAsKicHSqrtL) {
     }
 }
 
-TEST(Fracture, VerticalFaceNeverBendsASlopedFaceBendsBeforeSplitting) {
-  const double h = 1.0;
-  Rig rig({rect_floe(1, 0, -100, 200, 200, h)});
+TEST(Fracture, APushReactedByInertiaAndDragSplitsAFloeAtTheFreeFloeLoad) {
+  // PHYSICS.md §2.2: the push F is reacted by the floe's other contacts (F_c, diametral: C_s = 2) and by its inertia
+  // and the water's drag (F - F_c: C_s,free = 2.5). A 40 m floe, 1 m thick: C_s K_IC h sqrt(L) = 1.897 MN diametral,
+  // 2.372 MN free. Pushed alone (through open water, at any speed: the push is all inertia and drag) it holds at
+  // 0.95 x 2.372 MN and splits at 1.05 x. Pushed with 2 MN held by floe 2 with 1.3 MN: 1.3 / 1.897 + 0.7 / 2.372 =
+  // 0.980, it holds; held with 1.7 MN: 1.7 / 1.897 + 0.3 / 2.372 = 1.022, it splits.
+  const double h = 1.0, L = 40.0, k = 1.5e5 * h * std::sqrt(L), reacted = 2 * k, free = 2.5 * k;
+  SimulateOptions o = testing::floe_options();
+  o.fracture.splitting_coefficient = 2.0;
+  o.fracture.splitting_coefficient_free = 2.5;
+  Rig rig({rect_floe(1, 0, -L / 2, L, L, h), rect_floe(2, L, -L / 2, 1000, L, h)}, 60, o);
   World world(rig.model);
   const double dt = rig.model.settings.time_step_s;
-  const Vec3 p(0.05, 0, 0);
+  const Vec3 p(0.01, 0, 0), q(L - 0.01, 0, 0);
+  EXPECT_TRUE(decide(world, {pushing_contact(p, Vec3::UnitX(), 0.95 * free, h, dt)}, dt).empty());
+  const auto alone = decide(world, {pushing_contact(p, Vec3::UnitX(), 1.05 * free, h, dt)}, dt);
+  ASSERT_EQ(alone.size(), 1u);
+  EXPECT_EQ(alone[0].event.mode, kFractureSplitting);
+  EXPECT_NEAR(alone[0].event.threshold_n, free, 0.05 * free);
+  EXPECT_TRUE(decide(world, {pushing_contact(p, Vec3::UnitX(), 2e6, h, dt), reaction_contact(q, 1.3e6, h, dt)}, dt)
+                  .empty());
+  const auto held =
+      decide(world, {pushing_contact(p, Vec3::UnitX(), 2e6, h, dt), reaction_contact(q, 1.7e6, h, dt)}, dt);
+  ASSERT_EQ(held.size(), 1u);
+  EXPECT_EQ(held[0].body, 1);
+  EXPECT_EQ(held[0].event.mode, kFractureSplitting);
+  EXPECT_GT(1.7 / (reacted / 1e6) + 0.3 / (free / 1e6), 1.0);  // the hand sums above
+  EXPECT_LT(1.3 / (reacted / 1e6) + 0.7 / (free / 1e6), 1.0);
+}
+
+TEST(Fracture, VerticalFaceNeverBendsASlopedFaceBendsBeforeSplitting) {
+  const double h = 1.0;
+  Rig rig({rect_floe(1, 0, -100, 200, 200, h), rect_floe(2, 200, -100, 1000, 200, h)});
+  World world(rig.model);
+  const double dt = rig.model.settings.time_step_s;
+  const Vec3 p(0.05, 0, 0), q(199.95, 0, 0);  // floe 2 holds floe 1 at its east edge
   // §2.4: F_V/F_H = (cos b - mu sin b) / (sin b + mu cos b) on the ice; at 90 deg with mu = 0.1 it is -0.10: the
   // face lifts the ice, never bends it down. Built from its normal and a friction force mu F_n upward on the ice.
   auto face_force = [](double beta_deg, double mu) {
@@ -230,7 +273,7 @@ TEST(Fracture, VerticalFaceNeverBendsASlopedFaceBendsBeforeSplitting) {
     c.t1 = Vec3::UnitZ();
     c.pn = 10e6 * dt * f90.x() / f90.norm();
     c.pt1 = 10e6 * dt * f90.z() / f90.norm();
-    const auto cuts = find_fractures(world.model(), world.state(), {c}, dt);
+    const auto cuts = decide(world, {c, reaction_contact(q, 10e6, h, dt)}, dt);
     ASSERT_EQ(cuts.size(), 1u);
     EXPECT_EQ(cuts[0].event.mode, kFractureSplitting);
   }
@@ -242,7 +285,7 @@ TEST(Fracture, VerticalFaceNeverBendsASlopedFaceBendsBeforeSplitting) {
     Contact c = pushing_contact(p, Vec3::UnitX(), 1.0, h, dt);
     c.normal = f30.normalized();
     c.pn = mag * dt;
-    const auto cuts = find_fractures(world.model(), world.state(), {c}, dt);
+    const auto cuts = decide(world, {c, reaction_contact(q, mag, h, dt)}, dt);
     if (cuts.empty()) continue;
     EXPECT_NE(cuts[0].event.mode, kFractureSplitting) << "at " << mag << " N";
     break;
@@ -407,6 +450,97 @@ TEST(Fracture, ResultsAreByteIdenticalOnRerunAndAcrossThreads) {
   EXPECT_EQ(bytes[0], bytes[2]);
 }
 
+// PHYSICS.md §10.2's worked example: a 0.5 m sheet (E 5 GPa, nu 0.3, sigma_f 0.5 MPa: l_c = 8.686 m) and a
+// 5 m x 5 m x 0.5 m piece, contact width 1 m, mu_ii 0.15. The sheet is one tile of level ice east of x = 0; the
+// piece (body 1) lies west of it. `theta_deg` fixes the wedge angle.
+struct SheetRig {
+  Model model;
+  int tile = -1;
+  explicit SheetRig(double theta_deg) {
+    SimulateOptions o = testing::floe_options();
+    o.fracture.wedge_angle_deg = {theta_deg, theta_deg};
+    o.fracture.load_window_s = 0;
+    o.ice.mu_ice_ice = 0.15;
+    o.vessel.x_m = -5000;
+    o.level_ice.extent_m = {0, -50, 100, 50};
+    o.level_ice.tile_m = 100;
+    o.level_ice.thickness_m = 0.5;
+    FloeField f;
+    f.floes = {rect_floe(1, -10, -2.5, 5, 5, 0.5)};
+    const HullModel hull = coarse_hull();
+    model = build_model(f, &hull, o);
+    for (size_t b = 0; b < model.bodies.size(); ++b)
+      if (model.bodies[b].fixed) tile = static_cast<int>(b);
+  }
+  // A contact of the piece on the tile at `point`, force `normal_n` along `normal` (on the tile) and `friction_n`
+  // along `t1`, over a width of 1 m along y.
+  Contact contact(const Vec3& point, const Vec3& normal, double normal_n, const Vec3& t1, double friction_n,
+                  double dt) const {
+    Contact c;
+    c.body_a = 1;
+    c.body_b = tile;
+    c.point = point;
+    c.normal = normal;
+    c.t1 = t1;
+    c.pn = normal_n * dt;
+    c.pt1 = friction_n * dt;
+    c.span_lo = point - 0.5 * Vec3::UnitY();
+    c.span_hi = point + 0.5 * Vec3::UnitY();
+    c.type = ContactType::crushing;
+    return c;
+  }
+};
+
+TEST(SheetEdge, APiecePushedThroughAnInclinedFaceBreaksTheEdgeAtTheBriefsHorizontalLoad) {
+  // §10.2: F_V / F_H = (cos b - mu sin b) / (sin b + mu cos b) = 1.839 at 20 deg and 0.739 at 45 deg, and the edge
+  // cracks at P_r = sigma_f h^2 / C_r(w / l_c) = 23.8 kN, so F_H = 12.9 kN at 20 deg and 32.2 kN at 45 deg. The brief's
+  // figures are the radial-crack load; with theta = 45 deg the wedge's P_f (Nevel's table at a / l_c = 0.147) is
+  // 23.8 kN too, so max(P_r, P_f) is the same load.
+  SheetRig rig(45);
+  ASSERT_GE(rig.tile, 0);
+  World world(rig.model);
+  const double dt = rig.model.settings.time_step_s, mu = 0.15;
+  for (const auto& [beta_deg, expected] : {std::pair{20.0, 12.9e3}, std::pair{45.0, 32.2e3}}) {
+    const double b = beta_deg * kPi / 180;
+    const Vec3 n(std::sin(b), 0, -std::cos(b));  // on the sheet: into it and down
+    const Vec3 up(std::cos(b), 0, std::sin(b));  // friction on the sheet as the piece slides down its face
+    double broke_at = 0;
+    for (double fh = 0.8 * expected; fh < 1.3 * expected; fh *= 1.005) {
+      const double fn = fh / (std::sin(b) + mu * std::cos(b));
+      if (!decide(world, {rig.contact(Vec3(0.05, 0, 0), n, fn, up, mu * fn, dt)}, dt).empty()) {
+        broke_at = fh;
+        break;
+      }
+    }
+    EXPECT_NEAR(broke_at, expected, 0.05 * expected) << beta_deg << " deg";
+  }
+}
+
+TEST(SheetEdge, OnePieceHeldUnderTheEdgeDoesNotBreakItTwoDo) {
+  // §10.2: a buoyant 5 x 5 x 0.5 m piece held under the edge presses up with (rho_w - rho_i) g V = 15.3 kN, below
+  // P_r = 23.8 kN; two stacked press 30.7 kN, above max(P_r, P_f) = 29.7 kN (theta = 60 deg): the edge breaks and
+  // a wedge of the sheet is cut out (it is free, the rest of the tile stays held). The load acts 0.3 m in from the
+  // edge on the sheet's flat bottom: the sheet bends at its free edge.
+  SheetRig rig(60);
+  World world(rig.model);
+  const double dt = rig.model.settings.time_step_s;
+  const double one = (1025.0 - 900.0) * 9.81 * 5 * 5 * 0.5;
+  EXPECT_NEAR(one, 15.3e3, 0.05e3);
+  const Vec3 at(0.3, 0, -0.25);
+  EXPECT_TRUE(decide(world, {rig.contact(at, Vec3::UnitZ(), one, Vec3::UnitX(), 0, dt)}, dt).empty());
+  const auto cuts = decide(world, {rig.contact(at, Vec3::UnitZ(), 2 * one, Vec3::UnitX(), 0, dt)}, dt);
+  ASSERT_EQ(cuts.size(), 1u);
+  EXPECT_EQ(cuts[0].body, rig.tile);
+  EXPECT_GE(cuts[0].wedge_pieces, 1);
+  EXPECT_FALSE(cuts[0].event.at_structure);
+  // The piece cut out reaches (xi* - alpha) l_c = 0.51 l_c into the sheet (§10.2: xi* = 0.62 at alpha = 0.110).
+  double reach = 0;
+  const Vec3 c = world.state().position[rig.tile];
+  for (int k = 0; k < cuts[0].wedge_pieces; ++k)
+    for (const Vec2& v : cuts[0].pieces[k]) reach = std::max(reach, v.x() + c.x());
+  EXPECT_NEAR(reach, (0.62 - 0.110) * 8.686, 0.1 * 0.51 * 8.686);
+}
+
 TEST(Fracture, BadOptionsNameTheKey) {
   const std::vector<std::pair<std::string, std::string>> bad = {
       {R"({"fracture": {"flexural_strength_pa": -1}})", "flexural_strength_pa"},
@@ -418,6 +552,10 @@ TEST(Fracture, BadOptionsNameTheKey) {
       {R"({"fracture": {"wedge_angle_deg": [45, 180]}})", "wedge_angle_deg"},
       {R"({"fracture": {"wedge_angle_deg": [90, 45]}})", "wedge_angle_deg"},
       {R"({"fracture": {"min_piece_area_m2": -1}})", "min_piece_area_m2"},
+      {R"({"fracture": {"brash": "deleted"}})", "brash"},
+      {R"({"fracture": {"splitting_coefficient_free": 0}})", "splitting_coefficient_free"},
+      {R"({"fracture": {"load_window_s": -0.01}})", "load_window_s"},
+      {R"({"fracture": {"load_window_s": "auto"}})", "load_window_s"},
       {R"({"fracture": {"piece_size": "wang"}})", "piece_size"},
       {R"({"fracture": {"piece_c_l": 0}})", "piece_c_l"},
       {R"({"fracture": {"piece_c_l": 2}})", "piece_c_l"},

@@ -240,6 +240,41 @@ TEST(SimTransit, MeanLoadIsTheMomentumGivenToTheIce) {
   EXPECT_LT(worst_speed, 1e-4);
 }
 
+// The same kinematic face meeting brash (issue #33): three blocks 0.8 m x 0.8 m x 1 m, narrower than thick and under
+// fracture.min_piece_area_m2, are bodies with rigid contacts (no crushing rows). Rigid contacts without restitution
+// leave each block moving with the face at U, so the mean surge ice load is again -M U / T (M = rho_i x 3 x 0.64 m^3
+// by hand), all of it recorded as the rigid part.
+TEST(SimTransit, BrashMeanLoadIsTheMomentumItIsGivenAndIsTheRigidPart) {
+  SimulateOptions o = testing::floe_options();
+  o.water.enabled = false;
+  o.water.gravity_mps2 = 0;
+  o.water.density_kg_m3 = 1e12;
+  o.vessel.x_m = 50;  // face at x = 52 m
+  o.vessel.initial_speed_mps = 2.0;
+  o.vessel.autopilot.enabled = false;
+  o.vessel.propulsion.mode = "constant_thrust";
+  o.vessel.propulsion.thrust_n = 0;
+  o.duration_s = 12;
+  o.steady_start_s = 0;
+  o.output_interval_s = 1.0;
+  FloeField field;
+  for (int i = 0; i < 3; ++i) field.floes.push_back(rect_floe(i + 1, 53.003 + 4 * i, -13 + 10 * i, 0.8, 0.8, 1.0));
+  const HullModel hull = box_hull(4, 30, -3, 6);
+  const Model m = build_model(field, &hull, o);
+  for (const Body& b : m.bodies)
+    if (b.kind == BodyKind::floe) ASSERT_TRUE(b.brash) << "floe " << b.id;
+  RunStats stats;
+  const Results r = simulate(o, m, stats);
+  const nlohmann::json s = summarize(o, m, r);
+  const double mean = s["mean_surge_ice_load_N"].get<double>();
+  const double M = o.ice.density_kg_m3 * 3 * 0.8 * 0.8 * 1.0, U = 2.0, T = o.duration_s;
+  std::printf("[measured] brash: mean surge ice load %.4f kN, -M U / T = %.4f kN (%+.2e), rigid part %.4f kN\n",
+              mean / 1e3, -M * U / T / 1e3, mean / (-M * U / T) - 1, s["mean_surge_ice_load_rigid_N"].get<double>() / 1e3);
+  EXPECT_NEAR(mean / (-M * U / T), 1.0, 1e-3);
+  EXPECT_DOUBLE_EQ(s["mean_surge_ice_load_rigid_N"].get<double>(), mean);
+  EXPECT_EQ(s["mean_surge_ice_load_compliant_N"].get<double>(), 0.0);
+}
+
 // Momentum budget of the ice over a short transit of the generated hull through 20 floes in water (compliant
 // contacts, fracture and sleeping off so that no floe leaves or is stopped by hand): the impulse the hull gives the
 // ice (minus the recorded ice load on the vessel, integrated) equals the change of the ice's momentum minus the
