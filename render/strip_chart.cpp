@@ -53,9 +53,13 @@ LoadStripChart::LoadStripChart(const Results& r, const RenderOptions& o, const s
   if (o.strip_average_window_s.is_string()) {
     FilteredLoad f = auto_filtered_surge_ice_resistance_kN(r, source);
     scale_.window_s = f.window_s;
+    const bool both = f.text.rfind("rigid part", 0) == 0;
+    scale_.average_label = both ? "moving average 20 s rigid + 0.5 s compliant"
+                                : "moving average " + fmt("%g s", scale_.window_s);
     average = std::move(f.kN);
   } else {
     scale_.window_s = o.strip_average_window_s.get<double>();
+    scale_.average_label = "moving average " + fmt("%g s", scale_.window_s);
     average = moving_average_centred(load, window_samples(scale_.window_s, dt));
   }
 
@@ -139,7 +143,7 @@ void LoadStripChart::draw_load_axis(cv::Mat& img) const {
   };
   say("surge ice load (" + scale_.unit + ")", kLabel);
   say("each step", kStripRawBgr);
-  say("moving average " + fmt("%g s", scale_.window_s), kStripAverageBgr);
+  say(scale_.average_label, kStripAverageBgr);
 }
 
 void LoadStripChart::draw_time_axis_and_curves(cv::Mat& img, double t0) const {

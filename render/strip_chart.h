@@ -25,7 +25,8 @@ struct StripChartScale {
   std::string unit = "kN";
   double per_kN = 1;            // display units per kN (1000 for N, 1 for kN, 0.001 for MN)
   double y_lo = 0, y_hi = 0;    // axis range, display units
-  double window_s = 0;          // moving-average window used
+  double window_s = 0;          // moving-average window used (the longest, with "auto" on a run of both laws)
+  std::string average_label;    // the legend's name of the average, e.g. "moving average 0.5 s"
   double t_first = 0, t_last = 0;  // the run's time range (series and frames)
   double span_s = 0;            // time shown at once
 };

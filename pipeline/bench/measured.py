@@ -150,9 +150,9 @@ def add_record_option(ap):
 def parse_floesim_bench(text):
     figs, field = [], None
     for line in text.splitlines():
-        m = re.match(r'field (\d+)x, fracture (on|off): .*?, (\d+) floes \((\d+) convex parts\)', line)
+        m = re.match(r'field (\d+)x, (.*?): [0-9.]+ m x [0-9.]+ m, (\d+) floes \((\d+) convex parts\)', line)
         if m:
-            field = f'{m.group(1)}x fracture {m.group(2)}'
+            field = f'{m.group(1)}x {m.group(2)}'
             figs += [(f'{field} floes', m.group(3), '-'), (f'{field} convex parts', m.group(4), '-')]
             continue
         m = re.match(r'\s+per step \(mean\): awake floes ([0-9.]+), contacts ([0-9.]+), broad-phase part pairs '
@@ -171,10 +171,20 @@ def parse_floesim_bench(text):
         if m and field:
             figs.append((f'{field} peak memory', m.group(1), 'MB'))
             continue
-        m = re.match(r'(fracture_speed_ratio|realtime_factor) ([0-9.eE+-]+)$', line.strip())
+        m = re.match(r'\s+brash: ([0-9.]+) t removed; rigid contacts carry ([-0-9.]+) % of the mean surge ice load',
+                     line)
+        if m and field:
+            figs += [(f'{field} brash removed', m.group(1), 't'),
+                     (f'{field} rigid share of the mean surge ice load', m.group(2), '%')]
+            continue
+        m = re.match(r'speed ratio against (.*): ([0-9.eE+-]+)$', line.strip())
         if m:
-            figs.append((m.group(1), m.group(2), '-' if m.group(1) == 'fracture_speed_ratio'
-                         else 'simulated s per wall s'))
+            figs.append((f'speed ratio of the defaults against {m.group(1)}', m.group(2), '-'))
+            continue
+        m = re.match(r'(fracture_speed_ratio|rigid_brash_speed_ratio|realtime_factor) ([0-9.eE+-]+)$', line.strip())
+        if m:
+            figs.append((m.group(1), m.group(2), 'simulated s per wall s' if m.group(1) == 'realtime_factor'
+                         else '-'))
     return figs
 
 

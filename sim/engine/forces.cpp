@@ -309,8 +309,10 @@ Wrench drag_clipped(const Model& m, const Body& b, const BodyKinematics& k, Forc
       ac.area = f.area;
       ac.centroid = k.x + k.R * f.centroid;
     } else if (f.count <= 8) {
-      // Side walls (quads) cut by the waterline: clipped on the stack.
-      Vec3 in[8], out[9];
+      // Side walls (quads) and small top or bottom faces cut by the waterline: clipped on the stack. A face of a
+      // non-convex outline (a top or bottom of up to 8 vertices, tilted through the water plane) can cross it at
+      // every edge, so the cut has up to 2 x 8 vertices (a tilted small brash piece found the 9 of a convex one).
+      Vec3 in[8], out[16];
       for (int i = 0; i < f.count; ++i) in[i] = s.vertices[b.drag_face_index[f.first + i]];
       ac = polygon_area_centroid(out, clip_polygon_z(in, f.count, 0.0, true, out));
     } else {

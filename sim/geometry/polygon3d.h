@@ -55,8 +55,8 @@ inline void clip_polygon_z(const Vec3* p, int n, double z0, bool below, std::vec
   }
 }
 
-// The same into a caller's array of at least n + 1 points (a convex polygon gains at most one vertex); returns
-// the count.
+// The same into a caller's array of at least n + 1 points for a convex polygon (it gains at most one vertex), 2 n
+// for any other (each edge gives at most two points); returns the count.
 inline int clip_polygon_z(const Vec3* p, int n, double z0, bool below, Vec3* out) {
   int k = 0;
   for (int i = 0; i < n; ++i) {

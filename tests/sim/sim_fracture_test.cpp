@@ -419,6 +419,21 @@ TEST(Fracture, EventsConserveMassAndMomentumAndPiecesDoNotOverlap) {
     }
   }
   EXPECT_GT(checked, 2) << "the transit broke too few floes to test";
+  // Brash stays in the water (fracture.brash "rigid"): the ice alive at the end weighs what the field did.
+  double start = 0, end = 0;
+  for (size_t b = 0; b < model.bodies.size(); ++b)
+    if (model.bodies[b].kind == BodyKind::floe) start += model.bodies[b].mass_kg;
+  const Model& m = world.model();
+  int brash = 0;
+  for (size_t b = 0; b < m.bodies.size(); ++b)
+    if (m.bodies[b].kind == BodyKind::floe && world.state().alive[b]) {
+      end += m.bodies[b].mass_kg;
+      brash += m.bodies[b].brash;
+    }
+  EXPECT_EQ(world.brash_mass_kg(), 0.0);
+  EXPECT_NEAR(end, start, 1e-12 * start);
+  std::printf("[measured] %d events checked; %d brash bodies alive at the end; ice mass %.9g kg -> %.9g kg\n", checked,
+              brash, start, end);
 }
 
 TEST(Fracture, ResultsAreByteIdenticalOnRerunAndAcrossThreads) {
