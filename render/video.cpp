@@ -101,8 +101,9 @@ RenderStats render_video(const Results& r, const RenderOptions& o, const fs::pat
   return st;
 }
 
-// The series the render draws (the strip chart's surge ice load); the others stay on disk.
-const std::set<std::string> kRenderSeries = {"time_s", "ice_load"};
+// The series the render draws (the strip chart's surge ice load, and its rigid and compliant parts for the filter of
+// PHYSICS.md §5); the others stay on disk.
+const std::set<std::string> kRenderSeries = {"time_s", "ice_load", "ice_load_rigid", "ice_load_compliant"};
 
 RenderStats render_video(const fs::path& results, const fs::path& config, const fs::path& out_mp4) {
   const RenderOptions o = read_render_options(config);
