@@ -278,7 +278,8 @@ void script_plot_command(std::ostream& gp, const AtomicFile& data, const SurgeLo
      << " index 0 using 1:2 with lines lc rgb '#a9b8c6' lw 0.8 title "
      << quoted("ice resistance, every time step (Δt = " + fmt("%g", s.time_step_s) + " s)") << " noenhanced, \\\n"
      << "  '' index 1 using 1:2 with lines lc rgb '#101010' lw 2 title "
-     << quoted(s.filter + (s.moving_average_complete ? "" : " (longer than the run: cut windows)")) << " noenhanced, \\\n"
+     << quoted(s.filter + (s.moving_average_complete ? "" : " (longer than the run: cut windows)"))
+     << " noenhanced, \\\n"
      << "  '' index 2 using 1:2 with lines lc rgb '#d1232a' lw 2.5 dt (8,4) title " << quoted(mean_title)
      << " noenhanced";
   const std::string y_mark = fmt("%.9g", y_lo_u + 0.012 * (y_hi_u - y_lo_u));

@@ -9,9 +9,8 @@
 // the end, the fracture stage's time, who presses on the hull (input floes, pieces), and
 // `fracture_speed_ratio <with / without>`. It also runs the Oden-size field with fracture at the hull only and with
 // brash removed (the model before issue #33), so that the cost of ice-ice failure and of keeping brash as rigid
-// bodies is a ratio of the same run (`rigid_brash_speed_ratio <brash kept / removed, simulated s per wall s, ice-ice failure on>`). The last
-// line is
-// `realtime_factor <simulated s per wall s on the Oden-size field, fracture on>`.
+// bodies is a ratio of the same run (`rigid_brash_speed_ratio <brash kept / removed, simulated s per wall s, with
+// ice-ice failure>`). The last line is `realtime_factor <simulated s per wall s on the Oden-size field, the defaults>`.
 //
 //   floesim-bench [--duration 200] [--threads 2] [--scales 1,4,9] [--seed 1] [--keep DIR] [--no-compare]
 //

@@ -367,7 +367,8 @@ int World::vessel_ice_load(const std::vector<Contact>& contacts, Wrench* rigid, 
 }
 
 void World::stage_fracture() {
-  std::vector<FractureCut> cuts = find_fractures(model_, state_, contacts_, model_.settings.time_step_s, &state_.pair_loads);
+  std::vector<FractureCut> cuts =
+      find_fractures(model_, state_, contacts_, model_.settings.time_step_s, &state_.pair_loads);
   for (FractureCut& c : cuts) apply_fracture(c);
   report_.fracture_events = static_cast<int>(cuts.size());
 }

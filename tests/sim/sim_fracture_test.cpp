@@ -201,7 +201,8 @@ TEST(Fracture, SplittingLoadScalesAsKicHSqrtL) {
   // along the force is L, so F_split = C_s K_IC h sqrt(L) (C_s = 2, K_IC = 150 kPa sqrt(m)).
   for (double h : {0.5, 1.5})
     for (double L : {10.0, 40.0, 160.0}) {
-      // Floe 2 east of it (1 km long: it does not split itself) holds it: the push is pressed against a reaction (PHYSICS.md §2.2).
+      // Floe 2 east of it (1 km long: it does not split itself) holds it: the push is pressed against a reaction
+      // (PHYSICS.md §2.2).
       Rig rig({rect_floe(1, 0, -L / 2, L, L, h), rect_floe(2, L, -L / 2, 1000, L, h)});
       World world(rig.model);
       const double dt = rig.model.settings.time_step_s;

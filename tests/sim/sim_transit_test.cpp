@@ -269,7 +269,8 @@ TEST(SimTransit, BrashMeanLoadIsTheMomentumItIsGivenAndIsTheRigidPart) {
   const double mean = s["mean_surge_ice_load_N"].get<double>();
   const double M = o.ice.density_kg_m3 * 3 * 0.8 * 0.8 * 1.0, U = 2.0, T = o.duration_s;
   std::printf("[measured] brash: mean surge ice load %.4f kN, -M U / T = %.4f kN (%+.2e), rigid part %.4f kN\n",
-              mean / 1e3, -M * U / T / 1e3, mean / (-M * U / T) - 1, s["mean_surge_ice_load_rigid_N"].get<double>() / 1e3);
+              mean / 1e3, -M * U / T / 1e3, mean / (-M * U / T) - 1,
+              s["mean_surge_ice_load_rigid_N"].get<double>() / 1e3);
   EXPECT_NEAR(mean / (-M * U / T), 1.0, 1e-3);
   EXPECT_DOUBLE_EQ(s["mean_surge_ice_load_rigid_N"].get<double>(), mean);
   EXPECT_EQ(s["mean_surge_ice_load_compliant_N"].get<double>(), 0.0);
