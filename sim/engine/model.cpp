@@ -282,12 +282,15 @@ void set_added_mass(Body& b, const Vec3& added_mass, const Vec3& added_inertia) 
 
 }  // namespace
 
-bool is_brash(const Polygon& outline, double thickness_m, double min_area_m2) {
-  const double area = signed_area(outline);
-  if (area < min_area_m2) return true;
+double perimeter_m(const Polygon& outline) {
   double perimeter = 0;
   for (size_t i = 0; i < outline.size(); ++i) perimeter += (outline[(i + 1) % outline.size()] - outline[i]).norm();
-  return 4 * area / perimeter < thickness_m;
+  return perimeter;
+}
+
+bool is_brash(const Polygon& outline, double thickness_m, double min_area_m2) {
+  const double area = signed_area(outline);
+  return area < min_area_m2 || 4 * area / perimeter_m(outline) < thickness_m;  // plan width 4 A / perimeter
 }
 
 void hold_fixed(Body& b) {
@@ -309,11 +312,8 @@ Body make_floe_body(const Polygon& outline, double h, int id, int body_index, co
   b.id = id;
   b.thickness_m = h;
   b.brash = o.fracture.brash == "rigid" && is_brash(outline, h, o.fracture.min_piece_area_m2);
-  if (b.brash) {
-    double perimeter = 0;
-    for (size_t i = 0; i < outline.size(); ++i) perimeter += (outline[(i + 1) % outline.size()] - outline[i]).norm();
-    b.brash_crush_force_n = o.ice.crushing_strength_pa * h * 4 * signed_area(outline) / perimeter;
-  }
+  if (b.brash)  // p_c h x the plan width 4 A / perimeter
+    b.brash_crush_force_n = o.ice.crushing_strength_pa * h * 4 * signed_area(outline) / perimeter_m(outline);
   b.outline = outline;
   b.buoyancy_mesh = extrude_polygon(b.outline, -h / 2, h);
   // Second moments of the section (Green's theorem over the CCW outline, which is centred on its centroid).

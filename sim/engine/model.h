@@ -180,6 +180,8 @@ Body make_floe_body(const Polygon& outline, double thickness_m, int id, int body
 // (plan width 4 A / perimeter below h: a block, whose tiny inertia about its long axis the crushing rows of a plate
 // would only destabilise).
 bool is_brash(const Polygon& outline, double thickness_m, double min_area_m2);
+// The length of an outline's boundary, m.
+double perimeter_m(const Polygon& outline);
 
 // A body the solver and the integrator never move: a domain wall or a tile of level ice.
 inline bool is_fixed_body(const Body& b) { return b.kind == BodyKind::wall || b.fixed; }

@@ -202,9 +202,9 @@ TEST(SimTransit, FloesMarkedInContactAreTheOnesTheHullPressesOn) {
   EXPECT_GT(frames_in_contact, 5u) << "the bow reaches the block";
 }
 
-TEST(SimTransit, MeanLoadIsTheMomentumGivenToTheIce) {
+// The kinematic face of the two tests below: the box hull at 2 m/s with no thrust, in vacuum without gravity, 12 s.
+SimulateOptions kinematic_face_options() {
   SimulateOptions o = testing::floe_options();
-  o.fracture.enabled = false;  // the contact law alone
   o.water.enabled = false;
   o.water.gravity_mps2 = 0;
   o.water.density_kg_m3 = 1e12;
@@ -216,6 +216,12 @@ TEST(SimTransit, MeanLoadIsTheMomentumGivenToTheIce) {
   o.duration_s = 12;
   o.steady_start_s = 0;
   o.output_interval_s = 1.0;
+  return o;
+}
+
+TEST(SimTransit, MeanLoadIsTheMomentumGivenToTheIce) {
+  SimulateOptions o = kinematic_face_options();
+  o.fracture.enabled = false;  // the contact law alone
   FloeField field;
   for (int i = 0; i < 3; ++i) field.floes.push_back(rect_floe(i + 1, 53.003 + 4 * i, -13 + 10 * i, 6, 6, 1.0));
   const HullModel hull = box_hull(4, 30, -3, 6);
@@ -245,18 +251,7 @@ TEST(SimTransit, MeanLoadIsTheMomentumGivenToTheIce) {
 // leave each block moving with the face at U, so the mean surge ice load is again -M U / T (M = rho_i x 3 x 0.64 m^3
 // by hand), all of it recorded as the rigid part.
 TEST(SimTransit, BrashMeanLoadIsTheMomentumItIsGivenAndIsTheRigidPart) {
-  SimulateOptions o = testing::floe_options();
-  o.water.enabled = false;
-  o.water.gravity_mps2 = 0;
-  o.water.density_kg_m3 = 1e12;
-  o.vessel.x_m = 50;  // face at x = 52 m
-  o.vessel.initial_speed_mps = 2.0;
-  o.vessel.autopilot.enabled = false;
-  o.vessel.propulsion.mode = "constant_thrust";
-  o.vessel.propulsion.thrust_n = 0;
-  o.duration_s = 12;
-  o.steady_start_s = 0;
-  o.output_interval_s = 1.0;
+  const SimulateOptions o = kinematic_face_options();
   FloeField field;
   for (int i = 0; i < 3; ++i) field.floes.push_back(rect_floe(i + 1, 53.003 + 4 * i, -13 + 10 * i, 0.8, 0.8, 1.0));
   const HullModel hull = box_hull(4, 30, -3, 6);
