@@ -256,8 +256,11 @@ TEST(SimTransit, BrashMeanLoadIsTheMomentumItIsGivenAndIsTheRigidPart) {
   for (int i = 0; i < 3; ++i) field.floes.push_back(rect_floe(i + 1, 53.003 + 4 * i, -13 + 10 * i, 0.8, 0.8, 1.0));
   const HullModel hull = box_hull(4, 30, -3, 6);
   const Model m = build_model(field, &hull, o);
-  for (const Body& b : m.bodies)
-    if (b.kind == BodyKind::floe) ASSERT_TRUE(b.brash) << "floe " << b.id;
+  for (const Body& b : m.bodies) {
+    if (b.kind == BodyKind::floe) {
+      ASSERT_TRUE(b.brash) << "floe " << b.id;
+    }
+  }
   RunStats stats;
   const Results r = simulate(o, m, stats);
   const nlohmann::json s = summarize(o, m, r);
