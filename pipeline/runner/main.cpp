@@ -20,7 +20,8 @@ int main(int argc, char** argv) {
                "  floesim-gather      a sweep's members -> sweep.csv, statistics and plots\n"
                "  floesim-identify    measured ship data -> identified ice loads\n"
                "  floesim-shipdata    a simulated transit -> the data a ship would have recorded\n"
-               "  floesim-resistance  Lindqvist's and Riska's level-ice resistance for a hull",
+               "  floesim-resistance  Lindqvist's and Riska's level-ice resistance for a hull\n"
+               "  floesim-ice-actions structures by the design formulas (ISO 19906, Croasdale, Ralston; mooring, DP)",
                "floesim"};
   app.require_subcommand(1);
   floesim::runner::RunOptions o;

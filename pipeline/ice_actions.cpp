@@ -1,0 +1,167 @@
+#include "pipeline/ice_actions.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "pipeline/error.h"
+
+namespace floesim {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double rad(double deg) { return deg * kPi / 180.0; }
+
+std::string range_text(const char* field, double value, const char* what) {
+  std::ostringstream s;
+  s << field << " " << what << ", got " << value;
+  return s.str();
+}
+
+// The problems common to every formula: the ice's own numbers.
+void ice_problems(const StructureIce& ice, std::vector<std::string>& out) {
+  auto positive = [&](const char* field, double v) {
+    if (!(std::isfinite(v) && v > 0)) out.push_back(range_text(field, v, "must be > 0"));
+  };
+  positive("thicknesses_m", ice.thickness_m);
+  positive("fracture.flexural_strength_pa", ice.flexural_strength_pa);
+  positive("fracture.youngs_modulus_pa", ice.youngs_modulus_pa);
+  positive("ice.density_kg_m3", ice.ice_density_kg_m3);
+  positive("water.density_kg_m3", ice.water_density_kg_m3);
+  positive("water.gravity_mps2", ice.gravity_mps2);
+  if (!(ice.poisson_ratio >= 0 && ice.poisson_ratio < 0.5))
+    out.push_back(range_text("fracture.poisson_ratio", ice.poisson_ratio, "must be in [0, 0.5)"));
+  if (!(ice.friction >= 0 && ice.friction < 2)) out.push_back(range_text("ice.mu_ice_structure", ice.friction, "must be in [0, 2)"));
+}
+
+// A cone's slope and width, and the friction the slope can carry.
+void slope_problems(const SlopingStructure& s, const StructureIce& ice, std::vector<std::string>& out) {
+  if (!(std::isfinite(s.waterline_width_m) && s.waterline_width_m > 0))
+    out.push_back(range_text("structure.waterline_width_m", s.waterline_width_m, "must be > 0"));
+  if (!(s.slope_deg >= 20 && s.slope_deg <= 70)) {
+    out.push_back(range_text("structure.slope_deg", s.slope_deg,
+                             "must be in [20, 70] deg (the range of the sloping-structure methods)"));
+    return;
+  }
+  const double a = rad(s.slope_deg);
+  const double limit = std::min(std::tan(a), 1.0 / std::tan(a));
+  if (ice.friction >= limit)
+    out.push_back(range_text("ice.mu_ice_structure", ice.friction,
+                             ("must be below min(tan a, cot a) = " + std::to_string(limit) +
+                              " for this slope (the ice would not slide up it)")
+                                 .c_str()));
+}
+
+void throw_if(const std::vector<std::string>& problems, const char* what) {
+  if (problems.empty()) return;
+  std::string m = std::string(what) + ": ";
+  for (size_t i = 0; i < problems.size(); ++i) m += (i ? "; " : "") + problems[i];
+  throw Error(m);
+}
+
+}  // namespace
+
+double characteristic_length_m(const StructureIce& ice) {
+  const double d = ice.youngs_modulus_pa * std::pow(ice.thickness_m, 3) / (12 * (1 - ice.poisson_ratio * ice.poisson_ratio));
+  return std::pow(d / (ice.water_density_kg_m3 * ice.gravity_mps2), 0.25);
+}
+
+IsoCrushing iso_global_crushing(double h, double w, double c_r, IsoCrushingForm form) {
+  std::vector<std::string> p;
+  if (!(std::isfinite(h) && h > 0)) p.push_back(range_text("thicknesses_m", h, "must be > 0"));
+  if (!(std::isfinite(w) && w > 0)) p.push_back(range_text("structure.waterline_width_m", w, "must be > 0"));
+  if (!(std::isfinite(c_r) && c_r > 0)) p.push_back(range_text("strength_coefficient_pa", c_r, "must be > 0"));
+  throw_if(p, "ISO 19906 global crushing");
+  const double n = h < 1.0 ? -0.5 + h / 5.0 : -0.3, m = -0.16;
+  double shape = std::pow(h / 1.0, n) * std::pow(w / h, m);
+  if (form == IsoCrushingForm::iso2019) shape += std::exp(-w / (3 * h)) * std::sqrt(1 + 5 * h / w);
+  IsoCrushing r;
+  r.pressure_pa = c_r * shape;
+  r.force_n = r.pressure_pa * w * h;
+  return r;
+}
+
+std::vector<std::string> croasdale_problems(const SlopingStructure& s, const StructureIce& ice, const Rubble& r) {
+  std::vector<std::string> p;
+  ice_problems(ice, p);
+  slope_problems(s, ice, p);
+  if (!(r.height_m >= 0)) p.push_back(range_text("rubble.height_m", r.height_m, "must be >= 0"));
+  if (!(r.porosity >= 0 && r.porosity < 1)) p.push_back(range_text("rubble.porosity", r.porosity, "must be in [0, 1)"));
+  if (!(r.cohesion_pa >= 0)) p.push_back(range_text("rubble.cohesion_pa", r.cohesion_pa, "must be >= 0"));
+  if (!(r.friction_angle_deg > 0 && r.friction_angle_deg < 90))
+    p.push_back(range_text("rubble.friction_angle_deg", r.friction_angle_deg, "must be in (0, 90) deg"));
+  if (!(r.ice_ice_friction >= 0)) p.push_back(range_text("rubble.mu_ice_ice", r.ice_ice_friction, "must be >= 0"));
+  if (!(r.pile_slope_deg > 0 && r.pile_slope_deg < s.slope_deg))
+    p.push_back(range_text("rubble.pile_slope_deg", r.pile_slope_deg,
+                           "must be in (0, structure.slope_deg): the pile is flatter than the structure"));
+  return p;
+}
+
+CroasdaleLoad croasdale(const SlopingStructure& s, const StructureIce& ice, const Rubble& r) {
+  throw_if(croasdale_problems(s, ice, r), "Croasdale's sloping-structure load");
+  const double a = rad(s.slope_deg), th = rad(r.pile_slope_deg), ph = rad(r.friction_angle_deg);
+  const double w = s.waterline_width_m, h = ice.thickness_m, mu = ice.friction, mui = r.ice_ice_friction;
+  const double rho_i = ice.ice_density_kg_m3, g = ice.gravity_mps2, e = r.porosity, hr = r.height_m;
+  const double sa = std::sin(a), ca = std::cos(a), cot_a = ca / sa, cot_th = 1 / std::tan(th);
+  CroasdaleLoad o;
+  o.characteristic_length_m = characteristic_length_m(ice);
+  o.effective_width_m = w + kPi * kPi * o.characteristic_length_m / 4;
+  o.xi = (sa + mu * ca) / (ca - mu * sa);
+  const double ar = 1 - std::tan(th) / std::tan(a);  // (1 - tan theta / tan alpha)
+  const double unit = rho_i * g * (1 - e);            // the rubble's unit weight
+  o.breaking_n = 0.68 * o.xi * ice.flexural_strength_pa *
+                 std::pow(ice.water_density_kg_m3 * g * std::pow(h, 5) / ice.youngs_modulus_pa, 0.25) *
+                 o.effective_width_m;
+  o.push_through_n = w * hr * hr * mui * unit * ar * ar / (2 * std::tan(th));
+  const double pr = 0.5 * mui * (mui + mu) * unit * hr * hr * sa * (cot_th - cot_a) * ar +
+                    0.5 * (mui + mu) * unit * hr * hr * ca * cot_a * ar + hr * h * rho_i * g * (sa + mu * ca) / sa;
+  o.ride_up_n = w * pr / (ca - mu * sa);
+  o.lift_n = o.xi * w * hr * ar * (0.5 * hr * unit * (cot_th - cot_a + std::tan(ph) * ar) + r.cohesion_pa);
+  o.turning_n = 1.5 * w * h * h * rho_i * g * ca / (sa - mu * ca);
+  const double sum = o.breaking_n + o.push_through_n + o.ride_up_n + o.lift_n + o.turning_n;
+  const double denominator = 1 - o.breaking_n / (ice.flexural_strength_pa * o.effective_width_m * h);
+  if (!(denominator > 0))
+    throw Error("Croasdale's sloping-structure load: H_B reaches sigma_f h L_eff (the breaking term alone would fail "
+                "the sheet in compression): the method does not apply to this slope and ice");
+  o.horizontal_n = sum / denominator;
+  o.vertical_breaking_n = o.breaking_n / o.xi;
+  return o;
+}
+
+std::vector<std::string> ralston_problems(const SlopingStructure& s, const StructureIce& ice, const Rubble& r) {
+  std::vector<std::string> p;
+  ice_problems(ice, p);
+  slope_problems(s, ice, p);
+  if (!(s.neck_width_m >= 0 && s.neck_width_m < s.waterline_width_m))
+    p.push_back(range_text("structure.neck_width_m", s.neck_width_m, "must be in [0, structure.waterline_width_m)"));
+  if (!(r.ride_up_thickness_m >= 0))
+    p.push_back(range_text("rubble.ride_up_thickness_m", r.ride_up_thickness_m, "must be >= 0"));
+  return p;
+}
+
+RalstonLoad ralston(const SlopingStructure& s, const StructureIce& ice, const Rubble& r) {
+  throw_if(ralston_problems(s, ice, r), "Ralston's cone load");
+  constexpr double kY = 2.711;  // Tresca
+  const double a = rad(s.slope_deg), sa = std::sin(a), ca = std::cos(a);
+  const double w = s.waterline_width_m, h = ice.thickness_m, mu = ice.friction, sf = ice.flexural_strength_pa;
+  const double rho_g = ice.ice_density_kg_m3 * ice.gravity_mps2;
+  RalstonLoad o;
+  o.g_ratio = rho_g * w * w / (4 * sf * h);
+  o.x = 1 + 1 / std::sqrt(3 * o.g_ratio + 0.5 * kY);
+  o.g_r = (sa + a / ca) / (2 * mu * a * ca + 0.5 * kPi * sa * sa);
+  if (!(1 - o.g_r * mu > 0))
+    throw Error("Ralston's cone load: 1 - g_r mu <= 0 (ice.friction too high for this slope): the method does not "
+                "apply");
+  const double x = o.x;
+  o.breaking_n = sf * h * h / 3 * std::tan(a) / (1 - o.g_r * mu) *
+                 (o.g_ratio * (x - 1) * (x + 2) + (1 + kY * x * std::log(x)) / (x - 1));
+  const double k = sa, big_k = std::comp_ellint_1(k), big_e = std::comp_ellint_2(k);
+  o.ride_up_weight_n = rho_g * r.ride_up_thickness_m * (w * w - s.neck_width_m * s.neck_width_m) / (4 * ca);
+  const double f = mu * big_k * ca + sa;
+  o.ride_up_n = o.ride_up_weight_n * (std::tan(a) + mu * (big_e - f * o.g_r * ca)) / (1 - o.g_r * mu);
+  o.horizontal_n = o.breaking_n + o.ride_up_n;
+  return o;
+}
+
+}  // namespace floesim

@@ -1,0 +1,111 @@
+// The station-keeping closed forms of the core (pipeline/station_keeping.h) against PHYSICS.md §8.4, reproduced by
+// ../shared/docs/physics-scripts/structures_ridges.py: one catenary line of chain (k_H = 92.37 kN/m, and k_H against
+// a central difference of X(H), a second algorithm), the 12-line spread (K_xx = 557.3 kN/m; offsets 1.64 m and
+// 2.74 m under 1 and 2 MN, the windward lines stiffening), the DP gains of §8.4.2; bad lines refused, named.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <string>
+
+#include "pipeline/error.h"
+#include "pipeline/station_keeping.h"
+
+using namespace floesim;
+
+namespace {
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// §8.4.1's chain: w_l = 1.0 kN/m, h_d = 40 m, L = 600 m, pretension H_0 = 300 kN.
+CatenaryLine chain() { return CatenaryLine{1000.0, 40.0, 600.0}; }
+
+TEST(Catenary, TheBriefsChainLine) {
+  const CatenaryState s = catenary_at_tension(chain(), 300e3);
+  EXPECT_NEAR(s.suspended_length_m, 160.00, 0.005);
+  EXPECT_NEAR(s.suspended_span_m, 153.25, 0.005);
+  EXPECT_NEAR(s.span_m, 593.25, 0.005);
+  EXPECT_NEAR(s.fairlead_tension_n, 340e3, 1e-6);
+  EXPECT_NEAR(s.fairlead_vertical_n, 160e3, 0.5);
+  EXPECT_NEAR(s.stiffness_n_per_m, 92.37e3, 0.005e3);
+  // k_H against a central difference of the span (the closed-form derivative against X(H) itself).
+  const double dh = 1.0;
+  const double fd = 2 * dh / (catenary_at_tension(chain(), 300e3 + dh).span_m -
+                              catenary_at_tension(chain(), 300e3 - dh).span_m);
+  EXPECT_NEAR(s.stiffness_n_per_m / fd, 1.0, 1e-6);
+  // The inverse: the tension at that span is the pretension.
+  EXPECT_NEAR(catenary_at_span(chain(), s.span_m).horizontal_tension_n, 300e3, 1e-3);
+}
+
+std::vector<MooringLeg> twelve_lines() {
+  std::vector<MooringLeg> legs;
+  for (int i = 0; i < 12; ++i) legs.push_back(leg_from_pretension(chain(), 15 + 30 * i, 300e3));
+  return legs;
+}
+
+TEST(SpreadMooring, TheBriefsTwelveLines) {
+  const std::vector<MooringLeg> legs = twelve_lines();
+  const std::vector<double> k = spread_linear_stiffness(legs);
+  EXPECT_NEAR(k[0], 557.3e3, 0.05e3);
+  EXPECT_NEAR(k[3], 557.3e3, 0.05e3);  // the spread is symmetric: the same across
+  EXPECT_NEAR(k[1], 0.0, 1e-6 * k[0]);
+  // At the station the pretensions cancel.
+  const SpreadState rest = spread_at_offset(legs, 0, 0);
+  EXPECT_NEAR(rest.force_x_n, 0.0, 1e-6);
+  EXPECT_NEAR(rest.force_y_n, 0.0, 1e-6);
+  // 1 MN along x: 1.64 m (linear 1.79 m), largest H 520 kN, largest fairlead tension 560 kN, smallest H 193 kN;
+  // 2 MN: 2.74 m (linear 3.59 m), 832 / 872 kN, the leeward lines down to 149 kN.
+  struct Case {
+    double load, offset, h_max, h_min;
+  };
+  for (const Case& c : {Case{1e6, 1.64, 520e3, 193e3}, Case{2e6, 2.74, 832e3, 149e3}}) {
+    const SpreadOffset o = spread_offset(legs, c.load, 0);
+    EXPECT_NEAR(o.dx_m, c.offset, 0.005) << c.load;
+    EXPECT_NEAR(o.dy_m, 0.0, 1e-6) << c.load;
+    double h_max = 0, h_min = 1e300, t_max = 0;
+    for (const CatenaryState& s : o.state.lines) {
+      h_max = std::max(h_max, s.horizontal_tension_n);
+      h_min = std::min(h_min, s.horizontal_tension_n);
+      t_max = std::max(t_max, s.fairlead_tension_n);
+    }
+    EXPECT_NEAR(h_max, c.h_max, 0.5e3) << c.load;
+    EXPECT_NEAR(t_max, c.h_max + 40e3, 0.5e3) << c.load;
+    EXPECT_NEAR(h_min, c.h_min, 0.5e3) << c.load;
+    // The legs balance the load: the restoring force is minus it.
+    EXPECT_NEAR(o.state.force_x_n, -c.load, 1e-6 * c.load);
+    EXPECT_GT(c.load / k[0], o.dx_m);  // the windward lines stiffen: the linear offset is larger
+  }
+}
+
+TEST(DynamicPositioning, TheBriefsSurgeGains) {
+  // §8.4.2: M = 1.3e7 kg x 1.05 added mass, T_n = 100 s, zeta = 0.7: K_p 53.9 kN/m, K_d 1201 kN s/m,
+  // K_i 0.339 kN/(m s); under a 0.5 MN mean load, P alone leaves 9.3 m.
+  const DpGains g = dp_gains(1.3e7 * 1.05, 100, 0.7);
+  EXPECT_NEAR(g.proportional, 53.9e3, 0.05e3);
+  EXPECT_NEAR(g.derivative, 1201e3, 0.5e3);
+  EXPECT_NEAR(g.integral, 0.339e3, 0.0005e3);
+  EXPECT_NEAR(0.5e6 / g.proportional, 9.3, 0.05);
+}
+
+TEST(StationKeeping, BadLinesAndGainsNameTheField) {
+  CatenaryLine short_line = chain();
+  short_line.length_m = 30;  // shorter than the 40 m to the seabed
+  EXPECT_NE(error_of([&] { catenary_at_tension(short_line, 1e5); }).find("length_m"), std::string::npos);
+  CatenaryLine above = chain();
+  above.fairlead_height_m = -5;  // the anchor above the fairlead: not on the seabed
+  EXPECT_NE(error_of([&] { catenary_at_tension(above, 1e5); }).find("fairlead_height_m"), std::string::npos);
+  // A tension that lifts the whole line off the seabed.
+  EXPECT_NE(error_of([] { catenary_at_tension(chain(), 1e9); }).find("lift its anchor"), std::string::npos);
+  EXPECT_NE(error_of([] { dp_gains(1e7, 100, -0.7); }).find("damping_ratio"), std::string::npos);
+  EXPECT_NE(error_of([] { dp_gains(-1e7, 100, 0.7); }).find("mass_kg"), std::string::npos);
+}
+
+}  // namespace
