@@ -42,6 +42,53 @@ struct HullGeneratorOptions {
   }
 };
 
+// A structure's hull from parameters (issue #34): a vertical cylinder, a caisson, or a cone with a neck, breaking the
+// ice upwards (the cone widens downwards from its neck above the waterline, as on bridge piers and lighthouses) or
+// downwards (it widens upwards from a neck below the waterline, as on Kulluk). Frame: z up, calm waterline z = 0,
+// origin on the axis at the waterline; x is the direction the ice comes from (a caisson's length). Round sections are
+// regular polygons of `sides` faces around the circle of the stated diameter (its width across flats; a face looks
+// along +x), so that every side face has the stated slope.
+struct StructureShapeOptions {
+  std::string shape = "cone";       // cone | cylinder | caisson
+  std::string breaking = "upward";  // cone: upward | downward
+  double waterline_width_m = 10;    // w: diameter (cone, cylinder) or width across y (caisson) at the waterline
+  double neck_width_m = 4;          // w_T: cone's neck diameter
+  double slope_deg = 45;            // alpha: cone's slope from the horizontal
+  double length_m = 0;              // caisson's length along x; 0 = waterline_width_m
+  double depth_m = 10;              // the structure reaches this far below the waterline
+  double height_m = 10;             // and this far above it
+  int sides = 32;                   // vertices of a round section
+  template <class V>
+  void visit(V& v) {
+    v.field("shape", shape, "-", "cone, cylinder (vertical) or caisson (a box)", one_of({"cone", "cylinder", "caisson"}));
+    v.field("breaking", breaking, "-",
+            "cone: upward (widens downwards from a neck above the waterline) or downward (widens upwards from a neck "
+            "below it)",
+            one_of({"upward", "downward"}));
+    v.field("waterline_width_m", waterline_width_m, "m", "width at the waterline: a cone's or cylinder's diameter, a "
+            "caisson's width across y", positive());
+    v.field("neck_width_m", neck_width_m, "m", "cone: neck diameter w_T (below waterline_width_m)", positive());
+    v.field("slope_deg", slope_deg, "deg", "cone: slope from the horizontal (20-70, the design formulas' range)",
+            in_range(20, 70));
+    v.field("length_m", length_m, "m", "caisson: length along x (0 = waterline_width_m)", non_negative());
+    v.field("depth_m", depth_m, "m", "how far the structure reaches below the waterline", positive());
+    v.field("height_m", height_m, "m", "how far it reaches above the waterline", positive());
+    v.field("sides", sides, "-", "faces around a round section (a regular polygon around the circle)",
+            int_in_range(8, 256));
+    if (shape == "cone" && neck_width_m >= waterline_width_m)
+      v.problem("neck_width_m", "must be smaller than waterline_width_m (the cone narrows to its neck)");
+  }
+};
+
+// The structure as convex parts: a cylinder or caisson is one part; a cone is its frustum from the structure's end
+// on the wide side to the neck, and the neck's cylinder from there to the other end (an Error if the neck lies beyond
+// that end: raise height_m, or depth_m for a downward-breaking cone, or widen the neck).
+std::vector<TriMesh> generate_structure(const StructureShapeOptions& o);
+// The floesim-hull stage for a structure: writes out_obj and its sidecar (hydrostatics, the shape's figures, no ship
+// particulars) atomically and returns the summary printed on stdout.
+std::string write_generated_structure(const StructureShapeOptions& o, const std::filesystem::path& out_obj,
+                                      const std::filesystem::path& config_file);
+
 // Builds the hull as convex parts (one mesh each) and writes it as an OBJ with one object ("o part_k") per part.
 std::vector<TriMesh> generate_hull(const HullGeneratorOptions& o);
 void write_obj(const std::filesystem::path& file, const std::vector<TriMesh>& parts, const std::string& header);

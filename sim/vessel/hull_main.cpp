@@ -1,5 +1,5 @@
-// floesim-hull: writes the parametric icebreaker (Oden's main particulars by default), or places and decomposes a
-// user's mesh (a config with "file"), as an OBJ of convex parts with a JSON sidecar of particulars, hydrostatics,
+// floesim-hull: writes the parametric icebreaker (Oden's main particulars by default), a structure from parameters
+// (a config with "structure": cylinder, caisson, cone), or places and decomposes a user's mesh (a config with "file"), as an OBJ of convex parts with a JSON sidecar of particulars, hydrostatics,
 // the angles and lengths the ice-resistance formulas take (measured from the mesh) and provenance.
 #include <iostream>
 
@@ -8,6 +8,19 @@
 #include "pipeline/options.h"
 #include "pipeline/stage_main.h"
 #include "sim/vessel/hull.h"
+
+namespace {
+
+// A structure's config: {"structure": {...}} (errors name structure.<key>).
+struct StructureHullConfig {
+  floesim::sim::StructureShapeOptions structure;
+  template <class V>
+  void visit(V& v) {
+    v.section("structure", structure, "a structure's hull from parameters: cylinder, caisson or cone");
+  }
+};
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"Writes a hull as an OBJ of convex parts (one object per part) plus FILE.json with its hydrostatics\n"
@@ -25,8 +38,10 @@ int main(int argc, char** argv) {
   return floesim::run_stage(app, argc, argv, [&] {
     namespace sim = floesim::sim;
     if (help_config) {
-      std::cout << "Parametric icebreaker (a config without \"file\"):\n\n"
+      std::cout << "Parametric icebreaker (a config without \"file\" or \"structure\"):\n\n"
                 << floesim::options_doc(sim::HullGeneratorOptions{})
+                << "\nA structure (a config with \"structure\", as a case's hull section):\n\n"
+                << floesim::options_doc(StructureHullConfig{})
                 << "\nA user's mesh (a config with \"file\", as a case's hull section):\n\n"
                 << floesim::options_doc(sim::HullImportOptions{});
       return;
@@ -43,6 +58,13 @@ int main(int argc, char** argv) {
       }
       if (out.empty()) throw floesim::Error("--out FILE.obj is required");
       std::cout << sim::write_imported_hull(o, out, config);
+      return;
+    }
+    if (j.is_object() && j.contains("structure")) {  // a structure from parameters
+      const auto o = floesim::read_options<StructureHullConfig>(j, config);
+      if (check_config) return;
+      if (out.empty()) throw floesim::Error("--out FILE.obj is required");
+      std::cout << sim::write_generated_structure(o.structure, out, config);
       return;
     }
     const auto o = floesim::read_options<sim::HullGeneratorOptions>(j, config);

@@ -24,6 +24,7 @@ namespace {
 namespace fs = std::filesystem;
 
 using testing::hull_file;
+using testing::expect_error;
 using testing::temp_dir;
 
 // Half-breadths of the waterline: points where edges of the parts cross z = 0.
@@ -172,6 +173,79 @@ TEST(GeneratedHull, BadOptionsAreErrors) {
   o = HullGeneratorOptions{};
   o.sections = 2;
   EXPECT_THROW(generate_hull(o), Error);
+}
+
+// A structure's hull from parameters (issue #34). A round section is the regular N-gon around the circle of the
+// stated diameter, of area N r^2 tan(pi / N); a frustum between two such sections of areas A0, A1 a height H apart
+// holds H (A0 + A1 + sqrt(A0 A1)) / 3 (the pyramid frustum). Each part is convex, the parts' volumes add up to the
+// closed form of the whole, and every side face of a cone leans at the stated slope: its outward normal makes the
+// angle alpha with the vertical, up and out on an upward-breaking cone, down and out on a downward-breaking one.
+double ngon_area(double r, int n) { return n * r * r * std::tan(kPi / n); }
+double frustum_volume(double a0, double a1, double h) { return h * (a0 + a1 + std::sqrt(a0 * a1)) / 3; }
+
+// The largest deviation from `slope_deg` of the side faces' lean (faces neither horizontal nor vertical), and the
+// sign of their normals' z.
+std::pair<double, double> side_face_lean(const TriMesh& part, double slope_deg) {
+  double worst = 0, sign = 0;
+  for (const auto& t : part.triangles) {
+    const Vec3 n = (part.vertices[t[1]] - part.vertices[t[0]]).cross(part.vertices[t[2]] - part.vertices[t[0]]).normalized();
+    if (std::abs(n.z()) > 1 - 1e-9 || std::abs(n.z()) < 1e-9) continue;  // a cap or a vertical side
+    worst = std::max(worst, std::abs(std::acos(std::abs(n.z())) * 180 / kPi - slope_deg));
+    sign = n.z() > 0 ? 1 : -1;
+  }
+  return {worst, sign};
+}
+
+TEST(StructureShapes, VolumesWaterplanesAndSlopesAgainstClosedForms) {
+  StructureShapeOptions o;  // upward cone: w 10 m, neck 4 m, 45 deg, 10 m below and above the waterline, 32 faces
+  const int n = o.sides;
+  const std::vector<TriMesh> up = generate_structure(o);
+  ASSERT_EQ(up.size(), 2u);
+  for (const TriMesh& p : up) EXPECT_TRUE(is_convex(p));
+  // Frustum from r = 5 + 10 = 15 m at z = -10 to the neck r = 2 at z = 3 (tan 45 x (10 - 4) / 2); neck to z = 10.
+  const double v_cone = frustum_volume(ngon_area(15, n), ngon_area(2, n), 13), v_neck = ngon_area(2, n) * 7;
+  EXPECT_NEAR(mass_properties(up[0]).volume, v_cone, 1e-9 * v_cone);
+  EXPECT_NEAR(mass_properties(up[1]).volume, v_neck, 1e-9 * v_neck);
+  const Hydrostatics h = hydrostatics(up);
+  EXPECT_NEAR(h.volume_m3, frustum_volume(ngon_area(15, n), ngon_area(5, n), 10), 1e-9 * h.volume_m3);
+  EXPECT_NEAR(h.waterplane_area_m2, ngon_area(5, n), 1e-9 * h.waterplane_area_m2);
+  const auto [lean_up, up_sign] = side_face_lean(up[0], 45);
+  EXPECT_LT(lean_up, 1e-9);
+  EXPECT_EQ(up_sign, 1.0);
+  // Downward cone at 60 deg, neck 3 m below the waterline... tan 60 x (10 - 4) / 2 = 5.196 m; 8 m deep.
+  o.breaking = "downward";
+  o.slope_deg = 60;
+  o.depth_m = 8;
+  const std::vector<TriMesh> down = generate_structure(o);
+  ASSERT_EQ(down.size(), 2u);
+  const double neck = std::tan(60 * kPi / 180) * 3, rt = 5 + 10 / std::tan(60 * kPi / 180);
+  EXPECT_NEAR(mass_properties(down[1]).volume, frustum_volume(ngon_area(2, n), ngon_area(rt, n), 10 + neck), 1e-6);
+  EXPECT_NEAR(hydrostatics(down).waterplane_area_m2, ngon_area(5, n), 1e-9 * ngon_area(5, n));
+  const auto [lean_down, down_sign] = side_face_lean(down[1], 60);
+  EXPECT_LT(lean_down, 1e-9);
+  EXPECT_EQ(down_sign, -1.0);
+  // A cylinder and a caisson: prisms.
+  StructureShapeOptions c;
+  c.shape = "cylinder";
+  EXPECT_NEAR(hydrostatics(generate_structure(c)).volume_m3, ngon_area(5, n) * 10, 1e-9 * 800);
+  c.shape = "caisson";
+  c.length_m = 30;
+  EXPECT_NEAR(hydrostatics(generate_structure(c)).volume_m3, 30.0 * 10 * 10, 1e-9);
+}
+
+TEST(StructureShapes, BadOptionsNameTheKey) {
+  StructureShapeOptions o;
+  o.neck_width_m = 12;  // wider than the waterline
+  expect_error([&] { generate_structure(o); }, {"neck_width_m"});
+  o = StructureShapeOptions{};
+  o.height_m = 2;  // the 45 deg cone's neck is 3 m up
+  expect_error([&] { generate_structure(o); }, {"height_m"});
+  o = StructureShapeOptions{};
+  o.slope_deg = 85;
+  expect_error([&] { generate_structure(o); }, {"slope_deg"});
+  o = StructureShapeOptions{};
+  o.shape = "tripod";
+  expect_error([&] { generate_structure(o); }, {"shape"});
 }
 
 TEST(LoadHull, MissingAndUnreadableFilesNameTheFile) {
