@@ -32,7 +32,8 @@ void ice_problems(const StructureIce& ice, std::vector<std::string>& out) {
   positive("water.gravity_mps2", ice.gravity_mps2);
   if (!(ice.poisson_ratio >= 0 && ice.poisson_ratio < 0.5))
     out.push_back(range_text("fracture.poisson_ratio", ice.poisson_ratio, "must be in [0, 0.5)"));
-  if (!(ice.friction >= 0 && ice.friction < 2)) out.push_back(range_text("ice.mu_ice_structure", ice.friction, "must be in [0, 2)"));
+  if (!(ice.friction >= 0 && ice.friction < 2))
+    out.push_back(range_text("ice.mu_ice_structure", ice.friction, "must be in [0, 2)"));
 }
 
 // A cone's slope and width, and the friction the slope can carry.
@@ -63,7 +64,8 @@ void throw_if(const std::vector<std::string>& problems, const char* what) {
 }  // namespace
 
 double characteristic_length_m(const StructureIce& ice) {
-  const double d = ice.youngs_modulus_pa * std::pow(ice.thickness_m, 3) / (12 * (1 - ice.poisson_ratio * ice.poisson_ratio));
+  const double nu = ice.poisson_ratio;
+  const double d = ice.youngs_modulus_pa * std::pow(ice.thickness_m, 3) / (12 * (1 - nu * nu));
   return std::pow(d / (ice.water_density_kg_m3 * ice.gravity_mps2), 0.25);
 }
 

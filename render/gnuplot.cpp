@@ -70,8 +70,9 @@ void run_gnuplot(const fs::path& script, const fs::path& log, const std::vector<
                   read_text(log));
   for (const fs::path& image : images) {
     std::error_code ec;
-    FLOESIM_REQUIRE(fs::file_size(image, ec) > 0 && !ec, "gnuplot wrote no image drawing ", what, ":\n",
-                    read_text(log));
+    // An empty or missing image after exit 0 is a write that failed, most often for a full disk: say which.
+    FLOESIM_REQUIRE(fs::file_size(image, ec) > 0 && !ec, image.string(), ": gnuplot wrote no image drawing ", what,
+                    ": ", cut_short_reason(image.parent_path()), "\n", read_text(log));
     // gnuplot may exit 0 after a failed write (a full disk): the image must be whole, a PNG that decodes, an
     // SVG that ends.
     if (image.extension() == ".png")

@@ -60,7 +60,8 @@ struct StructureShapeOptions {
   int sides = 32;                   // vertices of a round section
   template <class V>
   void visit(V& v) {
-    v.field("shape", shape, "-", "cone, cylinder (vertical) or caisson (a box)", one_of({"cone", "cylinder", "caisson"}));
+    v.field("shape", shape, "-", "cone, cylinder (vertical) or caisson (a box)",
+            one_of({"cone", "cylinder", "caisson"}));
     v.field("breaking", breaking, "-",
             "cone: upward (widens downwards from a neck above the waterline) or downward (widens upwards from a neck "
             "below it)",

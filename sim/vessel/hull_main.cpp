@@ -1,6 +1,7 @@
 // floesim-hull: writes the parametric icebreaker (Oden's main particulars by default), a structure from parameters
-// (a config with "structure": cylinder, caisson, cone), or places and decomposes a user's mesh (a config with "file"), as an OBJ of convex parts with a JSON sidecar of particulars, hydrostatics,
-// the angles and lengths the ice-resistance formulas take (measured from the mesh) and provenance.
+// (a config with "structure": cylinder, caisson, cone), or places and decomposes a user's mesh (a config with
+// "file"), as an OBJ of convex parts with a JSON sidecar of particulars, hydrostatics, the angles and lengths the
+// ice-resistance formulas take (measured from the mesh) and provenance.
 #include <iostream>
 
 #include <CLI/CLI.hpp>
@@ -26,7 +27,8 @@ int main(int argc, char** argv) {
   CLI::App app{"Writes a hull as an OBJ of convex parts (one object per part) plus FILE.json with its hydrostatics\n"
                "and the particulars the ice-resistance formulas take (stem angle, entrance angle, flare, L, B, T,\n"
                "parallel midbody, bow length; measured from the mesh): the parametric icebreaker (config: generator\n"
-               "options), or a user's mesh placed in the hull frame and cut into convex parts (config with \"file\":\n"
+               "options), a structure from parameters (config with \"structure\": cylinder, caisson, cone), or a\n"
+               "user's mesh placed in the hull frame and cut into convex parts (config with \"file\":\n"
                "the case's hull section).",
                "floesim-hull"};
   std::string config, out;
@@ -40,7 +42,7 @@ int main(int argc, char** argv) {
     if (help_config) {
       std::cout << "Parametric icebreaker (a config without \"file\" or \"structure\"):\n\n"
                 << floesim::options_doc(sim::HullGeneratorOptions{})
-                << "\nA structure (a config with \"structure\", as a case's hull section):\n\n"
+                << "\nA structure (a config with \"structure\"; not yet a case's hull):\n\n"
                 << floesim::options_doc(StructureHullConfig{})
                 << "\nA user's mesh (a config with \"file\", as a case's hull section):\n\n"
                 << floesim::options_doc(sim::HullImportOptions{});

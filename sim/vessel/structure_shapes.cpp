@@ -53,8 +53,9 @@ std::vector<TriMesh> generate_structure(const StructureShapeOptions& o) {
   // The cone: the radius changes by dz / tan(alpha) per metre of height, the waterline radius w / 2.
   const double cot = 1 / std::tan(o.slope_deg * kPi / 180), neck = neck_offset_m(o), rn = o.neck_width_m / 2;
   if (o.breaking == "upward") {
-    FLOESIM_REQUIRE(neck < zt, "structure: the cone reaches its neck ", neck, " m above the waterline, beyond its top at "
-                    "height_m = ", zt, " m: raise height_m or widen neck_width_m");
+    FLOESIM_REQUIRE(neck < zt, "structure: the cone reaches its neck ", neck,
+                    " m above the waterline, beyond its top at height_m = ", zt,
+                    " m: raise height_m or widen neck_width_m");
     std::vector<TriMesh> parts = {frustum(w / 2 + o.depth_m * cot, zb, rn, neck, o.sides)};
     parts.push_back(frustum(rn, neck, rn, zt, o.sides));
     return parts;
@@ -78,8 +79,8 @@ std::string write_generated_structure(const StructureShapeOptions& o, const fs::
   shape << o.shape;
   if (o.shape == "cone")
     shape << " (" << o.breaking << "-breaking), waterline diameter " << o.waterline_width_m << " m, neck "
-          << o.neck_width_m << " m " << fmt_num(neck_offset_m(o)) << " m " << (o.breaking == "upward" ? "above" : "below")
-          << " the waterline, slope " << o.slope_deg << " deg";
+          << o.neck_width_m << " m " << fmt_num(neck_offset_m(o)) << " m "
+          << (o.breaking == "upward" ? "above" : "below") << " the waterline, slope " << o.slope_deg << " deg";
   else if (o.shape == "cylinder")
     shape << ", diameter " << o.waterline_width_m << " m";
   else
@@ -91,9 +92,9 @@ std::string write_generated_structure(const StructureShapeOptions& o, const fs::
        << "written by floesim-hull " << version() << "; frame: x the way the ice comes from, y to port, z up, "
        << "metres; calm waterline z = 0; origin on the axis at the waterline\n";
   nlohmann::json side;
-  side["provenance"] = make_provenance(
-      "floesim-hull", config_file.empty() ? std::vector<NamedInput>{} : std::vector<NamedInput>{{"config", config_file}},
-      options_to_json(o));
+  const std::vector<NamedInput> inputs =
+      config_file.empty() ? std::vector<NamedInput>{} : std::vector<NamedInput>{{"config", config_file}};
+  side["provenance"] = make_provenance("floesim-hull", inputs, options_to_json(o));
   side["hull_file"] = out_obj.filename().string();
   side["frame"] = "z up; calm waterline z = 0; origin on the structure's axis at the waterline; metres";
   side["parts"] = parts.size();

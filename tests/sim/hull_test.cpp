@@ -188,7 +188,8 @@ double frustum_volume(double a0, double a1, double h) { return h * (a0 + a1 + st
 std::pair<double, double> side_face_lean(const TriMesh& part, double slope_deg) {
   double worst = 0, sign = 0;
   for (const auto& t : part.triangles) {
-    const Vec3 n = (part.vertices[t[1]] - part.vertices[t[0]]).cross(part.vertices[t[2]] - part.vertices[t[0]]).normalized();
+    const Vec3& a = part.vertices[t[0]];
+    const Vec3 n = (part.vertices[t[1]] - a).cross(part.vertices[t[2]] - a).normalized();
     if (std::abs(n.z()) > 1 - 1e-9 || std::abs(n.z()) < 1e-9) continue;  // a cap or a vertical side
     worst = std::max(worst, std::abs(std::acos(std::abs(n.z())) * 180 / kPi - slope_deg));
     sign = n.z() > 0 ? 1 : -1;
