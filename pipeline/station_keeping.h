@@ -1,8 +1,8 @@
 // Station keeping in ice by closed forms (PHYSICS.md §8.4): the quasi-static catenary of a mooring line with a part
 // grounded on a horizontal seabed (inextensible, no seabed friction, the anchor pulled horizontally), a spread of such
 // lines holding a body (its restoring force at an offset, its linear stiffness, the offset under a steady load), and
-// the PID gains of a dynamic-positioning controller. In the core, so that the engine's moored bodies, the structure
-// formula tool and the tests use the same lines.
+// the PID gains of a dynamic-positioning controller. In the core, so that the structure formula tool, the tests and
+// (issue #34's next step) the engine's moored bodies use the same lines.
 //
 // Units are SI (N, m; azimuths in degrees at the interface). Lines lie in the horizontal plane of the fairleads:
 // x forward, y to port. Functions throw an Error listing what is wrong, each problem naming the field.
