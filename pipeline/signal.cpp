@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <boost/math/distributions/students_t.hpp>
 
@@ -151,6 +152,75 @@ double uniform_step(const std::vector<double>& t, const char* what) {
                     " against a mean step of ", dt, " s");
   }
   return dt;
+}
+
+LoadCycles load_cycles(const std::vector<double>& x, double dt_s, double band_std) {
+  FLOESIM_REQUIRE(dt_s > 0, "load_cycles: the sample step must be > 0, got ", dt_s);
+  FLOESIM_REQUIRE(band_std >= 0, "load_cycles: the hysteresis band must be >= 0 standard deviations, got ", band_std);
+  LoadCycles c;
+  c.mean_peak = c.mean_period_s = std::numeric_limits<double>::quiet_NaN();
+  const size_t n = x.size();
+  if (n < 3) return c;
+  double mean = 0;
+  for (double v : x) mean += v;
+  mean /= static_cast<double>(n);
+  double var = 0;
+  for (double v : x) var += (v - mean) * (v - mean);
+  const double band = band_std * std::sqrt(var / static_cast<double>(n));
+  // Armed once the series is below mean - band; an up-crossing of the mean while armed starts a cycle.
+  bool armed = x[0] < mean - band;
+  for (size_t i = 1; i < n; ++i) {
+    if (x[i] < mean - band) armed = true;
+    if (armed && x[i - 1] < mean && x[i] >= mean) {
+      c.crossings.push_back(i);
+      armed = x[i] < mean - band;
+    }
+  }
+  for (size_t k = 0; k + 1 < c.crossings.size(); ++k) {
+    size_t best = c.crossings[k];
+    for (size_t i = c.crossings[k]; i < c.crossings[k + 1]; ++i)
+      if (x[i] > x[best]) best = i;
+    c.peak_index.push_back(best);
+    c.peak.push_back(x[best]);
+  }
+  if (!c.peak.empty()) {
+    double sum = 0;
+    for (double p : c.peak) sum += p;
+    c.mean_peak = sum / static_cast<double>(c.peak.size());
+    c.mean_period_s = dt_s * static_cast<double>(c.crossings.back() - c.crossings.front()) /
+                      static_cast<double>(c.peak.size());
+  }
+  return c;
+}
+
+double dominant_period_s(const std::vector<double>& x, double dt_s, double min_period_s, double max_period_s) {
+  FLOESIM_REQUIRE(dt_s > 0 && min_period_s > 0 && max_period_s > min_period_s,
+                  "dominant_period_s: needs dt > 0 and 0 < min_period_s < max_period_s, got dt ", dt_s, ", ",
+                  min_period_s, " .. ", max_period_s, " s");
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const size_t n = x.size();
+  const size_t lo = std::max<size_t>(1, static_cast<size_t>(std::floor(min_period_s / dt_s)));
+  const size_t hi = static_cast<size_t>(std::ceil(max_period_s / dt_s));
+  if (n < 2 * (hi + 1)) return nan;
+  double mean = 0;
+  for (double v : x) mean += v;
+  mean /= static_cast<double>(n);
+  // The autocorrelation r(k) = sum (x_i - m)(x_{i+k} - m) / n (the biased estimate: it tapers with the lag, so of
+  // a period's multiples, equal in a periodic signal, the shortest wins), one lag beyond each end for the parabola.
+  auto r = [&](size_t k) {
+    double s = 0;
+    for (size_t i = 0; i + k < n; ++i) s += (x[i] - mean) * (x[i + k] - mean);
+    return s / static_cast<double>(n);
+  };
+  if (!(r(0) > 0)) return nan;
+  std::vector<double> rk(hi + 2);
+  for (size_t k = lo - 1; k <= hi + 1; ++k) rk[k] = r(k);
+  size_t best = lo;
+  for (size_t k = lo; k <= hi; ++k)
+    if (rk[k] > rk[best]) best = k;
+  const double a = rk[best - 1], b = rk[best], c = rk[best + 1], d = a - 2 * b + c;
+  const double shift = d < 0 ? 0.5 * (a - c) / d : 0.0;
+  return dt_s * (static_cast<double>(best) + std::clamp(shift, -0.5, 0.5));
 }
 
 }  // namespace floesim

@@ -60,6 +60,27 @@ struct ConfidenceInterval {
 // Error if level is not in (0, 1) or a sample is not finite.
 ConfidenceInterval student_t_interval(const std::vector<double>& x, double level = 0.95);
 
+// Load cycles of a structure in ice (issue #34; PHYSICS.md §8.2.4-8.2.5): the series is cut into cycles at its
+// up-crossings of its mean, with a hysteresis band of `band_std` standard deviations (a crossing counts once the
+// series has been below mean - band since the last one, so that noise on a slow rise does not split a cycle). Each
+// cycle from one up-crossing to the next holds one peak, its largest sample; the incomplete parts before the first
+// and after the last crossing are left out. `mean_peak` is the mean of the cycles' peaks (NaN without a whole
+// cycle), `mean_period_s` the mean cycle length.
+struct LoadCycles {
+  std::vector<size_t> crossings;  // samples of the up-crossings (a cycle is [crossings[k], crossings[k+1]))
+  std::vector<size_t> peak_index;
+  std::vector<double> peak;
+  double mean_peak = 0;
+  double mean_period_s = 0;
+};
+LoadCycles load_cycles(const std::vector<double>& x, double dt_s, double band_std = 0.1);
+
+// The dominant period of a series: the lag in [min_period_s, max_period_s] at which its autocorrelation (about its
+// mean; the biased estimate, which tapers with the lag so that a period wins over its multiples) is largest, refined
+// by a parabola through that lag and its neighbours. NaN when the series is constant or
+// shorter than two of the longest lag. O(n x lags).
+double dominant_period_s(const std::vector<double>& x, double dt_s, double min_period_s, double max_period_s);
+
 // Sample step of a time column: (t_last - t_first) / (n - 1); Error if fewer than 2 samples, not increasing, or
 // not uniform to 1 % (the averages above assume a fixed step).
 double uniform_step(const std::vector<double>& t, const char* what);

@@ -1,5 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
 #include "pipeline/error.h"
 #include "pipeline/signal.h"
 #include "pipeline/units.h"
@@ -12,6 +16,55 @@ std::vector<double> ramp(size_t n, double a, double b) {
   for (size_t i = 0; i < n; ++i) x[i] = a + b * static_cast<double>(i);
   return x;
 }
+
+// Load cycles of a structure (issue #34). An ISO-like sawtooth (PHYSICS.md §8.2.4: rises over 80 % of its period from
+// 0.1 to 1.0 and drops at once), 4 s period at 0.01 s: every whole cycle peaks at exactly 1.0 and the up-crossings of
+// the mean are exactly 400 samples apart, so the mean peak is 1.0 and the period 4 s to round-off; the autocorrelation
+// peaks at 4 s.
+TEST(LoadCycles, SawtoothPeaksAndPeriodAreItsOwn) {
+  const double dt = 0.01;
+  std::vector<double> x;
+  for (int cycle = 0; cycle < 25; ++cycle) {
+    for (int i = 0; i < 320; ++i) x.push_back(0.1 + 0.9 * i / 319.0);  // 0.1 .. 1.0 in 320 samples
+    for (int i = 0; i < 80; ++i) x.push_back(0.1);
+  }
+  const LoadCycles c = load_cycles(x, dt);
+  ASSERT_EQ(c.crossings.size(), 25u);  // one per cycle (the first rise crosses too)
+  EXPECT_EQ(c.peak.size(), 24u);
+  EXPECT_DOUBLE_EQ(c.mean_peak, 1.0);
+  EXPECT_NEAR(c.mean_period_s, 4.0, 1e-12);
+  for (size_t k = 0; k + 1 < c.crossings.size(); ++k) EXPECT_EQ(c.crossings[k + 1] - c.crossings[k], 400u);
+  EXPECT_NEAR(dominant_period_s(x, dt, 1.0, 10.0), 4.0, dt);
+}
+
+// A sine of period 7.3 s and amplitude 1 with uniform noise of +-0.3 (a fixed linear congruential sequence): the
+// autocorrelation finds 7.3 s within two samples; a hysteresis band of one standard deviation (0.73, more than twice
+// the noise's reach) keeps one cycle per period (the noise makes many spurious crossings of the mean without it),
+// and each cycle's peak is the sine's 1 give or take the noise.
+TEST(LoadCycles, HysteresisKeepsNoisyCyclesWhole) {
+  const double dt = 0.01, period = 7.3, duration = 73.0 * 2;
+  uint64_t state = 12345;
+  auto noise = [&] {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return 0.6 * (static_cast<double>(state >> 11) / 9007199254740992.0 - 0.5);
+  };
+  std::vector<double> x;
+  for (int i = 0; i < static_cast<int>(duration / dt); ++i)
+    x.push_back(std::sin(2 * 3.14159265358979323846 * i * dt / period) + noise());
+  EXPECT_NEAR(dominant_period_s(x, dt, 2.0, 20.0), period, 2 * dt);
+  const LoadCycles c = load_cycles(x, dt, 1.0);
+  EXPECT_EQ(c.peak.size(), 19u);  // 20 periods: 20 up-crossings, 19 whole cycles between them
+  EXPECT_NEAR(c.mean_period_s, period, 0.05);
+  for (double p : c.peak) {
+    EXPECT_GT(p, 1.0 - 0.3);
+    EXPECT_LE(p, 1.0 + 0.3);
+  }
+  EXPECT_GT(load_cycles(x, dt, 0.0).peak.size(), 40u);  // without the band the noise splits the cycles
+  // A constant series has no period and no cycle.
+  EXPECT_TRUE(std::isnan(dominant_period_s(std::vector<double>(5000, 2.0), dt, 1.0, 10.0)));
+  EXPECT_TRUE(std::isnan(load_cycles(std::vector<double>(5000, 2.0), dt).mean_peak));
+}
+
 }  // namespace
 
 TEST(Signal, WindowSamplesRoundsAndIsAtLeastOne) {
