@@ -1,6 +1,8 @@
 #include "pipeline/station_keeping.h"
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 #include <sstream>
 
 #include "pipeline/error.h"
@@ -196,6 +198,75 @@ DpGains dp_gains(double mass_kg, double natural_period_s, double damping_ratio) 
   g.derivative = 2 * damping_ratio * mass_kg * wn;
   g.integral = g.proportional * wn / 10;
   return g;
+}
+
+namespace {
+
+// The angle a - b wrapped to (-pi, pi].
+double angle_difference(double a, double b) {
+  double d = std::fmod(a - b, 2 * kPi);
+  if (d > kPi) d -= 2 * kPi;
+  if (d <= -kPi) d += 2 * kPi;
+  return d;
+}
+
+}  // namespace
+
+DpController::DpController(const DpControllerSettings& s, double xs, double ys, double psis, double x0, double y0,
+                           double psi0)
+    : s_(s), set_{xs, ys, psis}, est_{x0, y0, psi0}, integral_{0, 0, 0}, prev_{x0, y0, psi0} {
+  std::vector<std::string> p;
+  for (const auto& [g, name] : {std::pair{&s.surge, "surge"}, std::pair{&s.sway, "sway"}, std::pair{&s.yaw, "yaw"}})
+    if (!(g->proportional >= 0 && g->derivative >= 0 && g->integral >= 0))
+      p.push_back(std::string("dp.") + name + " gains must be >= 0 (a negative gain pushes away from the set point)");
+  if (!(s.max_force_x_n > 0 && s.max_force_y_n > 0 && s.max_moment_z_nm > 0))
+    p.push_back("dp thrust limits (max_force_x_n, max_force_y_n, max_moment_z_nm) must be > 0");
+  if (!(s.observer_time_constant_s >= 0))
+    p.push_back("dp.observer_time_constant_s must be >= 0, got " + text(s.observer_time_constant_s));
+  throw_if(p, "dynamic positioning");
+}
+
+DpCommand DpController::step(double dt, double x, double y, double psi) {
+  // 1. The observer: x_est += (x - x_est) dt / (T + dt) (backward Euler of the first-order low-pass).
+  const double a = s_.observer_time_constant_s > 0 ? dt / (s_.observer_time_constant_s + dt) : 1.0;
+  est_[0] += a * (x - est_[0]);
+  est_[1] += a * (y - est_[1]);
+  est_[2] += a * angle_difference(psi, est_[2]);
+  // 2. Errors (earth frame) and their rates from the observed pose.
+  const double e[3] = {est_[0] - set_[0], est_[1] - set_[1], angle_difference(est_[2], set_[2])};
+  double rate[3] = {0, 0, 0};
+  if (!first_) {
+    rate[0] = (est_[0] - prev_[0]) / dt;
+    rate[1] = (est_[1] - prev_[1]) / dt;
+    rate[2] = angle_difference(est_[2], prev_[2]) / dt;
+  }
+  first_ = false;
+  for (int k = 0; k < 3; ++k) prev_[k] = est_[k];
+  // 3. PID in the earth frame with the integral as it stands, turned into body axes, clipped at the limits.
+  const DpGains* g[3] = {&s_.surge, &s_.sway, &s_.yaw};
+  auto earth_command = [&](const double* integral, double* out) {
+    // Surge and sway gains act along the body axes: the earth-frame error is turned into body axes first.
+    const double c = std::cos(est_[2]), sn = std::sin(est_[2]);
+    const double eb[3] = {c * e[0] + sn * e[1], -sn * e[0] + c * e[1], e[2]};
+    const double rb[3] = {c * rate[0] + sn * rate[1], -sn * rate[0] + c * rate[1], rate[2]};
+    const double ib[3] = {c * integral[0] + sn * integral[1], -sn * integral[0] + c * integral[1], integral[2]};
+    for (int k = 0; k < 3; ++k) out[k] = -(g[k]->proportional * eb[k] + g[k]->derivative * rb[k] + g[k]->integral * ib[k]);
+  };
+  const double limit[3] = {s_.max_force_x_n, s_.max_force_y_n, s_.max_moment_z_nm};
+  DpCommand cmd;
+  earth_command(integral_, cmd.demanded);
+  // 4. Conditional integration: the error enters the integral on an axis unless that axis is saturated and the
+  // error would drive it further into the limit.
+  double trial[3] = {integral_[0] + e[0] * dt, integral_[1] + e[1] * dt, integral_[2] + e[2] * dt};
+  double with[3];
+  earth_command(trial, with);
+  bool hold = false;
+  for (int k = 0; k < 3; ++k)
+    if (std::abs(cmd.demanded[k]) >= limit[k] && std::abs(with[k]) > std::abs(cmd.demanded[k])) hold = true;
+  if (!hold)
+    for (int k = 0; k < 3; ++k) integral_[k] = trial[k];
+  for (int k = 0; k < 3; ++k) cmd.delivered[k] = std::clamp(cmd.demanded[k], -limit[k], limit[k]);
+  return cmd;
 }
 
 }  // namespace floesim

@@ -76,4 +76,40 @@ struct DpGains {
 };
 DpGains dp_gains(double mass_kg, double natural_period_s, double damping_ratio);
 
+// A dynamic-positioning controller (§8.4.2): PID on the earth-frame position (x, y) and heading psi about a set
+// point, fed by a first-order low-pass observer of the measured pose (floe impacts at 0.05-0.5 Hz lie far above the
+// DP bandwidth: unfiltered, the D-term would chase single floes), its command turned into body axes and clipped at
+// the thrusters' limits. The integral stops growing on an axis that is saturated and would saturate further
+// (conditional integration: no wind-up).
+struct DpControllerSettings {
+  DpGains surge, sway, yaw;          // gains per degree of freedom (yaw: N m/rad, N m s/rad, N m/(rad s))
+  double max_force_x_n = 0;          // thrust limits, body axes: surge, sway force and yaw moment (> 0)
+  double max_force_y_n = 0;
+  double max_moment_z_nm = 0;
+  double observer_time_constant_s = 10;  // the low-pass observer's time constant (0: the measured pose as it is)
+};
+
+// The demanded (before the limits) and delivered (after) generalised force, body axes: surge, sway, yaw moment.
+struct DpCommand {
+  double demanded[3] = {0, 0, 0};
+  double delivered[3] = {0, 0, 0};
+};
+
+class DpController {
+ public:
+  // The set point (earth frame) and the pose at the start (the observer starts there, the integral at 0).
+  DpController(const DpControllerSettings& s, double x_set_m, double y_set_m, double psi_set_rad, double x0_m,
+               double y0_m, double psi0_rad);
+  // One control step of dt seconds with the measured pose: the command the thrusters are to give until the next.
+  DpCommand step(double dt_s, double x_m, double y_m, double psi_rad);
+
+ private:
+  DpControllerSettings s_;
+  double set_[3];
+  double est_[3];       // the observer's pose
+  double integral_[3];  // of the error, earth frame (x, y) and heading
+  bool first_ = true;
+  double prev_[3];
+};
+
 }  // namespace floesim
