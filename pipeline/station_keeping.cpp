@@ -100,10 +100,17 @@ MooringLeg leg_from_pretension(const CatenaryLine& line, double azimuth_deg, dou
 }
 
 SpreadState spread_at_offset(const std::vector<MooringLeg>& legs, double dx, double dy) {
+  return spread_at_pose(legs, dx, dy, 0.0);
+}
+
+SpreadState spread_at_pose(const std::vector<MooringLeg>& legs, double dx, double dy, double dpsi) {
   SpreadState r;
+  const double c = std::cos(dpsi), sn = std::sin(dpsi);
   for (size_t i = 0; i < legs.size(); ++i) {
     const MooringLeg& g = legs[i];
-    const double vx = g.anchor_x_m - (g.fairlead_x_m + dx), vy = g.anchor_y_m - (g.fairlead_y_m + dy);
+    // The fairlead turned with the body about its reference point, then moved with it.
+    const double fx = c * g.fairlead_x_m - sn * g.fairlead_y_m, fy = sn * g.fairlead_x_m + c * g.fairlead_y_m;
+    const double vx = g.anchor_x_m - (fx + dx), vy = g.anchor_y_m - (fy + dy);
     const double x = std::hypot(vx, vy);
     CatenaryState s;
     try {
@@ -112,8 +119,10 @@ SpreadState spread_at_offset(const std::vector<MooringLeg>& legs, double dx, dou
       throw Error("mooring leg " + std::to_string(i) + " at the offset (" + text(dx) + ", " + text(dy) + ") m: " +
                   e.what());
     }
-    r.force_x_n += s.horizontal_tension_n * vx / x;
-    r.force_y_n += s.horizontal_tension_n * vy / x;
+    const double px = s.horizontal_tension_n * vx / x, py = s.horizontal_tension_n * vy / x;
+    r.force_x_n += px;
+    r.force_y_n += py;
+    r.moment_z_nm += fx * py - fy * px;  // the lever from the reference point to the turned fairlead
     r.lines.push_back(s);
   }
   return r;

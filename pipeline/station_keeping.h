@@ -52,10 +52,13 @@ MooringLeg leg_from_pretension(const CatenaryLine& line, double azimuth_deg, dou
 
 struct SpreadState {
   double force_x_n = 0, force_y_n = 0;   // restoring force on the body
+  double moment_z_nm = 0;                // and yaw moment about its reference point
   std::vector<CatenaryState> lines;     // each leg's line
 };
 // The legs' pull on the body translated by (dx, dy) from its station (no rotation).
 SpreadState spread_at_offset(const std::vector<MooringLeg>& legs, double dx_m, double dy_m);
+// The same with the body also turned by dpsi (rad, about its reference point): the fairleads turn with it.
+SpreadState spread_at_pose(const std::vector<MooringLeg>& legs, double dx_m, double dy_m, double dpsi_rad);
 // Linear surge-sway stiffness at the station: K = sum k_H n n^T + (H / X)(I - n n^T), n each leg's horizontal unit
 // vector (the second term the geometric stiffness of lines across the offset). Row-major [xx, xy, yx, yy].
 std::vector<double> spread_linear_stiffness(const std::vector<MooringLeg>& legs);

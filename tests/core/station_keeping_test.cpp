@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <functional>
 #include <string>
+#include <utility>
 
 #include "pipeline/error.h"
 #include "pipeline/station_keeping.h"
@@ -173,6 +174,50 @@ TEST(DynamicPositioning, NegativeGainsAreRefusedNamingTheAxis) {
   s.sway.derivative = 1;
   s.max_moment_z_nm = 0;
   EXPECT_NE(error_of([&] { DpController(s, 0, 0, 0, 0, 0, 0); }).find("limits"), std::string::npos);
+}
+
+
+// A barge's four lines from its corners (+-20, +-10) m, each anchored along its corner's diagonal at 300 kN
+// pretension, the barge moved by (1.0, -0.5) m and turned by 0.05 rad. The restoring force and yaw moment, summed
+// from each line's pull at its turned fairlead, equal the virtual work of the lines' horizontal tensions,
+// -sum H_i dX_i/dq for q = x, y, psi, with the spans X_i differentiated numerically from the geometry alone.
+TEST(SpreadMooring, ForceAndYawMomentAreTheLinesVirtualWork) {
+  std::vector<MooringLeg> legs;
+  for (const auto& [x, y] : {std::pair{20.0, 10.0}, std::pair{-20.0, 10.0}, std::pair{-20.0, -10.0},
+                             std::pair{20.0, -10.0}}) {
+    const double span = catenary_at_tension(chain(), 300e3).span_m, d = std::hypot(x, y);
+    MooringLeg g;
+    g.line = chain();
+    g.fairlead_x_m = x;
+    g.fairlead_y_m = y;
+    g.anchor_x_m = x + span * x / d;
+    g.anchor_y_m = y + span * y / d;
+    legs.push_back(g);
+  }
+  const double q[3] = {1.0, -0.5, 0.05};
+  const SpreadState s = spread_at_pose(legs, q[0], q[1], q[2]);
+  auto span = [&](const MooringLeg& g, const double* p) {
+    const double c = std::cos(p[2]), sn = std::sin(p[2]);
+    return std::hypot(g.anchor_x_m - (c * g.fairlead_x_m - sn * g.fairlead_y_m + p[0]),
+                      g.anchor_y_m - (sn * g.fairlead_x_m + c * g.fairlead_y_m + p[1]));
+  };
+  double work[3] = {0, 0, 0};
+  for (int k = 0; k < 3; ++k) {
+    const double h = k < 2 ? 1e-5 : 1e-7;
+    double up[3] = {q[0], q[1], q[2]}, down[3] = {q[0], q[1], q[2]};
+    up[k] += h;
+    down[k] -= h;
+    for (size_t i = 0; i < legs.size(); ++i)
+      work[k] -= s.lines[i].horizontal_tension_n * (span(legs[i], up) - span(legs[i], down)) / (2 * h);
+  }
+  EXPECT_NEAR(s.force_x_n, work[0], 1e-6 * 300e3);
+  EXPECT_NEAR(s.force_y_n, work[1], 1e-6 * 300e3);
+  EXPECT_NEAR(s.moment_z_nm, work[2], 1e-6 * 300e3 * 20);
+  EXPECT_LT(s.moment_z_nm, 0);  // turned anticlockwise, pulled back
+  // At the station the four pretensions cancel, force and moment.
+  const SpreadState rest = spread_at_pose(legs, 0, 0, 0);
+  EXPECT_NEAR(rest.force_x_n, 0, 1e-6);
+  EXPECT_NEAR(rest.moment_z_nm, 0, 1e-5);
 }
 
 }  // namespace
