@@ -251,24 +251,25 @@ DpCommand DpController::step(double dt, double x, double y, double psi) {
   }
   first_ = false;
   for (int k = 0; k < 3; ++k) prev_[k] = est_[k];
-  // 3. PID in the earth frame with the integral as it stands, turned into body axes, clipped at the limits.
+  // 3. The PID command in body axes (surge and sway gains act along the body's axes, so the earth-frame error, rate
+  // and integral are turned into them first), with the integral as it stands; clipped at the limits below.
   const DpGains* g[3] = {&s_.surge, &s_.sway, &s_.yaw};
-  auto earth_command = [&](const double* integral, double* out) {
-    // Surge and sway gains act along the body axes: the earth-frame error is turned into body axes first.
+  auto body_command = [&](const double* integral, double* out) {
     const double c = std::cos(est_[2]), sn = std::sin(est_[2]);
     const double eb[3] = {c * e[0] + sn * e[1], -sn * e[0] + c * e[1], e[2]};
     const double rb[3] = {c * rate[0] + sn * rate[1], -sn * rate[0] + c * rate[1], rate[2]};
     const double ib[3] = {c * integral[0] + sn * integral[1], -sn * integral[0] + c * integral[1], integral[2]};
-    for (int k = 0; k < 3; ++k) out[k] = -(g[k]->proportional * eb[k] + g[k]->derivative * rb[k] + g[k]->integral * ib[k]);
+    for (int k = 0; k < 3; ++k)
+      out[k] = -(g[k]->proportional * eb[k] + g[k]->derivative * rb[k] + g[k]->integral * ib[k]);
   };
   const double limit[3] = {s_.max_force_x_n, s_.max_force_y_n, s_.max_moment_z_nm};
   DpCommand cmd;
-  earth_command(integral_, cmd.demanded);
-  // 4. Conditional integration: the error enters the integral on an axis unless that axis is saturated and the
-  // error would drive it further into the limit.
+  body_command(integral_, cmd.demanded);
+  // 4. Conditional integration: this step's error enters the integral unless some axis is saturated and the error
+  // would drive it further into its limit (then the integral is held on every axis, as it is kept in earth axes).
   double trial[3] = {integral_[0] + e[0] * dt, integral_[1] + e[1] * dt, integral_[2] + e[2] * dt};
   double with[3];
-  earth_command(trial, with);
+  body_command(trial, with);
   bool hold = false;
   for (int k = 0; k < 3; ++k)
     if (std::abs(cmd.demanded[k]) >= limit[k] && std::abs(with[k]) > std::abs(cmd.demanded[k])) hold = true;
