@@ -4,12 +4,11 @@
 #include <sstream>
 
 #include "pipeline/error.h"
+#include "pipeline/geometry2d.h"
 
 namespace floesim {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 double rad(double deg) { return deg * kPi / 180.0; }
 

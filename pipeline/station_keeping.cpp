@@ -6,12 +6,11 @@
 #include <sstream>
 
 #include "pipeline/error.h"
+#include "pipeline/geometry2d.h"
 
 namespace floesim {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 template <class T>
 std::string text(const T& v) {

@@ -9,29 +9,15 @@
 
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
+#include "pipeline/geometry2d.h"
 #include "pipeline/provenance.h"
+#include "sim/analysis/table_text.h"
 
 namespace fs = std::filesystem;
 
 namespace floesim::sim {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-std::string shortest(double v) {
-  char buf[64];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
-
-std::string fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
-
-double kn(double n) { return n / 1e3; }
 
 // One thickness's loads on the structure.
 struct ThicknessRow {

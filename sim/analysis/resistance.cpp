@@ -9,29 +9,11 @@
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
 #include "pipeline/provenance.h"
+#include "sim/analysis/table_text.h"
 
 namespace fs = std::filesystem;
 
 namespace floesim::sim {
-
-namespace {
-
-// The shortest text that reads back as the same double (as floesim-gather writes its tables).
-std::string shortest(double v) {
-  char buf[64];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
-
-std::string fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
-
-double kn(double n) { return n / 1e3; }
-
-}  // namespace
 
 LevelIce level_ice(const IceResistanceOptions& o, double h) {
   LevelIce i;

@@ -279,6 +279,32 @@ void write_obj(const fs::path& file, const std::vector<TriMesh>& parts, const st
   f.commit();
 }
 
+namespace detail {
+
+nlohmann::json generated_mesh_json(const std::vector<TriMesh>& parts, const Hydrostatics& h, double rho_w) {
+  const Bounds b(merge(parts).vertices);
+  size_t nv = 0, nt = 0;
+  for (const TriMesh& p : parts) nv += p.vertices.size(), nt += p.triangles.size();
+  return {{"parts", parts.size()},
+          {"vertices", nv},
+          {"triangles", nt},
+          {"extent_m", {{"x", {b.lo.x(), b.hi.x()}}, {"y", {b.lo.y(), b.hi.y()}}, {"z", {b.lo.z(), b.hi.z()}}}},
+          {"hydrostatics", hydrostatics_json(h, rho_w)}};
+}
+
+fs::path write_generated_files(const std::vector<TriMesh>& parts, const fs::path& out_obj, const std::string& header,
+                               const nlohmann::json& side) {
+  fs::path sidecar = out_obj;
+  sidecar.replace_extension(".json");
+  FLOESIM_REQUIRE(sidecar != out_obj, out_obj.string(), ": the hull file must not end in .json (the sidecar does)");
+  ensure_directory(out_obj.parent_path());
+  write_obj(out_obj, parts, header);
+  write_text_atomic(sidecar, side.dump(2) + "\n");
+  return sidecar;
+}
+
+}  // namespace detail
+
 std::string write_generated_hull(const HullGeneratorOptions& o, const fs::path& out_obj, const fs::path& config_file) {
   const std::vector<TriMesh> parts = generate_hull(o);
   constexpr double rho_w = 1025.0;
@@ -306,20 +332,10 @@ std::string write_generated_hull(const HullGeneratorOptions& o, const fs::path& 
       options_to_json(o));
   side["hull_file"] = out_obj.filename().string();
   side["frame"] = "x forward, y to port, z up; calm waterline z = 0; origin midship on the centreline; metres";
-  side["parts"] = parts.size();
-  side["vertices"] = nv;
-  side["triangles"] = nt;
-  side["extent_m"] = {{"x", {b.lo.x(), b.hi.x()}}, {"y", {b.lo.y(), b.hi.y()}}, {"z", {b.lo.z(), b.hi.z()}}};
-  side["hydrostatics"] = hydrostatics_json(h, rho_w);
+  side.update(generated_mesh_json(parts, h, rho_w));
   std::ostringstream particulars_text;
   add_particulars(merge(parts), "the generated hull", side, particulars_text);
-
-  fs::path sidecar = out_obj;
-  sidecar.replace_extension(".json");
-  FLOESIM_REQUIRE(sidecar != out_obj, out_obj.string(), ": the hull file must not end in .json (the sidecar does)");
-  ensure_directory(out_obj.parent_path());
-  write_obj(out_obj, parts, head.str());
-  write_text_atomic(sidecar, side.dump(2) + "\n");
+  const fs::path sidecar = write_generated_files(parts, out_obj, head.str(), side);
 
   std::ostringstream sum;
   sum << "hull: " << parts.size() << " convex parts, " << nv << " vertices, " << nt << " triangles -> "

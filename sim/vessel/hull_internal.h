@@ -40,6 +40,14 @@ struct Bounds {
 // The hydrostatics block of a hull sidecar (generated and imported hulls alike).
 nlohmann::json hydrostatics_json(const Hydrostatics& h, double rho_w);
 
+// The mesh's part of a generated hull's sidecar: parts, vertices, triangles, extent_m and the hydrostatics.
+nlohmann::json generated_mesh_json(const std::vector<TriMesh>& parts, const Hydrostatics& h, double rho_w);
+
+// Writes a generated hull: out_obj (parts, with `header` as comments) and its sidecar (out_obj with extension
+// .json), each atomically; returns the sidecar's path. Error if out_obj itself ends in .json.
+std::filesystem::path write_generated_files(const std::vector<TriMesh>& parts, const std::filesystem::path& out_obj,
+                                            const std::string& header, const nlohmann::json& side);
+
 // The particulars the ice-resistance formulas take, measured from `surface`, into the sidecar and the summary. A hull
 // whose bow cannot be measured (a catamaran has no stem on its centreline) is still written: the sidecar then holds
 // "particulars": null and the reason, which floesim-resistance reports.

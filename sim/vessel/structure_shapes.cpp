@@ -72,9 +72,6 @@ std::string write_generated_structure(const StructureShapeOptions& o, const fs::
   const std::vector<TriMesh> parts = generate_structure(o);
   constexpr double rho_w = 1025.0;
   const Hydrostatics h = hydrostatics(parts, rho_w, 0.0);
-  const Bounds b(merge(parts).vertices);
-  size_t nv = 0, nt = 0;
-  for (const TriMesh& p : parts) nv += p.vertices.size(), nt += p.triangles.size();
   std::ostringstream shape;
   shape << o.shape;
   if (o.shape == "cone")
@@ -97,26 +94,18 @@ std::string write_generated_structure(const StructureShapeOptions& o, const fs::
   side["provenance"] = make_provenance("floesim-hull", inputs, options_to_json(o));
   side["hull_file"] = out_obj.filename().string();
   side["frame"] = "z up; calm waterline z = 0; origin on the structure's axis at the waterline; metres";
-  side["parts"] = parts.size();
-  side["vertices"] = nv;
-  side["triangles"] = nt;
-  side["extent_m"] = {{"x", {b.lo.x(), b.hi.x()}}, {"y", {b.lo.y(), b.hi.y()}}, {"z", {b.lo.z(), b.hi.z()}}};
-  side["hydrostatics"] = hydrostatics_json(h, rho_w);
+  side.update(generated_mesh_json(parts, h, rho_w));
   side["structure"] = {{"shape", o.shape}, {"description", shape.str()}};
   if (o.shape == "cone") side["structure"]["neck_offset_m"] = neck_offset_m(o);
   // The ship's particulars (stem, entrance angle, ...) do not apply: floesim-resistance says so if given this file.
   side["particulars"] = nullptr;
   side["particulars_error"] = "a structure (" + o.shape + "), not a ship: its ice loads are floesim-ice-actions'";
 
-  fs::path sidecar = out_obj;
-  sidecar.replace_extension(".json");
-  FLOESIM_REQUIRE(sidecar != out_obj, out_obj.string(), ": the hull file must not end in .json (the sidecar does)");
-  ensure_directory(out_obj.parent_path());
-  write_obj(out_obj, parts, head.str());
-  write_text_atomic(sidecar, side.dump(2) + "\n");
+  const fs::path sidecar = write_generated_files(parts, out_obj, head.str(), side);
 
   std::ostringstream sum;
-  sum << "structure: " << shape.str() << "\n  " << parts.size() << " convex parts, " << nv << " vertices, " << nt
+  sum << "structure: " << shape.str() << "\n  " << parts.size() << " convex parts, " << side["vertices"].get<size_t>()
+      << " vertices, " << side["triangles"].get<size_t>()
       << " triangles -> " << out_obj.string() << " (+ " << sidecar.filename().string() << ")\n"
       << "  volume below z = 0   " << fmt_num(h.volume_m3) << " m^3\n"
       << "  waterplane area      " << fmt_num(h.waterplane_area_m2) << " m^2\n";

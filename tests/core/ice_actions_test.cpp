@@ -10,13 +10,12 @@
 #include <string>
 
 #include "pipeline/error.h"
+#include "pipeline/geometry2d.h"
 #include "pipeline/ice_actions.h"
 
 using namespace floesim;
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 std::string error_of(const std::function<void()>& f) {
   try {
