@@ -70,9 +70,10 @@ const char* fracture_mode_name(int32_t mode) {
     case kFractureBending: return "bending";
     case kFractureRadial: return "radial";
     case kFractureSplitting: return "splitting";
+    case kFractureCrushing: return "crushing";
   }
   throw Error("unknown fracture mode " + std::to_string(mode) +
-              " (expected 0 input, 1 bending, 2 radial, 3 splitting)");
+              " (expected 0 input, 1 bending, 2 radial, 3 splitting, 4 crushing)");
 }
 
 size_t Results::steps() const {
@@ -189,7 +190,7 @@ std::vector<T> read_ds(hid_t file_id, const std::string& name, size_t cols, cons
 // plot and render: /1 had no fracture (no /fracture, no lineage), /2 no solver series beyond sweeps and residual,
 // /3 no /states/in_contact, /4 no /geometry/floe_level_ice, /5 no ice_load_level_ice series, /6 every alive body
 // in every frame (which FrameReplay reads like the changed bodies of /7) and no ice_kinetic_energy series.
-constexpr int kLayoutVersion = 7;
+constexpr int kLayoutVersion = 8;
 constexpr const char* kLayoutPrefix = "floesim-results/";
 std::string layout_name(int version) { return kLayoutPrefix + std::to_string(version); }
 
@@ -260,9 +261,9 @@ std::string fracture_problem(const Results& r) {
   // Events: modes, flags, time order.
   for (size_t k = 0; k < E; ++k) {
     const std::string at = " at event " + std::to_string(k);
-    if (r.fracture_mode[k] < kFractureBending || r.fracture_mode[k] > kFractureSplitting)
+    if (r.fracture_mode[k] < kFractureBending || r.fracture_mode[k] > kFractureCrushing)
       return "/fracture/mode is " + std::to_string(r.fracture_mode[k]) + at +
-             "; expected 1 (bending), 2 (radial) or 3 (splitting)";
+             "; expected 1 (bending), 2 (radial), 3 (splitting) or 4 (crushing)";
     if (r.fracture_at_structure[k] != 0 && r.fracture_at_structure[k] != 1)
       return "/fracture/at_structure is " + std::to_string(r.fracture_at_structure[k]) + at + "; expected 0 or 1";
     if (!std::isfinite(r.fracture_time_s[k])) return "/fracture/time_s is not finite" + at;
@@ -287,8 +288,8 @@ std::string fracture_problem(const Results& r) {
   for (size_t g = 0; g < n; ++g) {
     const std::string floe = " for floe " + std::to_string(r.floe_id[g]);
     const int32_t parent = r.floe_parent_id[g], mode = r.floe_origin_mode[g];
-    if (mode < kFractureNone || mode > kFractureSplitting)
-      return "/geometry/floe_origin_mode is " + std::to_string(mode) + floe + "; expected 0..3";
+    if (mode < kFractureNone || mode > kFractureCrushing)
+      return "/geometry/floe_origin_mode is " + std::to_string(mode) + floe + "; expected 0..4";
     if ((parent == -1) != (mode == kFractureNone))
       return "/geometry/floe_parent_id is " + std::to_string(parent) + floe + " but /geometry/floe_origin_mode is " +
              std::to_string(mode) + " (-1 goes with 0: a floe of the input field)";

@@ -30,7 +30,8 @@
 //   /geometry/hull_triangles     [T x 3]  int32
 //   /fracture/time_s             [E]      float64   one row per fracture event (PHYSICS.md §2), in time order
 //   /fracture/parent_id          [E]      int32     the floe that broke (it ends at this time)
-//   /fracture/mode               [E]      int32     FractureMode: 1 bending, 2 radial, 3 splitting
+//   /fracture/mode               [E]      int32     FractureMode: 1 bending, 2 radial, 3 splitting, 4 crushing
+//                                                   (a fixed structure's crushed ice cleared from a level-ice tile)
 //   /fracture/at_structure       [E]      int32     1: at a contact with the vessel, 0: floe-floe contact
 //   /fracture/force_n            [E x 3]  float64   contact force on the floe at failure, world frame
 //   /fracture/threshold_n        [E]      float64   the failure load it reached (vertical for bending/radial,
@@ -38,11 +39,12 @@
 //   /fracture/point_m            [E x 3]  float64   contact point, world frame
 //   /fracture/width_m            [E]      float64   contact width used (never below the thickness)
 //   /fracture/theta_rad          [E]      float64   wedge angle (bending/radial), 0 for splitting
-//   /fracture/brash_mass_kg      [E]      float64   mass of pieces below the minimum size, removed (counted here)
+//   /fracture/brash_mass_kg      [E]      float64   mass of pieces below the minimum size, removed (counted here);
+//                                                   for a crushing event the crushed ice cleared
 //   /fracture/child_offset       [E+1]    int64     pieces of event k: child_id[offset[k] .. offset[k+1]-1]
 //   /fracture/child_id           [C]      int32     floe ids of the pieces that became bodies
-//   Layout "floesim-results/7" (this one) stores only the changed bodies in a frame and added the series
-//   ice_kinetic_energy (NaN when reading an earlier file); earlier layouts stored every alive body in every frame,
+//   Layout "floesim-results/8" (this one) added the fracture mode 4, crushing. "/7" stores only the changed bodies
+//   in a frame and added the series ice_kinetic_energy (NaN when reading an earlier file); earlier layouts stored every alive body in every frame,
 //   which FrameReplay reads the same way. "/6" added the series ice_load_level_ice (NaN when reading an earlier file);
 //   "/5" added /geometry/floe_level_ice (all 0 when reading an earlier file); "/4" added /states/in_contact; "/3"
 //   added the solver series (relax sweeps and residual, subspace solves, capped steps, contact-law violations); "/2"
@@ -66,7 +68,15 @@ namespace floesim {
 // How a fracture event broke a floe (PHYSICS.md §2.1-2.4): a wedge cut out when the circumferential (Nevel) load
 // P_f governs (bending) or when the radial-crack initiation load P_r governs (radial), or a split along the force
 // line (splitting). 0 marks a floe of the input field in /geometry/floe_origin_mode.
-enum FractureMode : int32_t { kFractureNone = 0, kFractureBending = 1, kFractureRadial = 2, kFractureSplitting = 3 };
+// A crushing event (4, layout /8) is not a crack: a fixed structure's crushed ice cleared from a level-ice tile
+// (level_ice.clearing_depth_m), the tile's rest its pieces, the crushed mass in /fracture/brash_mass_kg.
+enum FractureMode : int32_t {
+  kFractureNone = 0,
+  kFractureBending = 1,
+  kFractureRadial = 2,
+  kFractureSplitting = 3,
+  kFractureCrushing = 4
+};
 const char* fracture_mode_name(int32_t mode);  // "input", "bending", "radial", "splitting"
 
 struct FieldSpec {

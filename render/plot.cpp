@@ -124,7 +124,7 @@ VesselEvents vessel_fracture_events(const Results& r, const std::string& source,
   FLOESIM_REQUIRE(problem.empty(), source, ": ", problem);
   VesselEvents ev;
   for (size_t k = 0; k < events; ++k)
-    if (r.fracture_at_structure[k] == 1)
+    if (r.fracture_at_structure[k] == 1 && r.fracture_mode[k] != kFractureCrushing)  // crushing clears, not a crack
       (r.fracture_mode[k] == kFractureSplitting ? ev.split_t : ev.bend_t).push_back(r.fracture_time_s[k]);
   s.fracture_events = events;
   s.vessel_splitting_events = ev.split_t.size();

@@ -794,7 +794,8 @@ void floe_top_colour(const RenderOptions& o, int32_t origin_mode, int32_t genera
     case kFractureBending:
     case kFractureRadial: parse_hex_colour(o.bending_piece_colour, rgb); break;
     case kFractureSplitting: parse_hex_colour(o.splitting_piece_colour, rgb); break;
-    default: throw Error("floe origin mode " + std::to_string(origin_mode) + " is not 0..3 (see FractureMode)");
+    case kFractureCrushing: parse_hex_colour(o.floe_top_colour, rgb); return;  // the sheet, its crushed ice cleared
+    default: throw Error("floe origin mode " + std::to_string(origin_mode) + " is not 0..4 (see FractureMode)");
   }
   const float dim = 1.0f - 0.15f * float(std::clamp(generation, 1, 4) - 1);
   for (int i = 0; i < 3; ++i) rgb[i] *= dim;

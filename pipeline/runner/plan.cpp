@@ -157,11 +157,23 @@ class CasePlanner {
   // 3. The hull: a user's mesh placed and cut into convex parts, or the parametric icebreaker.
   void plan_hull() {
     const Json& h = require_object(c_, "hull", cf_);
-    FLOESIM_REQUIRE(h.contains("generate") != h.contains("file"), cf_,
+    FLOESIM_REQUIRE(int(h.contains("generate")) + int(h.contains("file")) + int(h.contains("structure")) == 1, cf_,
                     ": hull needs exactly one of \"file\" (an OBJ or any mesh assimp reads, with its placement "
-                    "options beside it) or \"generate\" (options for floesim-hull's parametric icebreaker)");
+                    "options beside it), \"generate\" (options for floesim-hull's parametric icebreaker) or "
+                    "\"structure\" (floesim-hull's structure from parameters: cone, cylinder, caisson)");
     FLOESIM_REQUIRE(!h.contains("generate") || h.size() == 1, cf_,
                     ": hull.generate takes no keys beside it (the placement options go with \"file\")");
+    FLOESIM_REQUIRE(!h.contains("structure") || h.size() == 1, cf_,
+                    ": hull.structure takes no keys beside it (the placement options go with \"file\")");
+    if (h.contains("structure")) {
+      // A structure from parameters: floesim-hull's config is {"structure": {...}}.
+      PlannedStage* st = add("hull", "hull", "structure from parameters", Json{{"structure", h["structure"]}}, {},
+                             {"hull.obj"}, "floesim-hull");
+      hull_obj_ = st->outputs[0];
+      st->args = {"--config", st->config.string(), "--out", hull_obj_.string()};
+      plan_.artefacts.push_back({"hull", "hull/hull.obj", "the structure as convex parts, m (OBJ)"});
+      return;
+    }
     if (h.contains("generate")) {
       PlannedStage* st =
           add("hull", "hull.generate", "parametric icebreaker hull", h["generate"], {}, {"hull.obj"}, "floesim-hull");

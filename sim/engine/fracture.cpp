@@ -12,6 +12,9 @@ namespace floesim::sim {
 namespace {
 
 constexpr double kDegToRad = kPi / 180.0;
+// A structure's face pushes the ice up, and bends it up, when its normal on the ice rises more than this (the sine
+// of 10 degrees): an upward-breaking cone's slope; a vertical face (its friction lifting the ice a little) does not.
+constexpr double kUpwardFaceSine = 0.17;
 // Draws of a failure's cut (wedge angle, split line) tried in one step before the floe is left whole (see cut()).
 constexpr int kCutAttempts = 8;
 
@@ -122,12 +125,16 @@ Candidate evaluate(const Model& model, const State& state, const PairLoad& pl, c
       c.point = at;
     }
   }
-  // The hull bends the ice down (§2.4: F_V on a sloped face, the force as solved). Between floes either one may
+  // The hull bends the ice (§2.4: F_V on a sloped face, the force as solved). Between floes either one may
   // ride over the other, and the vertical force is §10.2's for a contact face inclined at beta to the horizontal
   // with the friction mu_ii at its limit against the slide: F_V = F_n (cos beta - mu_ii sin beta), F_n the normal
   // force, beta from the contact normal in the plate's frame. A face steeper than atan(1 / mu_ii) (81.5 deg) does
   // not bend the plate: two floes crushing edge to edge load each other in-plane only.
-  double f_v = -f_local.z();
+  // At a structure the plate bends the way the structure's face pushes it: down under a ship's bow or a downward-
+  // breaking cone (and by default, a face whose normal is nearly horizontal), up on an upward-breaking cone, whose
+  // face pushes the ice up the slope (the elastic plate on its foundation fails the same either way, §8.2.2).
+  const bool pushed_up = n3.z() > kUpwardFaceSine * n3.norm();
+  double f_v = pushed_up ? f_local.z() : -f_local.z();
   if (!pl.at_structure) {
     const double nn = n3.norm();
     const double fn = nn > 0 ? std::max(0.0, f_local.dot(n3) / nn) : 0.0;
@@ -246,9 +253,6 @@ Candidate evaluate(const Model& model, const State& state, const PairLoad& pl, c
 // A chip: a piece smaller than (h/2)^2 in plan or narrower than h/4. A crack that runs close to an earlier one (or
 // past a corner of a jagged edge) cuts one, a tall column of ice that the cut's geometry makes rather than the ice:
 // the closed-form laws do not resolve cracks that close, and any rigid impulse would throw its tiny mass about.
-bool is_chip(const Polygon& piece, double thickness_m) {
-  return is_brash(piece, 0.25 * thickness_m, 0.25 * thickness_m * thickness_m);
-}
 
 // The pieces of `parts` that are chips, moved out: returns the rest.
 std::vector<Polygon> without_chips(const std::vector<Polygon>& parts, double h, bool* had_chips) {
@@ -453,6 +457,10 @@ double wedge_angle_rad(const FractureOptions& o, int floe_id, long step, int att
   const double u = static_cast<double>(key >> 11) * 0x1.0p-53;  // uniform in [0, 1)
   const double lo = o.wedge_angle_deg[0] * kDegToRad, hi = o.wedge_angle_deg[1] * kDegToRad;
   return lo + u * (hi - lo);
+}
+
+bool is_chip(const Polygon& piece, double thickness_m) {
+  return is_brash(piece, 0.25 * thickness_m, 0.25 * thickness_m * thickness_m);
 }
 
 std::vector<FractureCut> find_fractures(const Model& model, const State& state, const std::vector<Contact>& contacts,

@@ -65,6 +65,10 @@ std::vector<FractureCut> find_fractures(const Model& model, const State& state, 
 // "empirical". The speed correction (1 + C_v v_n) multiplies it where the approach speed is known (the fracture step).
 double static_piece_rb_m(const FractureOptions& o, double rb_nevel_over_lc, double lc_m);
 
+// A chip: a piece smaller than (h/2)^2 in plan or narrower than h/4, a tall column that a cut's geometry makes rather
+// than the ice (the closed-form laws do not resolve cracks that close); no cut leaves one.
+bool is_chip(const Polygon& piece, double thickness_m);
+
 // The wedge angle drawn for a floe at a step: uniform in fracture.wedge_angle_deg (radians), from a hash of the seed,
 // the floe, the step and the attempt (a cut that would leave a chip is drawn again; attempt 0 is the first draw).
 double wedge_angle_rad(const FractureOptions& o, int floe_id, long step, int attempt = 0);

@@ -810,7 +810,18 @@ std::vector<Polygon> add_vessel(const HullModel& hull, const std::vector<Floe>& 
   const Vec3 com = vp.centre_of_mass_hull;  // hull frame
   Body b = vessel_body(fl.mass, vp, o);
   add_propellers(o, com, model);
-  place_vessel(b, hull, com, fl.dz, o, model);
+  // A fixed structure stands where the hull frame puts it (its waterline at z = 0, not floated to its weight).
+  place_vessel(b, hull, com, o.vessel.station_keeping.fixed() ? 0.0 : fl.dz, o, model);
+  if (o.vessel.station_keeping.fixed()) {
+    // A fixed structure: nothing moves it (its floating figures are reported, its stability does not matter).
+    b.kinematic = true;
+    b.inv_mass = 0;
+    b.inv_inertia.setZero();
+    b.inv_mass_added.setZero();
+    b.inv_inertia_added.setZero();
+    model.bodies.push_back(std::move(b));
+    return vessel_footprint(hull, model.bodies[0], com, floes, o);
+  }
   metacentric_heights(b, sub.volume, o, vp);
   if (o.water.enabled)
     set_damping(b, o, o.water.vessel_heave_damping_ratio, o.water.vessel_roll_damping_ratio,
@@ -943,8 +954,11 @@ Model build_model(const FloeField& field, const HullModel* hull, const EngineSet
   const double g = o.water.gravity_mps2;
   model.gravity = Vec3(0, 0, -g);
   const double cdir = o.water.current_direction_deg * kPi / 180, wdir = o.wind.direction_deg * kPi / 180;
-  model.current = o.water.current_speed_mps * Vec3(std::cos(cdir), std::sin(cdir), 0);
-  model.wind = o.wind.speed_mps * Vec3(std::cos(wdir), std::sin(wdir), 0);
+  // With a drift, the run is in the ice's frame: the water and the air move relative to it.
+  const Vec2 drift = o.drift.velocity();
+  model.frame_velocity = Vec3(drift.x(), drift.y(), 0);
+  model.current = o.water.current_speed_mps * Vec3(std::cos(cdir), std::sin(cdir), 0) - model.frame_velocity;
+  model.wind = o.wind.speed_mps * Vec3(std::cos(wdir), std::sin(wdir), 0) - model.frame_velocity;
 
   // 1. Floe geometry in the world: cleaned outline and convex pieces. The level ice sheets come as tiles (fixed
   // floes) after the free floes.

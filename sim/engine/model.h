@@ -106,6 +106,10 @@ struct Body {
   // width 4 A / perimeter (Metrikin's rigid contact with an ice crushing constraint, PHYSICS.md §1.7). Without it a
   // block squeezed between the hull and the sheet would take whatever impulse keeps them apart and spin off.
   double brash_crush_force_n = 0;
+  // A fixed structure (vessel.station_keeping.mode "fixed", issue #34): it moves at its set velocity (zero, or minus
+  // the drift in the ice's frame) and nothing moves it: inverse masses 0, no forces, always awake (it touches the
+  // ice it reaches); its contact impulses are the load it carries.
+  bool kinematic = false;
 };
 
 // What the vessel model needs of the hull, computed from the mesh at the design waterline (z = 0).
@@ -140,6 +144,9 @@ struct Model {
   Vec3 gravity = Vec3::Zero();
   Vec3 current = Vec3::Zero();        // water velocity, world
   Vec3 wind = Vec3::Zero();           // air velocity, world
+  // The velocity of the frame the run is computed in, relative to the earth: the ice's drift (settings.drift), or
+  // zero. current and wind above are relative to this frame; an earth-frame position is x + frame_velocity t.
+  Vec3 frame_velocity = Vec3::Zero();
   std::vector<double> thrust_time_s, thrust_n;  // thrust_series mode
   std::vector<Propeller> propellers;            // their jets wash the floes (forces.h, PropellerJet)
 

@@ -179,6 +179,22 @@ struct AutopilotOptions {
   }
 };
 
+// How the hull body is held (issue #34). A ship is driven by its propulsion; a structure is "fixed": it does not
+// move in the earth frame (in a run with drift, in the ice's frame it moves at minus the drift: Kinematic, infinite
+// mass), and the ice's load on it is what it carries.
+struct StationKeepingOptions {
+  std::string mode = "propulsion";  // propulsion | fixed
+  template <class V>
+  void visit(V& v) {
+    v.field("mode", mode, "-",
+            "propulsion (a ship, driven by vessel.propulsion and steered by vessel.autopilot) or fixed (a structure "
+            "that does not move in the earth frame: a bridge pier, a lighthouse, a platform on the seabed; the "
+            "vessel's propulsion, autopilot, resistance and initial speed do not apply)",
+            one_of({"propulsion", "fixed"}));
+  }
+  bool fixed() const { return mode == "fixed"; }
+};
+
 struct VesselOptions {
   double x_m = 0.0;               // initial centre of mass, world x
   double y_m = 0.0;               // initial centre of mass, world y
@@ -200,6 +216,7 @@ struct VesselOptions {
   PropulsionOptions propulsion;
   AutopilotOptions autopilot;
   std::vector<PropellerOptions> propellers;  // none: no propeller wash on the floes
+  StationKeepingOptions station_keeping;
   template <class V>
   void visit(V& v) {
     v.field("x_m", x_m, "m", "initial centre of mass, world x",
@@ -251,6 +268,9 @@ struct VesselOptions {
     v.section("autopilot", autopilot, "heading hold");
     v.list("propellers", propellers,
            "the vessel's propellers, whose jets (PHYSICS.md 3.5) wash the floes; [] = no propeller wash");
+    v.section("station_keeping", station_keeping, "how the hull body is held: a ship's propulsion, or fixed (a structure)");
+    if (station_keeping.fixed() && !propellers.empty())
+      v.problem("propellers", "a fixed structure (station_keeping.mode fixed) has no propellers: remove them");
     double shares = 0;
     for (const PropellerOptions& p : propellers) shares += p.thrust_share;
     if (shares > 1 + 1e-9)
@@ -606,6 +626,7 @@ struct LevelIceOptions {
   std::vector<ThicknessPoint> thickness_profile;  // [] = uniform thickness_m
   std::vector<LevelIceOpening> openings;
   double tile_m = 50.0;
+  double clearing_depth_m = 0.1;
   template <class V>
   void visit(V& v) {
     v.field("extent_m", extent_m, "m",
@@ -621,6 +642,12 @@ struct LevelIceOptions {
             "side of the square tiles the sheet is cut into (fixed bodies; a crack stops at a tile's side, so keep "
             "it several times the ice's characteristic length)",
             in_range(1, 1e4));
+    v.field("clearing_depth_m", clearing_depth_m, "m",
+            "a structure (vessel.station_keeping.mode fixed) crushing into a tile: once its section in the ice's band "
+            "has pushed this far into the tile, the crushed ice is cleared (extruded: cut out of the tile along the "
+            "section, a fifth of this depth left in contact, its mass counted); without it a vertical structure "
+            "would tunnel into the sheet",
+            in_range(0.01, 10));
     for (size_t i = 1; i < thickness_profile.size(); ++i)
       if (!(thickness_profile[i].x_m > thickness_profile[i - 1].x_m))
         v.problem("thickness_profile", "needs strictly increasing x_m (point " + std::to_string(i) + ")");
@@ -640,6 +667,31 @@ struct LevelIceOptions {
 
 // What the engine reads: the time step, its threads and the physics sections. Read from a case through the
 // simulate stage's options (EngineSettings derives from it and keeps the keys and their order).
+// The ice's drift (issue #34): ice coming to a structure. With a drift the run is computed in the ice's frame,
+// which moves at the drift velocity: the level ice and the floes start at rest, the water moves at the current minus
+// the drift, the air at the wind minus the drift, and a fixed structure moves at minus the drift. Loads depend on
+// relative motion only, so this is exact, and ice far from the structure rests (asleep: it costs nothing) until the
+// structure reaches it. Positions in the results are in the ice's frame; an earth-frame position is that plus the
+// drift velocity times the time.
+struct DriftOptions {
+  double speed_mps = 0.0;      // 0: no drift, the earth frame
+  double direction_deg = 0.0;  // the direction the ice drifts to, CCW from +x
+  template <class V>
+  void visit(V& v) {
+    v.field("speed_mps", speed_mps, "m/s",
+            "the ice's drift speed in the earth frame (0: none); the run is computed in the ice's frame (ice carried "
+            "by the current: set water.current_speed_mps and current_direction_deg to the same drift)",
+            in_range(0, 10));
+    v.field("direction_deg", direction_deg, "deg", "the direction the ice drifts to, CCW from +x",
+            in_range(-360, 360));
+  }
+  // The drift velocity, earth frame (horizontal).
+  Vec2 velocity() const {
+    const double a = direction_deg * kPi / 180;
+    return speed_mps * Vec2(std::cos(a), std::sin(a));
+  }
+};
+
 struct EngineSettings {
   double time_step_s = 0.01;
   int threads = 1;
@@ -654,6 +706,7 @@ struct EngineSettings {
   SleepOptions sleep;
   HealthOptions health;
   LevelIceOptions level_ice;
+  DriftOptions drift;
 
   long reference_horizon_steps() const { return std::lround(solver.reference_horizon_s / time_step_s); }  // 0: none
 };

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "pipeline/error.h"
+#include "sim/engine/clearing.h"
 
 namespace floesim::sim {
 
@@ -88,6 +89,7 @@ World::World(Model built) : model_(std::move(built)), pool_(model_.settings.thre
     state_.awake[v] = 1;
     const Mat3 R = state_.orientation[v].toRotationMatrix();
     state_.velocity[v] = o.vessel.initial_speed_mps * R.col(0) + Vec3(model.current.x(), model.current.y(), 0);
+    if (model.bodies[v].kinematic) state_.velocity[v] = -model.frame_velocity;  // at rest in the earth frame
     state_.heading_ref_rad = heading_of(R);
   }
   // Inverse mass matrices (world) as the solver sees them; the forces stage refreshes those of awake bodies.
@@ -226,7 +228,7 @@ void World::stage_forces() {
   };
   // The vessel on this thread (its controllers keep state).
   const int vessel = model_.vessel;
-  if (vessel >= 0) {
+  if (vessel >= 0 && !model_.bodies[vessel].kinematic) {  // a fixed structure feels no force: it keeps its velocity
     const Body& body = model_.bodies[vessel];
     const BodyKinematics k = kinematics(vessel);
     Wrench total = gravity_force(model_, body);
@@ -370,7 +372,11 @@ void World::stage_fracture() {
   std::vector<FractureCut> cuts =
       find_fractures(model_, state_, contacts_, model_.settings.time_step_s, &state_.pair_loads);
   for (FractureCut& c : cuts) apply_fracture(c);
-  report_.fracture_events = static_cast<int>(cuts.size());
+  // A fixed structure's crushed ice cleared from the tiles it crushes (sim/engine/clearing.h); a tile that broke
+  // this step is not cleared (its contacts name a body no longer alive).
+  std::vector<FractureCut> clearings = find_clearings(model_, state_, contacts_);
+  for (FractureCut& c : clearings) apply_fracture(c);
+  report_.fracture_events = static_cast<int>(cuts.size() + clearings.size());
 }
 
 void World::grow_body_arrays() {
@@ -521,9 +527,18 @@ void World::stage_sleep() {
   for (int b : awake_list_)
     if (b == model_.vessel || state_.still_time_s[b] < s.time_s) island_ok_[find(b)] = 0;
   // Far astern (sleep.freeze_astern_m): asleep at any speed; the island rule above no longer applies to it.
+  // Astern is behind the vessel's bow, or behind a fixed structure's motion through the ice (downstream of it in
+  // the earth frame); a structure at rest in the ice has no astern.
   const int vessel = model_.vessel;
-  const bool freeze = s.freeze_astern_m > 0 && vessel >= 0;
-  const Vec3 heading = freeze ? Vec3(state_.orientation[vessel] * Vec3::UnitX()) : Vec3::UnitX();
+  bool freeze = s.freeze_astern_m > 0 && vessel >= 0;
+  Vec3 heading = Vec3::UnitX();
+  if (freeze && model_.bodies[vessel].kinematic) {
+    const Vec3 v(state_.velocity[vessel].x(), state_.velocity[vessel].y(), 0);
+    freeze = v.norm() > 0;
+    if (freeze) heading = v.normalized();
+  } else if (freeze) {
+    heading = state_.orientation[vessel] * Vec3::UnitX();
+  }
   auto far_astern = [&](int b) {
     const Vec3 d = state_.position[b] - state_.position[vessel];
     return d.dot(heading) < 0 && d.head<2>().norm() > s.freeze_astern_m;

@@ -82,7 +82,8 @@ class World {
   const std::vector<FractureEvent>& fracture_events() const { return events_; }
   // When each body left the world (broken up or removed), s; +inf while alive. Indexed like model().bodies.
   const std::vector<double>& ended_s() const { return ended_s_; }
-  // Mass of brash removed so far (pieces is_brash() rejected: below fracture.min_piece_area_m2 or slivers), kg.
+  // Mass of ice removed so far, kg: brash (pieces is_brash() rejected: below fracture.min_piece_area_m2 or slivers,
+  // with fracture.brash "removed") and the crushed ice a fixed structure cleared (sim/engine/clearing.h).
   double brash_mass_kg() const { return brash_mass_kg_; }
   const CollisionStats& collision_stats() const { return collision_->stats(); }
   // Accumulated wall time per stage (s).

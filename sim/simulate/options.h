@@ -48,6 +48,7 @@ struct SimulateOptions : EngineSettings {
     v.section("health", health, "numerical health limits");
     v.section("hull", hull, "how the hull file is loaded (non-convex meshes)");
     v.section("level_ice", level_ice, "a level ice sheet, broken by the fracture module (issue #10)");
+    v.section("drift", drift, "the ice's drift toward a structure: the run is computed in the ice's frame");
     // Cross-field checks: whole numbers of steps, statistics window inside the run.
     if (time_step_s > 0 && duration_s > 0) {
       const double n = duration_s / time_step_s;

@@ -37,14 +37,14 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
   nlohmann::json f;
   f["enabled"] = o.fracture.enabled;
   f["at_ice_ice_contacts"] = o.fracture.ice_ice;
-  int count[4] = {0, 0, 0, 0}, at_vessel = 0;
+  int count[5] = {0, 0, 0, 0, 0}, at_vessel = 0;
   for (size_t e = 0; e < r.fracture_mode.size(); ++e) {
-    ++count[std::clamp(r.fracture_mode[e], 0, 3)];
+    ++count[std::clamp(r.fracture_mode[e], 0, 4)];
     at_vessel += r.fracture_at_structure[e];
   }
   f["events"] = {{"bending", count[kFractureBending]}, {"radial", count[kFractureRadial]},
-                 {"splitting", count[kFractureSplitting]}, {"total", r.fracture_mode.size()},
-                 {"at_vessel", at_vessel}};
+                 {"splitting", count[kFractureSplitting]}, {"crushing_cleared", count[kFractureCrushing]},
+                 {"total", r.fracture_mode.size()}, {"at_vessel", at_vessel}};
   std::map<int32_t, double> area, thickness;  // by floe id
   std::map<int32_t, bool> tile;                // by floe id: a level ice tile
   double start = 0, end = 0, brash = 0, brash_kept = 0;
@@ -83,12 +83,16 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
   for (size_t e = 0; e < r.fracture_mode.size(); ++e)
     if (!r.fracture_at_structure[e] && tile[r.fracture_parent_id[e]]) ++sheet_edge;
   f["events"]["sheet_edge_by_ice"] = sheet_edge;
-  for (double b : r.fracture_brash_mass_kg) brash += b;
+  // Mass removed: brash (fracture.brash "removed"), and the crushed ice a fixed structure cleared from the sheet.
+  double crushed = 0;
+  for (size_t e = 0; e < r.fracture_mode.size(); ++e)
+    (r.fracture_mode[e] == kFractureCrushing ? crushed : brash) += r.fracture_brash_mass_kg[e];
   f["pieces_created"] = piece_area.size();
   f["ice_mass_start_kg"] = start;
-  f["ice_mass_end_kg"] = end + brash;
+  f["ice_mass_end_kg"] = end + brash + crushed;
   f["ice_mass_in_bodies_end_kg"] = end;
   f["brash_removed_kg"] = brash;
+  f["crushed_cleared_kg"] = crushed;
   f["min_piece_area_m2"] = o.fracture.min_piece_area_m2;
   f["brash"] = {{"mode", o.fracture.brash}, {"bodies_at_end", brash_bodies}, {"mass_at_end_kg", brash_kept}};
   f["piece_area_m2"] = distribution(piece_area);
@@ -104,7 +108,7 @@ nlohmann::json fracture_summary(const SimulateOptions& o, const Results& r) {
   int wedge_brash = 0;
   const double rho_w_g = o.water.density_kg_m3 * o.water.gravity_mps2;
   for (size_t e = 0; e < r.fracture_mode.size(); ++e) {
-    if (r.fracture_mode[e] == kFractureSplitting || rho_w_g <= 0) continue;
+    if (r.fracture_mode[e] == kFractureSplitting || r.fracture_mode[e] == kFractureCrushing || rho_w_g <= 0) continue;
     const double h = thickness[r.fracture_parent_id[e]];
     const double lc = characteristic_length_m(o.fracture.youngs_modulus_pa, o.fracture.poisson_ratio, h, rho_w_g);
     const double theta = r.fracture_theta_rad[e], w = r.fracture_width_m[e];
@@ -455,6 +459,7 @@ nlohmann::json summarize(const SimulateOptions& o, const Model& model, const Res
   s["small_floe_overlaps"] = model.small_overlaps;
   s["fracture"] = fracture_summary(o, r);
   s["level_ice"] = level_ice_summary(o, model, r, series);
+  if (o.vessel.station_keeping.fixed()) s["structure"] = structure_summary(o, model, r, series);
   const VesselParticulars& vp = model.vessel_info;
   s["vessel"] = {{"mass_kg", vp.mass_kg},
                  {"length_oa_m", vp.length_oa_m},

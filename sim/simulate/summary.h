@@ -24,4 +24,11 @@ nlohmann::json level_ice_summary(const SimulateOptions& o, const Model& model, c
                                  const SeriesSource& series);
 nlohmann::json level_ice_summary(const SimulateOptions& o, const Model& model, const Results& results);
 
+// A fixed structure (summary.json "structure", vessel.station_keeping.mode "fixed"): the ice's action along its drift
+// (-Fx in the structure's axes, x facing the ice that comes), transverse, vertical and overturning, raw and through
+// the 0.5 s filter of PHYSICS.md §5; the filtered load's cycles (mean of per-cycle peaks, mean period) and dominant
+// period against h/v; the rubble height the run shows near the structure (for Croasdale's F_H, §8.2).
+nlohmann::json structure_summary(const SimulateOptions& o, const Model& model, const Results& results,
+                                 const SeriesSource& series);
+
 }  // namespace floesim::sim

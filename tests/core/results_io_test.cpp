@@ -218,7 +218,7 @@ TEST(ResultsIo, FractureEventsAndLineageRoundTrip) {
   const Results r = fractured_results();
   write_results(p, r);
   const Results b = read_results(p);
-  EXPECT_EQ(b.attributes["layout"], "floesim-results/7");
+  EXPECT_EQ(b.attributes["layout"], "floesim-results/8");
   EXPECT_EQ(b.floe_id, r.floe_id);
   EXPECT_EQ(b.floe_vertices_m, r.floe_vertices_m);
   EXPECT_EQ(b.floe_parent_id, r.floe_parent_id);
@@ -269,7 +269,7 @@ TEST(ResultsIo, InconsistentFractureTablesAreRefusedOnWriteAndOnReadNamingTheDat
       {"/fracture/child_offset", "starts at 1", [](Results& r) { r.fracture_child_offset = {1, 2, 3}; }},
       {"/fracture/child_offset", "decreases", [](Results& r) { r.fracture_child_offset = {0, 3, 2}; }},
       {"/fracture/child_offset", "ends at 2", [](Results& r) { r.fracture_child_offset = {0, 1, 2}; }},
-      {"/fracture/mode", "is 4", [](Results& r) { r.fracture_mode[1] = 4; }},
+      {"/fracture/mode", "is 5", [](Results& r) { r.fracture_mode[1] = 5; }},
       {"/fracture/mode", "is 0", [](Results& r) { r.fracture_mode[0] = 0; }},
       {"/fracture/child_id", "99", [](Results& r) { r.fracture_child_id[2] = 99; }},
       {"/fracture/parent_id", "42", [](Results& r) { r.fracture_parent_id[0] = 42; }},
@@ -278,6 +278,7 @@ TEST(ResultsIo, InconsistentFractureTablesAreRefusedOnWriteAndOnReadNamingTheDat
   };
   const fs::path good = fs::temp_directory_path() / "floesim_results_fracture_good.h5";
   const fs::path bad = fs::temp_directory_path() / "floesim_results_fracture_bad.h5";
+  fs::remove(bad);  // what a failed run of this test may have left
   for (const Case& c : cases) {
     SCOPED_TRACE(std::string(c.dataset) + ": " + c.needle);
     Results r = fractured_results();
@@ -406,7 +407,7 @@ TEST(ResultsIo, LayoutOneFilesFromBeforeFractureReadWithDefaults) {
   // Rewritten, it becomes a file of the current layout with the same content.
   const fs::path q = fs::temp_directory_path() / "floesim_results_layout1_rewritten.h5";
   write_results(q, r);
-  EXPECT_EQ(read_results(q).attributes["layout"], "floesim-results/7");
+  EXPECT_EQ(read_results(q).attributes["layout"], "floesim-results/8");
   fs::remove(q);
 
   // A layout from the future is refused, naming it.

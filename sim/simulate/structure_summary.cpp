@@ -1,0 +1,148 @@
+// summary.json "structure": what an engineer checks a fixed structure's ice load by (issue #34, PHYSICS.md §8).
+#include <algorithm>
+#include <cmath>
+
+#include "pipeline/error.h"
+#include "pipeline/signal.h"
+#include "sim/simulate/summary.h"
+
+namespace floesim::sim {
+
+namespace {
+
+// PHYSICS.md §5: compliant contacts are read through a 0.5 s centred moving average.
+constexpr double kFilterS = 0.5;
+// The band of load periods searched for the dominant one, in h/v (PHYSICS.md §8.2.4: breaks of 3-12 h): wide
+// enough that a period outside the expected 4-12 h/v is found, not clipped.
+constexpr double kPeriodBandLoHV = 1.0, kPeriodBandHiHV = 30.0;
+
+struct Stats {
+  double mean = 0, std = 0, max = 0, min = 0;
+};
+Stats stats_of(const std::vector<double>& x) {
+  Stats s;
+  if (x.empty()) return s;
+  for (double v : x) s.mean += v;
+  s.mean /= static_cast<double>(x.size());
+  for (double v : x) s.std += (v - s.mean) * (v - s.mean);
+  s.std = std::sqrt(s.std / static_cast<double>(x.size()));
+  const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
+  s.min = *lo;
+  s.max = *hi;
+  return s;
+}
+
+nlohmann::json stats_json(const Stats& s) {
+  return {{"mean", s.mean}, {"std", s.std}, {"max", s.max}, {"min", s.min}};
+}
+
+// The highest ice within `radius` of the structure's axis at each stored frame of the steady part (the rubble and
+// ride-up pile, PHYSICS.md §8.2's h_r, measured from the water line): every alive floe's slab corners, posed.
+std::vector<double> rubble_heights(const Model& model, const Results& r, double from_s, double radius) {
+  std::vector<double> heights;
+  if (r.frames() == 0) return heights;
+  const Vec3 com = model.vessel_info.centre_of_mass_hull;
+  std::vector<size_t> geometry(r.floe_id.size());
+  FrameReplay replay(r, "the results");
+  for (size_t f = 0; f < r.frames(); ++f) {
+    replay.seek(f);
+    if (r.frame_time_s[f] < from_s) continue;
+    const int64_t vr = replay.vessel_row();
+    const Vec3 xs(r.state_position_m[3 * vr], r.state_position_m[3 * vr + 1], r.state_position_m[3 * vr + 2]);
+    const Quat qs(r.state_quaternion[4 * vr], r.state_quaternion[4 * vr + 1], r.state_quaternion[4 * vr + 2],
+                  r.state_quaternion[4 * vr + 3]);
+    const Vec3 axis = xs - qs * com;  // the hull frame's origin: the structure's axis at the water line
+    double top = 0;                   // open water: nothing above the water line
+    const std::vector<int64_t>& rows = replay.rows();
+    const std::vector<int32_t>& floes = replay.floes();
+    for (size_t k = 0; k < rows.size(); ++k) {
+      const int32_t g = floes[k];
+      if (g < 0) continue;  // the structure itself
+      const int64_t row = rows[k];
+      const Vec3 x(r.state_position_m[3 * row], r.state_position_m[3 * row + 1], r.state_position_m[3 * row + 2]);
+      const Quat q(r.state_quaternion[4 * row], r.state_quaternion[4 * row + 1], r.state_quaternion[4 * row + 2],
+                   r.state_quaternion[4 * row + 3]);
+      const double h = r.floe_thickness_m[g];
+      for (int64_t i = r.floe_vertex_offset[g]; i < r.floe_vertex_offset[g + 1]; ++i)
+        for (double z : {-0.5 * h, 0.5 * h}) {
+          const Vec3 p = x + q * Vec3(r.floe_vertices_m[2 * i], r.floe_vertices_m[2 * i + 1], z);
+          if ((p - axis).head<2>().norm() <= radius) top = std::max(top, p.z());
+        }
+    }
+    heights.push_back(top);
+  }
+  return heights;
+}
+
+}  // namespace
+
+nlohmann::json structure_summary(const SimulateOptions& o, const Model& model, const Results& r,
+                                 const SeriesSource& series) {
+  nlohmann::json j;
+  const size_t steps = series.steps();
+  size_t first = 0;
+  {
+    const std::vector<double> t = series.get("time_s");
+    while (first < steps && t[first] < o.steady_start_s - 0.5 * o.time_step_s) ++first;
+  }
+  const Vec3 com = model.vessel_info.centre_of_mass_hull;  // body axes are the hull frame's, about this point
+  // 1. The load in the structure's axes (x into the ice that comes), about its axis at the water line: the ice's
+  // action along its drift is -Fx, the vertical Fz, the overturning moment about y My + (com x F)_y.
+  std::vector<double> fh, fv, fy, my;
+  {
+    const std::vector<double> ice = series.get("ice_load");
+    for (size_t i = first; i < steps; ++i) {
+      const Vec3 F(ice[6 * i], ice[6 * i + 1], ice[6 * i + 2]);
+      const Vec3 M = Vec3(ice[6 * i + 3], ice[6 * i + 4], ice[6 * i + 5]) + com.cross(F);
+      fh.push_back(-F.x());
+      fy.push_back(F.y());
+      fv.push_back(F.z());
+      my.push_back(M.y());
+    }
+  }
+  const size_t nw = window_samples(kFilterS, o.time_step_s);
+  const std::vector<double> fh_f = moving_average_full_windows(fh, nw);
+  j["kind"] = o.vessel.station_keeping.mode;
+  j["reference_point"] = "the structure's axis at the water line (the hull frame's origin)";
+  j["filter"] = {{"kind", "centred moving average of the compliant contacts' load (PHYSICS.md 5)"},
+                 {"window_s", kFilterS}};
+  j["steady_part"] = {{"from_s", o.steady_start_s}, {"to_s", o.duration_s}, {"samples", fh.size()}};
+  j["drift_speed_mps"] = o.drift.speed_mps;
+  j["horizontal_load_N"] = stats_json(stats_of(fh));
+  j["horizontal_load_filtered_N"] = stats_json(stats_of(fh_f));
+  j["transverse_load_N"] = stats_json(stats_of(fy));
+  j["vertical_load_N"] = stats_json(stats_of(fv));
+  j["overturning_moment_y_Nm"] = stats_json(stats_of(my));
+  // 2. Load cycles of the filtered horizontal load: the mean of the per-cycle peaks and the mean period, and the
+  // autocorrelation's dominant period, against (4-12) h/v (PHYSICS.md §8.2.4).
+  const double h = o.level_ice.thickness_m, v = o.drift.speed_mps;
+  if (!fh_f.empty()) {
+    const LoadCycles c = load_cycles(fh_f, o.time_step_s);
+    j["cycles"] = {{"count", c.peak.size()},
+                   {"mean_peak_N", c.peak.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.mean_peak)},
+                   {"mean_period_s", c.peak.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.mean_period_s)}};
+    if (v > 0) {
+      // On the filtered load decimated to a tenth of the filter window (it holds nothing faster).
+      const size_t every = std::max<size_t>(1, nw / 10);
+      std::vector<double> coarse;
+      for (size_t i = 0; i < fh_f.size(); i += every) coarse.push_back(fh_f[i]);
+      const double dt = every * o.time_step_s, span = dt * static_cast<double>(coarse.size());
+      const double lo = kPeriodBandLoHV * h / v, hi = std::min(kPeriodBandHiHV * h / v, span / 2);
+      const double p = dominant_period_s(coarse, dt, lo, hi);
+      j["dominant_period_s"] = std::isfinite(p) ? nlohmann::json(p) : nlohmann::json(nullptr);
+      j["dominant_period_band_s"] = {lo, hi};
+      j["period_over_h_per_v"] = {
+          {"cycles", c.peak.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.mean_period_s * v / h)},
+          {"dominant", std::isfinite(p) ? nlohmann::json(p * v / h) : nlohmann::json(nullptr)},
+          {"thickness_m", h}};
+    }
+  }
+  // 3. The rubble the run shows: the highest ice within the waterline width of the axis, per stored frame.
+  const double radius = model.vessel_info.beam_wl_m;
+  const Stats hr = stats_of(rubble_heights(model, r, o.steady_start_s, radius));
+  j["rubble_height_m"] = {{"mean", hr.mean}, {"max", hr.max}, {"within_m_of_axis", radius},
+                          {"what", "the highest ice above the water line near the structure, per stored frame"}};
+  return j;
+}
+
+}  // namespace floesim::sim
