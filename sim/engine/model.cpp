@@ -964,6 +964,9 @@ Model build_model(const FloeField& field, const HullModel* hull, const EngineSet
   // floes) after the free floes.
   const std::vector<Floe> floes = model_floes(field, o.level_ice);
   const std::vector<FloeGeometry> geo = floe_geometry(floes);
+  FLOESIM_REQUIRE(o.drift.speed_mps == 0 || !floes.empty(), "drift.speed_mps is ", o.drift.speed_mps,
+                  " m/s but there is no ice to drift (no floes, no level_ice.extent_m): give the ice, or set "
+                  "drift.speed_mps to 0");
 
   // 2. Floes must not overlap each other.
   model.small_overlaps += count_small_overlaps(geo, o);

@@ -1,0 +1,159 @@
+// Fixed structures in drifting ice (issue #34): a vertical cylinder crushing a level ice sheet at the crushing
+// pressure over its width and clearing exactly the ice it sweeps (geometry by hand), the momentum a fixed structure
+// carries against the ice's (a momentum budget in a vacuum), an upward-breaking cone bending the sheet up and being
+// pushed down (PHYSICS.md §8.2.5's sign), the same bits on one thread and two, and bad input named.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "pipeline/error.h"
+#include "pipeline/options.h"
+#include "pipeline/results_io.h"
+#include "sim_fixtures.h"
+
+namespace floesim::sim {
+namespace {
+
+using testing::expect_error;
+
+HullModel structure(const std::string& shape, double width) {
+  StructureShapeOptions s;
+  s.shape = shape;
+  s.waterline_width_m = width;
+  s.neck_width_m = 0.4 * width;
+  s.slope_deg = 45;
+  s.depth_m = 6;
+  s.height_m = 8;
+  return hull_model_from_parts(generate_structure(s));
+}
+
+// A fixed structure at the origin, its x axis into the ice, in a sheet from x = 6 m drifting onto it at `drift`.
+SimulateOptions drifting_sheet(double h, double drift) {
+  SimulateOptions o;
+  o.vessel.station_keeping.mode = "fixed";
+  o.drift.speed_mps = drift;
+  o.drift.direction_deg = 180;
+  o.water.current_speed_mps = drift;
+  o.water.current_direction_deg = 180;
+  o.level_ice.extent_m = {6, -40, 86, 40};
+  o.level_ice.tile_m = 80;
+  o.level_ice.thickness_m = h;
+  return o;
+}
+
+TEST(Structure, ACylinderCrushesTheSheetAtItsPressureOverItsWidthAndClearsWhatItSweeps) {
+  const double h = 1.0, w = 10.0, v = 0.5, sigma_c = 2e6, rho_i = 900;
+  SimulateOptions o = drifting_sheet(h, v);
+  const HullModel cylinder = structure("cylinder", w);
+  World world(build_model(FloeField{}, &cylinder, o));
+  const double dt = o.time_step_s;
+  // The sheet's edge is 1 m from the cylinder's face: contact at 2 s; the crushed face widens as the chord
+  // 2 sqrt(2 R d - d^2) of the depth d until the front half is in the ice (d = R = 5 m, at 12 s); from 14 s on the
+  // front presses on a crescent across its whole width.
+  const double duration = 24.0;
+  double sum = 0;
+  int n = 0;
+  const long steps = std::lround(duration / dt);
+  for (long k = 1; k <= steps; ++k) {
+    world.step();
+    if (k * dt > 14.0) {
+      sum += -world.report().ice_load.force.x();  // the cylinder moves +x through the ice: the ice pushes it -x
+      ++n;
+    }
+  }
+  // A round face of 32 flats, 10 m across them: the crushed face is its front half, 10 m wide.
+  EXPECT_NEAR(sum / n, sigma_c * w * h, 0.02 * sigma_c * w * h);
+  // Cleared: the ice the section has swept, less the crescent still pressed (at most the clearing depth deep): the
+  // swept region is the front half-disc plus the width times the travel past the edge's first touch.
+  const double travel = v * duration - 1.0, radius = w / 2;
+  const double swept = kPi * radius * radius / 2 + w * (travel - radius);
+  double cleared = 0;
+  int events = 0;
+  for (const FractureEvent& e : world.fracture_events()) {
+    EXPECT_EQ(e.mode, kFractureCrushing);
+    cleared += e.brash_mass_kg;
+    ++events;
+  }
+  EXPECT_GT(events, 40);
+  const double band = o.level_ice.clearing_depth_m * w;  // the crescent left in contact
+  EXPECT_LE(cleared / (rho_i * h), swept * 1.01);
+  EXPECT_GE(cleared / (rho_i * h), (swept - band) * 0.99);
+}
+
+TEST(Structure, AFixedStructureCarriesTheMomentumTheIceBrings) {
+  // A vacuum without gravity: the contact is the only force on the floe, so what the structure takes over the run
+  // is the floe's loss of momentum, to round-off.
+  SimulateOptions o;
+  o.vessel.station_keeping.mode = "fixed";
+  o.water.enabled = false;
+  o.water.gravity_mps2 = 0;
+  o.fracture.enabled = false;
+  o.sleep.enabled = false;
+  FloeField field;
+  field.floes.push_back(testing::rect_floe(1, 6, -8, 20, 14, 1.0));
+  const HullModel caisson = structure("caisson", 10);
+  World world(build_model(field, &caisson, o));
+  const int floe = 1;
+  world.mutable_state().velocity[floe] = Vec3(-1.0, 0.2, 0);
+  const Vec3 p0 = world.model().bodies[floe].mass_kg * world.state().velocity[floe];
+  Vec3 impulse = Vec3::Zero();
+  for (int k = 0; k < 1500; ++k) {
+    world.step();
+    impulse += o.time_step_s * world.report().ice_load.force;
+  }
+  const Vec3 p1 = world.model().bodies[floe].mass_kg * world.state().velocity[floe];
+  ASSERT_GT((p0 - p1).norm(), 0.5 * p0.norm());  // the floe hit the caisson and lost most of its momentum
+  EXPECT_LT((impulse + (p1 - p0)).norm(), 1e-9 * p0.norm());
+  EXPECT_EQ(world.state().position[0], world.model().bodies[0].initial_position);  // and the caisson never moved
+}
+
+TEST(Structure, AnUpwardBreakingConeBendsTheSheetUpAndIsPushedDown) {
+  SimulateOptions o = drifting_sheet(0.5, 0.3);
+  const HullModel cone = structure("cone", 10);
+  World world(build_model(FloeField{}, &cone, o));
+  double fz = 0;
+  for (int k = 0; k < 3000; ++k) {
+    world.step();
+    fz += world.report().ice_load.force.z();
+  }
+  int bending = 0;
+  for (const FractureEvent& e : world.fracture_events())
+    if (e.at_structure && (e.mode == kFractureBending || e.mode == kFractureRadial)) {
+      ++bending;
+      EXPECT_GT(e.force_n.z(), 0) << "the cone lifts the ice it breaks";
+    }
+  EXPECT_GT(bending, 0);
+  EXPECT_LT(fz, 0) << "the ice riding up presses the cone down (PHYSICS.md 8.2.5)";
+}
+
+TEST(Structure, TheSameBitsOnOneThreadAndTwo) {
+  auto loads = [](int threads) {
+    SimulateOptions o = drifting_sheet(0.5, 0.3);
+    o.threads = threads;
+    const HullModel cone = structure("cone", 10);
+    World world(build_model(FloeField{}, &cone, o));
+    std::vector<double> f;
+    for (int k = 0; k < 2500; ++k) {
+      world.step();
+      for (int i = 0; i < 3; ++i) f.push_back(world.report().ice_load.force[i]);
+    }
+    return f;
+  };
+  EXPECT_EQ(loads(1), loads(2));
+}
+
+TEST(Structure, BadInputIsNamed) {
+  SimulateOptions o = drifting_sheet(1.0, 0.2);
+  o.level_ice.extent_m.clear();
+  const HullModel cone = structure("cone", 10);
+  expect_error([&] { build_model(FloeField{}, &cone, o); }, {"drift.speed_mps", "no ice"});
+  Json j = options_to_json(drifting_sheet(1.0, 0.2));
+  j["vessel"]["propellers"] = Json::array({Json{{"position_m", {-10, 0, -3}}}});
+  expect_error([&] { read_options<SimulateOptions>(j, "case.json"); }, {"propellers", "fixed"});
+  j = options_to_json(drifting_sheet(1.0, 0.2));
+  j["vessel"]["station_keeping"]["mode"] = "floating";
+  expect_error([&] { read_options<SimulateOptions>(j, "case.json"); }, {"station_keeping.mode"});
+}
+
+}  // namespace
+}  // namespace floesim::sim
