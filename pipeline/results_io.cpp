@@ -54,6 +54,17 @@ const std::vector<FieldSpec>& series_fields() {
        "kinetic energy of the floes and pieces (translation and rotation) at the end of the step: a long run's ice "
        "must not gain energy",
        7},
+      {"station_offset", 3, "m, m, rad",
+       "a moored or DP structure (simulate.vessel.station_keeping): its reference point's offset from its station, "
+       "earth frame (x, y), and its heading's change; 0 for a ship or a fixed structure",
+       8},
+      {"station_keeping_demanded", 3, "N, N, N m",
+       "a moored or DP structure's station-keeping force (x, y, yaw moment) as asked: the DP controller's command "
+       "before the thrust limits (body axes), or the mooring lines' pull (the station's axes); 0 otherwise",
+       8},
+      {"station_keeping_delivered", 3, "N, N, N m",
+       "the same as given: the DP thrusters' after their limits, or the mooring lines' pull",
+       8},
   };
   return k;
 }

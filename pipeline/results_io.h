@@ -43,7 +43,8 @@
 //                                                   for a crushing event the crushed ice cleared
 //   /fracture/child_offset       [E+1]    int64     pieces of event k: child_id[offset[k] .. offset[k+1]-1]
 //   /fracture/child_id           [C]      int32     floe ids of the pieces that became bodies
-//   Layout "floesim-results/8" (this one) added the fracture mode 4, crushing. "/7" stores only the changed bodies
+//   Layout "floesim-results/8" (this one) added the fracture mode 4, crushing, and the series station_offset,
+//   station_keeping_demanded and station_keeping_delivered (NaN when reading an earlier file). "/7" stores only the changed bodies
 //   in a frame and added the series ice_kinetic_energy (NaN when reading an earlier file); earlier layouts stored every alive body in every frame,
 //   which FrameReplay reads the same way. "/6" added the series ice_load_level_ice (NaN when reading an earlier file);
 //   "/5" added /geometry/floe_level_ice (all 0 when reading an earlier file); "/4" added /states/in_contact; "/3"
@@ -176,7 +177,7 @@ class FrameReplay {
 
 // The per-step series of a run, one at a time. A long simulation keeps only the rows since its last checkpoint in
 // Results::series and leaves the earlier ones on disk in the checkpoint's chunks (sim/simulate/checkpoint.h): all the series
-// together are 72 values, 0.58 kB, per step (207 MB per simulated hour at 0.01 s), one of them at most 6 values.
+// together are 81 values, 0.65 kB, per step (233 MB per simulated hour at 0.01 s), one of them at most 6 values.
 // The results writer and the summary read them through this, one series at a time, so that a run's memory does not
 // hold them all.
 class SeriesSource {
@@ -203,7 +204,7 @@ class ResultsSeries final : public SeriesSource {
 void write_results(const std::filesystem::path& file, const Results& r, const SeriesSource& series);
 void write_results(const std::filesystem::path& file, const Results& r);
 // Reads and validates; errors name the file and the dataset. `only_series` (non-empty) reads just those series
-// (and time_s): a reader that needs one series of a long run need not hold them all (72 values, 0.58 kB, per step).
+// (and time_s): a reader that needs one series of a long run need not hold them all (81 values, 0.65 kB, per step).
 Results read_results(const std::filesystem::path& file, bool with_states = true,
                      const std::set<std::string>& only_series = {});
 

@@ -98,6 +98,16 @@ MooringLeg leg_from_pretension(const CatenaryLine& line, double azimuth_deg, dou
   return g;
 }
 
+MooringLeg mooring_leg(const MooringLineOptions& o) {
+  MooringLeg g = leg_from_pretension(CatenaryLine{o.weight_n_per_m, o.fairlead_height_m, o.length_m}, o.azimuth_deg,
+                                     o.pretension_n);
+  g.fairlead_x_m = o.fairlead_m[0];
+  g.fairlead_y_m = o.fairlead_m[1];
+  g.anchor_x_m += o.fairlead_m[0];
+  g.anchor_y_m += o.fairlead_m[1];
+  return g;
+}
+
 SpreadState spread_at_offset(const std::vector<MooringLeg>& legs, double dx, double dy) {
   return spread_at_pose(legs, dx, dy, 0.0);
 }
@@ -232,6 +242,18 @@ DpController::DpController(const DpControllerSettings& s, double xs, double ys, 
   if (!(s.observer_time_constant_s >= 0))
     p.push_back("dp.observer_time_constant_s must be >= 0, got " + text(s.observer_time_constant_s));
   throw_if(p, "dynamic positioning");
+}
+
+std::vector<double> DpController::memory() const {
+  return {est_[0], est_[1], est_[2], integral_[0], integral_[1], integral_[2], prev_[0], prev_[1], prev_[2],
+          first_ ? 1.0 : 0.0};
+}
+
+void DpController::set_memory(const std::vector<double>& m) {
+  FLOESIM_REQUIRE(m.size() == static_cast<size_t>(kMemory), "dynamic positioning: a controller's memory has ",
+                  kMemory, " values, not ", m.size());
+  for (int k = 0; k < 3; ++k) est_[k] = m[k], integral_[k] = m[3 + k], prev_[k] = m[6 + k];
+  first_ = m[9] != 0;
 }
 
 DpCommand DpController::step(double dt, double x, double y, double psi) {

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/options.h"
+
 namespace floesim {
 
 // One line: submerged weight per length w_l, fairlead height above the seabed h_d, length L.
@@ -39,6 +41,35 @@ double catenary_liftoff_tension_n(const CatenaryLine& line);
 // The line at horizontal span X, in (L - h_d, X(liftoff)): H found by bisection on X(H), which rises with H.
 CatenaryState catenary_at_span(const CatenaryLine& line, double span_m);
 
+// One mooring line as a case gives it: the catenary, its direction and pretension at the station, its fairlead.
+struct MooringLineOptions {
+  double weight_n_per_m = 1000;   // w_l
+  double fairlead_height_m = 40;  // h_d
+  double length_m = 600;          // L
+  double azimuth_deg = 0;         // from +x towards +y
+  double pretension_n = 300e3;    // H_0: sets the anchor's distance
+  std::vector<double> fairlead_m = {0, 0};  // on the body, from its reference point (a structure's axis), body axes
+  template <class V>
+  void visit(V& v) {
+    v.field("weight_n_per_m", weight_n_per_m, "N/m", "submerged weight per metre w_l", positive());
+    v.field("fairlead_height_m", fairlead_height_m, "m",
+            "fairlead height above the seabed h_d (the anchor lies on the seabed below it)", positive());
+    v.field("length_m", length_m, "m", "line length L (longer than fairlead_height_m)", positive());
+    v.field("azimuth_deg", azimuth_deg, "deg", "direction from the fairlead to the anchor, from +x towards +y");
+    v.field("pretension_n", pretension_n, "N", "horizontal pretension H_0 at the station (places the anchor)",
+            positive());
+    v.field("fairlead_m", fairlead_m, "m",
+            "[x, y] of the fairlead on the body, from its reference point (a structure's axis at the water line), "
+            "body axes",
+            Check<std::vector<double>>([](const std::vector<double>& f) -> std::string {
+              if (f.size() != 2 || !std::isfinite(f[0]) || !std::isfinite(f[1])) return "must be [x, y] (2 numbers)";
+              return "";
+            }));
+    if (length_m <= fairlead_height_m)
+      v.problem("length_m", "must exceed fairlead_height_m: a line shorter than the depth cannot reach the seabed");
+  }
+};
+
 // A spread mooring: lines from fairleads on the body (relative to its reference point, body at rest heading +x) to
 // anchors on the seabed.
 struct MooringLeg {
@@ -49,6 +80,8 @@ struct MooringLeg {
 // A leg at azimuth theta (deg, from +x towards +y) from a fairlead at the reference point, its anchor at the span
 // that gives the pretension H_0.
 MooringLeg leg_from_pretension(const CatenaryLine& line, double azimuth_deg, double pretension_n);
+// The leg of a line as given: from its fairlead at its azimuth, the anchor at the pretension's span beyond it.
+MooringLeg mooring_leg(const MooringLineOptions& o);
 
 struct SpreadState {
   double force_x_n = 0, force_y_n = 0;   // restoring force on the body
@@ -105,6 +138,11 @@ class DpController {
                double y0_m, double psi0_rad);
   // One control step of dt seconds with the measured pose: the command the thrusters are to give until the next.
   DpCommand step(double dt_s, double x_m, double y_m, double psi_rad);
+  // What carries over from one step to the next (the observer's pose, the integral, the last pose, whether a step
+  // was made), so that a run saved and restored, or one controller per step, goes on exactly as one controller would.
+  static constexpr int kMemory = 10;
+  std::vector<double> memory() const;
+  void set_memory(const std::vector<double>& m);  // an Error unless m has kMemory values
 
  private:
   DpControllerSettings s_;

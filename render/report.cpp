@@ -491,6 +491,23 @@ void fracture_section(std::ostream& body, const Json& summary) {
   }
 }
 
+// 3. Section "Structure", only for a fixed structure (summary.json "structure"): its loads raw and filtered, their
+// cycles and period, the rubble on it.
+void structure_section(std::ostream& body, const Json& summary) {
+  const Json* st = find(summary, {"structure"});
+  if (!st) return;
+  body << "<h2>Structure</h2>\n<p>The ice's action on the structure, along the ice's drift (horizontal), across it "
+          "(transverse) and vertical, in N, and the overturning moment about the structure's axis at the water "
+          "line, in N m; filtered: "
+       << html_escape((*st).value("filter", Json::object()).value("kind", std::string()))
+       << " over " << scalar_text((*st).value("filter", Json::object()).value("window_s", Json())) << " s.</p>\n"
+       << "<table id=\"structure\">\n" << scalar_rows(*st);
+  for (const char* k : {"horizontal_load_N", "horizontal_load_filtered_N", "transverse_load_N", "vertical_load_N",
+                        "overturning_moment_y_Nm", "cycles", "period_over_h_per_v", "rubble_height_m"})
+    if (const Json* q = find(*st, {k})) body << scalar_rows(*q, std::string(k) + ".");
+  body << "</table>\n";
+}
+
 // 3. Section "Video": embedded up to max_video_mb, else named beside the page; its size and embedding into rs.
 void video_section(std::ostream& body, const fs::path& run_dir, const ReportOptions& o, Page& pg, ReportSummary& rs) {
   body << "<h2>Video</h2>\n";
@@ -560,6 +577,7 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
   identified_section(body, run_dir, pg, rs);
   ice_field_section(body, run_dir, pg);
   hull_section(body, run_dir, summary, pg);
+  structure_section(body, summary);
   fracture_section(body, summary);
   video_section(body, run_dir, o, pg, rs);
   settings_section(body, run_dir, summary, pg);

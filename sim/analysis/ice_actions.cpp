@@ -112,7 +112,7 @@ std::string run_ice_actions(const IceActionsOptions& o, const fs::path& config_f
     std::vector<MooringLeg> legs;
     nlohmann::json lines = nlohmann::json::array();
     for (size_t i = 0; i < o.mooring.lines.size(); ++i) {
-      const IceActionsLineOptions& l = o.mooring.lines[i];
+      const MooringLineOptions& l = o.mooring.lines[i];
       const CatenaryLine line{l.weight_n_per_m, l.fairlead_height_m, l.length_m};
       CatenaryState s;
       try {
@@ -120,7 +120,7 @@ std::string run_ice_actions(const IceActionsOptions& o, const fs::path& config_f
       } catch (const Error& e) {
         throw Error(cfg + ": mooring.lines[" + std::to_string(i) + "]: " + e.what());
       }
-      legs.push_back(leg_from_pretension(line, l.azimuth_deg, l.pretension_n));
+      legs.push_back(mooring_leg(l));
       lines.push_back({{"span_m", s.span_m},
                        {"suspended_length_m", s.suspended_length_m},
                        {"suspended_span_m", s.suspended_span_m},

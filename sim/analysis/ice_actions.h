@@ -61,28 +61,8 @@ struct IceActionsRubbleOptions {
   }
 };
 
-struct IceActionsLineOptions {
-  double weight_n_per_m = 1000;   // w_l
-  double fairlead_height_m = 40;  // h_d
-  double length_m = 600;          // L
-  double azimuth_deg = 0;         // from +x towards +y
-  double pretension_n = 300e3;    // H_0: sets the anchor's distance
-  template <class V>
-  void visit(V& v) {
-    v.field("weight_n_per_m", weight_n_per_m, "N/m", "submerged weight per metre w_l", positive());
-    v.field("fairlead_height_m", fairlead_height_m, "m",
-            "fairlead height above the seabed h_d (the anchor lies on the seabed below it)", positive());
-    v.field("length_m", length_m, "m", "line length L (longer than fairlead_height_m)", positive());
-    v.field("azimuth_deg", azimuth_deg, "deg", "direction from the fairlead to the anchor, from +x towards +y");
-    v.field("pretension_n", pretension_n, "N", "horizontal pretension H_0 at the station (places the anchor)",
-            positive());
-    if (length_m <= fairlead_height_m)
-      v.problem("length_m", "must exceed fairlead_height_m: a line shorter than the depth cannot reach the seabed");
-  }
-};
-
 struct IceActionsMooringOptions {
-  std::vector<IceActionsLineOptions> lines;
+  std::vector<MooringLineOptions> lines;
   std::vector<double> loads_n = {1e6, 2e6};
   double load_direction_deg = 0;
   template <class V>

@@ -457,4 +457,44 @@ Wrench vessel_autopilot(const Model& m, const Body& b, const BodyKinematics& k, 
   return w;
 }
 
+Wrench station_keeping_force(const Model& m, const BodyKinematics& k, double time_s, double dt,
+                             std::vector<double>* dp_memory, StationKeeping* out) {
+  const StationKeepingOptions& sk = m.settings.vessel.station_keeping;
+  const Vec3 ref = k.x + k.R * m.reference_point_body;  // the reference point, run frame
+  const Vec3 earth = ref + time_s * m.frame_velocity;
+  const Vec2 offset = (earth - m.station).head<2>();
+  const double psi = heading_of(k.R);
+  const double dpsi = std::remainder(psi - m.station_heading_rad, 2 * kPi);
+  out->offset = offset;
+  out->heading_change_rad = dpsi;
+  const double ramp = sk.applied_force_ramp_s > 0 ? std::min(1.0, time_s / sk.applied_force_ramp_s) : 1.0;
+  Vec3 force = ramp * Vec3(sk.applied_force_n[0], sk.applied_force_n[1], 0);
+  double moment_z = 0;
+  if (sk.moored()) {
+    // The legs are laid out in the station's axes: the offset turned into them, the pull turned back.
+    const double c0 = std::cos(m.station_heading_rad), s0 = std::sin(m.station_heading_rad);
+    const double dx = c0 * offset.x() + s0 * offset.y(), dy = -s0 * offset.x() + c0 * offset.y();
+    const SpreadState sp = spread_at_pose(m.mooring, dx, dy, dpsi);
+    out->delivered[0] = out->demanded[0] = sp.force_x_n;
+    out->delivered[1] = out->demanded[1] = sp.force_y_n;
+    out->delivered[2] = out->demanded[2] = sp.moment_z_nm;
+    force += Vec3(c0 * sp.force_x_n - s0 * sp.force_y_n, s0 * sp.force_x_n + c0 * sp.force_y_n, 0);
+    moment_z = sp.moment_z_nm;
+  } else if (sk.dp_held()) {
+    DpController dp(m.dp, m.station.x(), m.station.y(), m.station_heading_rad, m.station.x(), m.station.y(),
+                    m.station_heading_rad);
+    if (!dp_memory->empty()) dp.set_memory(*dp_memory);
+    const DpCommand c = dp.step(dt, earth.x(), earth.y(), psi);
+    *dp_memory = dp.memory();
+    for (int i = 0; i < 3; ++i) out->demanded[i] = c.demanded[i], out->delivered[i] = c.delivered[i];
+    const double cp = std::cos(psi), sp = std::sin(psi);
+    force += Vec3(cp * c.delivered[0] - sp * c.delivered[1], sp * c.delivered[0] + cp * c.delivered[1], 0);
+    moment_z = c.delivered[2];
+  }
+  Wrench w;
+  w.force = force;
+  w.torque = (ref - k.x).cross(force) + Vec3(0, 0, moment_z);
+  return w;
+}
+
 }  // namespace floesim::sim

@@ -823,6 +823,27 @@ std::vector<Polygon> add_vessel(const HullModel& hull, const std::vector<Floe>& 
     return vessel_footprint(hull, model.bodies[0], com, floes, o);
   }
   metacentric_heights(b, sub.volume, o, vp);
+  // A moored or DP body's station: its reference point (the hull frame's origin) and heading at the start.
+  model.reference_point_body = -com;
+  model.station = b.initial_position + b.initial_orientation * model.reference_point_body;
+  model.station_heading_rad = o.vessel.heading_deg * kPi / 180;
+  for (size_t i = 0; i < o.vessel.station_keeping.lines.size(); ++i) {
+    try {
+      model.mooring.push_back(mooring_leg(o.vessel.station_keeping.lines[i]));
+    } catch (const Error& e) {
+      throw Error("vessel.station_keeping.lines[" + std::to_string(i) + "]: " + e.what());
+    }
+  }
+  if (o.vessel.station_keeping.dp_held()) {  // gains per degree of freedom from its mass with the added mass
+    const DpOptions& d = o.vessel.station_keeping.dp;
+    model.dp.surge = dp_gains(b.mass_kg + b.added_mass.x(), d.natural_period_s, d.damping_ratio);
+    model.dp.sway = dp_gains(b.mass_kg + b.added_mass.y(), d.natural_period_s, d.damping_ratio);
+    model.dp.yaw = dp_gains(b.inertia(2, 2) + b.added_inertia.z(), d.yaw_natural_period_s, d.damping_ratio);
+    model.dp.max_force_x_n = d.max_force_x_n;
+    model.dp.max_force_y_n = d.max_force_y_n;
+    model.dp.max_moment_z_nm = d.max_moment_z_nm;
+    model.dp.observer_time_constant_s = d.observer_time_constant_s;
+  }
   if (o.water.enabled)
     set_damping(b, o, o.water.vessel_heave_damping_ratio, o.water.vessel_roll_damping_ratio,
                 o.water.vessel_pitch_damping_ratio);

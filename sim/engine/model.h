@@ -150,6 +150,16 @@ struct Model {
   std::vector<double> thrust_time_s, thrust_n;  // thrust_series mode
   std::vector<Propeller> propellers;            // their jets wash the floes (forces.h, PropellerJet)
 
+  // A structure held by station keeping (vessel.station_keeping, issue #34): its reference point (the hull frame's
+  // origin, a structure's axis at the water line) in the body frame, where it is and how it heads at the station (the
+  // start; earth frame), and a moored body's mooring legs (fairleads from the reference point, body axes at the
+  // station; anchors on the seabed relative to the station).
+  Vec3 reference_point_body = Vec3::Zero();
+  Vec3 station = Vec3::Zero();
+  double station_heading_rad = 0;
+  std::vector<MooringLeg> mooring;
+  DpControllerSettings dp;  // a DP body's controller: gains from its mass and added mass, limits, observer
+
   int wall_count = 0;                 // domain walls, the last bodies of the model as built
   // The bodies build_model made: the vessel, the input floes (and level ice tiles) and the walls. A world appends
   // the pieces of broken ice after them and never changes these entries, so the first built_bodies of a world's

@@ -13,6 +13,7 @@
 
 #include "pipeline/geometry2d.h"
 #include "pipeline/options.h"
+#include "pipeline/station_keeping.h"
 
 namespace floesim::sim {
 
@@ -179,20 +180,78 @@ struct AutopilotOptions {
   }
 };
 
-// How the hull body is held (issue #34). A ship is driven by its propulsion; a structure is "fixed": it does not
-// move in the earth frame (in a run with drift, in the ice's frame it moves at minus the drift: Kinematic, infinite
-// mass), and the ice's load on it is what it carries.
+// Dynamic positioning (§8.4.2): a PID controller over the earth-frame position and heading about the station (the
+// start), fed by a low-pass observer, its command in body axes clipped at the thrusters' limits. Gains per degree of
+// freedom from the closed loop asked for: K_p = M w_n^2, K_d = 2 zeta M w_n, K_i = K_p w_n / 10, M the body's mass (or
+// yaw inertia) with its added mass.
+struct DpOptions {
+  double natural_period_s = 100.0;         // T_n of surge and sway
+  double yaw_natural_period_s = 100.0;     // T_n of yaw
+  double damping_ratio = 0.7;
+  double max_force_x_n = 2e6;              // thrust limits, body axes
+  double max_force_y_n = 1e6;
+  double max_moment_z_nm = 5e7;
+  double observer_time_constant_s = 10.0;  // 0: the measured pose as it is
+  template <class V>
+  void visit(V& v) {
+    v.field("natural_period_s", natural_period_s, "s", "closed-loop natural period of surge and sway (60-150 s)",
+            positive());
+    v.field("yaw_natural_period_s", yaw_natural_period_s, "s", "closed-loop natural period of yaw", positive());
+    v.field("damping_ratio", damping_ratio, "-", "closed-loop damping ratio", positive());
+    v.field("max_force_x_n", max_force_x_n, "N", "largest surge thrust (body x)", positive());
+    v.field("max_force_y_n", max_force_y_n, "N", "largest sway thrust (body y)", positive());
+    v.field("max_moment_z_nm", max_moment_z_nm, "N m", "largest yaw moment of the thrusters", positive());
+    v.field("observer_time_constant_s", observer_time_constant_s, "s",
+            "time constant of the low-pass observer of the measured pose (0: none; floe impacts at 0.05-0.5 Hz lie "
+            "far above the DP bandwidth)",
+            non_negative());
+  }
+};
+
+// How the hull body is held (issue #34). A ship is driven by its propulsion; a structure is "fixed" (it does not move
+// in the earth frame: in a run with drift, in the ice's frame it moves at minus the drift; kinematic, infinite
+// mass), "moored" (it floats, held by a spread of catenary mooring lines, §8.4.1) or "dp" (it floats, held by a
+// dynamic-positioning controller, §8.4.2). The station is where the body starts.
 struct StationKeepingOptions {
-  std::string mode = "propulsion";  // propulsion | fixed
+  std::string mode = "propulsion";  // propulsion | fixed | moored | dp
+  std::vector<MooringLineOptions> lines;       // moored
+  DpOptions dp;
+  std::vector<double> applied_force_n = {0, 0};  // moored, dp: a steady pull, earth frame
+  double applied_force_ramp_s = 0;               // the pull grows linearly over this time (0: at once)
   template <class V>
   void visit(V& v) {
     v.field("mode", mode, "-",
-            "propulsion (a ship, driven by vessel.propulsion and steered by vessel.autopilot) or fixed (a structure "
-            "that does not move in the earth frame: a bridge pier, a lighthouse, a platform on the seabed; the "
-            "vessel's propulsion, autopilot, resistance and initial speed do not apply)",
-            one_of({"propulsion", "fixed"}));
+            "propulsion (a ship, driven by vessel.propulsion and steered by vessel.autopilot), fixed (a structure "
+            "that does not move in the earth frame: a bridge pier, a lighthouse, a platform on the seabed), moored "
+            "(a floating structure held by the mooring lines of station_keeping.lines) or dp (held by the "
+            "dynamic-positioning controller of station_keeping.dp); for all but propulsion the vessel's propulsion, "
+            "autopilot and initial speed do not apply, and the station is where the body starts",
+            one_of({"propulsion", "fixed", "moored", "dp"}));
+    v.list("lines", lines,
+           "moored: the mooring lines, each a catenary with a grounded part (PHYSICS.md 8.4.1) from its fairlead on "
+           "the body to its anchor on the seabed, placed by its azimuth and pretension at the station");
+    v.section("dp", dp, "dp: the dynamic-positioning controller");
+    v.field("applied_force_n", applied_force_n, "N",
+            "moored, dp: a steady external pull [x, y] on the body's reference point, earth frame (a tug, or a "
+            "pull test of the mooring)",
+            Check<std::vector<double>>([](const std::vector<double>& f) -> std::string {
+              if (f.size() != 2 || !std::isfinite(f[0]) || !std::isfinite(f[1])) return "must be [x, y] (2 numbers)";
+              return "";
+            }));
+    v.field("applied_force_ramp_s", applied_force_ramp_s, "s",
+            "the applied pull grows linearly from 0 over this time (a tug taking the strain; long against the "
+            "body's natural period, the pull is quasi-static); 0 = at once",
+            non_negative());
+    if (mode == "moored" && lines.empty()) v.problem("lines", "a moored body needs at least one mooring line");
+    if (mode != "moored" && !lines.empty())
+      v.problem("lines", "mooring lines hold only a moored body (mode \"moored\"), not mode \"" + mode + "\"");
+    if ((mode == "propulsion" || mode == "fixed") && (applied_force_n[0] != 0 || applied_force_n[1] != 0))
+      v.problem("applied_force_n", "acts only on a moored or dp body");
   }
   bool fixed() const { return mode == "fixed"; }
+  bool moored() const { return mode == "moored"; }
+  bool dp_held() const { return mode == "dp"; }
+  bool held() const { return mode != "propulsion"; }  // a structure: fixed, moored or dp
 };
 
 struct VesselOptions {
@@ -269,8 +328,9 @@ struct VesselOptions {
     v.list("propellers", propellers,
            "the vessel's propellers, whose jets (PHYSICS.md 3.5) wash the floes; [] = no propeller wash");
     v.section("station_keeping", station_keeping, "how the hull body is held: a ship's propulsion, or fixed (a structure)");
-    if (station_keeping.fixed() && !propellers.empty())
-      v.problem("propellers", "a fixed structure (station_keeping.mode fixed) has no propellers: remove them");
+    if (station_keeping.held() && !propellers.empty())
+      v.problem("propellers", "a structure (station_keeping.mode " + station_keeping.mode + ", not propulsion) has no "
+                "propellers whose wash is modelled: remove them");
     double shares = 0;
     for (const PropellerOptions& p : propellers) shares += p.thrust_share;
     if (shares > 1 + 1e-9)

@@ -89,7 +89,7 @@ World::World(Model built) : model_(std::move(built)), pool_(model_.settings.thre
     state_.awake[v] = 1;
     const Mat3 R = state_.orientation[v].toRotationMatrix();
     state_.velocity[v] = o.vessel.initial_speed_mps * R.col(0) + Vec3(model.current.x(), model.current.y(), 0);
-    if (model.bodies[v].kinematic) state_.velocity[v] = -model.frame_velocity;  // at rest in the earth frame
+    if (o.vessel.station_keeping.held()) state_.velocity[v] = -model.frame_velocity;  // at rest in the earth frame
     state_.heading_ref_rad = heading_of(R);
   }
   // Inverse mass matrices (world) as the solver sees them; the forces stage refreshes those of awake bodies.
@@ -239,12 +239,19 @@ void World::stage_forces() {
       report_.hydro_load += vessel_cross_flow(model_, k);
     }
     report_.wind_load = vessel_wind(model_, k);
-    report_.propulsion_load = vessel_propulsion(model_, k, state_.time_s, dt, state_.speed_error_integral,
-                                                report_.thrust_n);
-    report_.propulsion_load += vessel_autopilot(model_, body, k, state_.heading_ref_rad);
-    // The jets from the pose and thrust at the start of the step, for every floe's drag below. The vessel's own
-    // jets leave its hull astern; their effect on the hull (thrust deduction) is in the resistance and thrust.
-    propeller_jets(model_, k, report_.thrust_n, jets_);
+    if (model_.settings.vessel.station_keeping.held()) {
+      // A moored or DP structure: its mooring lines or thrusters take the place of propulsion and steering (its
+      // thrusters' wash is not modelled).
+      report_.propulsion_load =
+          station_keeping_force(model_, k, state_.time_s, dt, &state_.dp_memory, &report_.station_keeping);
+    } else {
+      report_.propulsion_load = vessel_propulsion(model_, k, state_.time_s, dt, state_.speed_error_integral,
+                                                  report_.thrust_n);
+      report_.propulsion_load += vessel_autopilot(model_, body, k, state_.heading_ref_rad);
+      // The jets from the pose and thrust at the start of the step, for every floe's drag below. The vessel's own
+      // jets leave its hull astern; their effect on the hull (thrust deduction) is in the resistance and thrust.
+      propeller_jets(model_, k, report_.thrust_n, jets_);
+    }
     total += report_.hydro_load;
     total += report_.wind_load;
     total += report_.propulsion_load;
@@ -662,6 +669,7 @@ void World::save(ByteWriter& w) const {
   }
   w.pod(s.speed_error_integral);
   w.pod(s.heading_ref_rad);
+  w.vec(s.dp_memory);
   // 3. What else carries over: mass matrices as the solver saw them, jets, the fracture record, moved bodies.
   put_mat3s(w, solver_bodies_.inv_mass);
   put_mat3s(w, solver_bodies_.inv_inertia_world);
@@ -808,6 +816,9 @@ std::unique_ptr<World> World::restore(const Model& base, ByteReader& r) {
   }
   s.speed_error_integral = r.pod<double>();
   s.heading_ref_rad = r.pod<double>();
+  s.dp_memory = r.vec<double>();
+  FLOESIM_REQUIRE(s.dp_memory.empty() || s.dp_memory.size() == static_cast<size_t>(DpController::kMemory), r.what(),
+                  ": damaged (a DP controller's memory of ", s.dp_memory.size(), " values)");
   // 3. The rest.
   get_mat3s(r, w->solver_bodies_.inv_mass);
   require_bodies(r, w->solver_bodies_.inv_mass.size(), n, "inverse masses");

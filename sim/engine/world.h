@@ -51,8 +51,9 @@ struct StepReport {
   double surge_load_error_n = 0;
   Wrench ice_load, ice_load_rigid, ice_load_compliant;
   Wrench ice_load_level_ice;  // part of ice_load from contacts with level ice tiles (breaking the sheet's edge)
-  Wrench hydro_load, wind_load, propulsion_load;
+  Wrench hydro_load, wind_load, propulsion_load;  // propulsion_load: a moored or DP body's station keeping
   double thrust_n = 0;
+  StationKeeping station_keeping;  // a moored or DP body: its offset, heading change, demanded and delivered force
 };
 
 class World {

@@ -158,6 +158,9 @@ Recorder::Recorder(const SimulateOptions& o, Results& r, long rows_held) : o_(o)
   c_vel_ = col.at("vessel_velocity_mps");
   c_omega_ = col.at("vessel_angular_velocity_radps");
   c_kinetic_ = col.at("ice_kinetic_energy");
+  c_offset_ = col.at("station_offset");
+  c_demanded_ = col.at("station_keeping_demanded");
+  c_delivered_ = col.at("station_keeping_delivered");
   for (const LoadSeries& f : kLoadSeries) c_loads_.push_back(col.at(f.name));
   for (const ScalarSeries& f : kScalarSeries) c_scalar_.push_back(col.at(f.name));
   // The states grow with the ice that moves (a frame stores only what changed: no reservation by field size).
@@ -186,6 +189,10 @@ void Recorder::record_step(const World& w, long k) {
   for (size_t i = 0; i < c_loads_.size(); ++i) push_body_wrench(*c_loads_[i], R, rep.*kLoadSeries[i].load);
   for (size_t i = 0; i < c_scalar_.size(); ++i) c_scalar_[i]->push_back(kScalarSeries[i].get(rep));
   c_kinetic_->push_back(ice_kinetic_energy(w));
+  const StationKeeping& sk = rep.station_keeping;
+  c_offset_->insert(c_offset_->end(), {sk.offset.x(), sk.offset.y(), sk.heading_change_rad});
+  c_demanded_->insert(c_demanded_->end(), {sk.demanded[0], sk.demanded[1], sk.demanded[2]});
+  c_delivered_->insert(c_delivered_->end(), {sk.delivered[0], sk.delivered[1], sk.delivered[2]});
   // 2. The run's sums.
   sums_.awake += rep.awake_floes;
   sums_.contacts += rep.contacts;

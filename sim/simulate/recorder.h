@@ -48,6 +48,7 @@ class Recorder {
   long every_;
   // Direct references to the series columns: no map look-up per step.
   std::vector<double>*c_time_, *c_pos_, *c_quat_, *c_vel_, *c_omega_, *c_kinetic_;
+  std::vector<double>*c_offset_, *c_demanded_, *c_delivered_;
   std::vector<std::vector<double>*> c_loads_;   // the wrench series, in the order of kLoadSeries
   std::vector<std::vector<double>*> c_scalar_;  // the scalar series, in the order of kScalarSeries
   std::vector<int8_t> pressed_;                 // per body: pressed against the vessel in this step (frames only)

@@ -37,7 +37,7 @@ struct CheckpointPlan {
   bool resume = false;               // continue from the checkpoint in dir (if there is one of this run)
   // The series rows written to a checkpoint leave memory (Results::series then starts at series_first_step; read
   // the whole series through CheckpointSeries, sim/simulate/checkpoint.h, before the checkpoint folder is removed): a long
-  // run's memory then holds one checkpoint interval of them, not 0.58 kB for every step.
+  // run's memory then holds one checkpoint interval of them, not 0.65 kB for every step.
   bool spill_series = false;
 };
 

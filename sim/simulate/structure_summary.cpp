@@ -4,6 +4,7 @@
 
 #include "pipeline/error.h"
 #include "pipeline/signal.h"
+#include "pipeline/station_keeping.h"
 #include "sim/simulate/summary.h"
 
 namespace floesim::sim {
@@ -74,6 +75,94 @@ std::vector<double> rubble_heights(const Model& model, const Results& r, double 
   return heights;
 }
 
+// A moored or DP structure: its offset and heading change, the force balance along the drift (PHYSICS.md §8.4.3:
+// the mean station-keeping force against the mean ice, water and wind loads, earth frame), and each mooring line's
+// tension (quasi-static: from the recorded offset, PHYSICS.md §8.4.1) or the DP thrusters' use of their limits.
+nlohmann::json station_keeping_summary(const SimulateOptions& o, const Model& model, const SeriesSource& series,
+                                       size_t first) {
+  nlohmann::json j;
+  const size_t steps = series.steps();
+  const std::vector<double> off = series.get("station_offset");
+  std::vector<double> dx, dy, dist, dpsi;
+  for (size_t i = first; i < steps; ++i) {
+    dx.push_back(off[3 * i]);
+    dy.push_back(off[3 * i + 1]);
+    dist.push_back(std::hypot(off[3 * i], off[3 * i + 1]));
+    dpsi.push_back(off[3 * i + 2] * 180 / kPi);
+  }
+  j["offset_x_m"] = stats_json(stats_of(dx));
+  j["offset_y_m"] = stats_json(stats_of(dy));
+  j["offset_m"] = stats_json(stats_of(dist));
+  j["heading_change_deg"] = stats_json(stats_of(dpsi));
+  // 1. The balance along the drift (or the station's x axis without one): each load turned into the earth frame.
+  const Vec2 drift = o.drift.velocity();
+  const double a = model.station_heading_rad;
+  const Vec3 along = drift.norm() > 0 ? Vec3(drift.x(), drift.y(), 0).normalized() : Vec3(std::cos(a), std::sin(a), 0);
+  const std::vector<double> quat = series.get("vessel_quaternion_wxyz");
+  const double n = static_cast<double>(steps - first);
+  auto mean_along = [&](const char* name) {
+    const std::vector<double> f = series.get(name);
+    double sum = 0;
+    for (size_t i = first; i < steps; ++i) {
+      const Quat q(quat[4 * i], quat[4 * i + 1], quat[4 * i + 2], quat[4 * i + 3]);
+      sum += along.dot(q * Vec3(f[6 * i], f[6 * i + 1], f[6 * i + 2]));
+    }
+    return sum / n;
+  };
+  const double ice = mean_along("ice_load"), water = mean_along("hydro_load"), wind = mean_along("wind_load");
+  const double held = mean_along("propulsion_load");
+  j["force_balance_along_drift_N"] = {{"ice", ice},
+                                      {"water", water},
+                                      {"wind", wind},
+                                      {"station_keeping", held},
+                                      {"residual", ice + water + wind + held},
+                                      {"station_keeping_over_loads", -held / (ice + water + wind)}};
+  // 2. The lines' tensions at the recorded offsets, or the thrusters' use of their limits.
+  const StationKeepingOptions& sk = o.vessel.station_keeping;
+  if (sk.moored()) {
+    const double c0 = std::cos(a), s0 = std::sin(a);
+    std::vector<Stats> h(model.mooring.size()), t(model.mooring.size());
+    std::vector<std::vector<double>> hs(model.mooring.size()), ts(model.mooring.size());
+    for (size_t i = first; i < steps; ++i) {
+      const double ex = off[3 * i], ey = off[3 * i + 1];
+      const SpreadState sp = spread_at_pose(model.mooring, c0 * ex + s0 * ey, -s0 * ex + c0 * ey, off[3 * i + 2]);
+      for (size_t l = 0; l < sp.lines.size(); ++l) {
+        hs[l].push_back(sp.lines[l].horizontal_tension_n);
+        ts[l].push_back(sp.lines[l].fairlead_tension_n);
+      }
+    }
+    nlohmann::json lines = nlohmann::json::array();
+    double largest = 0;
+    for (size_t l = 0; l < hs.size(); ++l) {
+      const Stats sh = stats_of(hs[l]), st = stats_of(ts[l]);
+      largest = std::max(largest, st.max);
+      lines.push_back({{"azimuth_deg", sk.lines[l].azimuth_deg},
+                       {"horizontal_tension_N", stats_json(sh)},
+                       {"fairlead_tension_N", stats_json(st)}});
+    }
+    j["lines"] = lines;
+    j["largest_fairlead_tension_N"] = largest;
+  } else {
+    const std::vector<double> dem = series.get("station_keeping_demanded");
+    const std::vector<double> del = series.get("station_keeping_delivered");
+    const double limit[3] = {sk.dp.max_force_x_n, sk.dp.max_force_y_n, sk.dp.max_moment_z_nm};
+    const char* axis[3] = {"surge", "sway", "yaw"};
+    for (int k = 0; k < 3; ++k) {
+      double use = 0, ask = 0;
+      size_t saturated = 0;
+      for (size_t i = first; i < steps; ++i) {
+        use = std::max(use, std::abs(del[3 * i + k]) / limit[k]);
+        ask = std::max(ask, std::abs(dem[3 * i + k]) / limit[k]);
+        saturated += std::abs(dem[3 * i + k]) > limit[k];
+      }
+      j["thrusters"][axis[k]] = {{"largest_delivered_over_limit", use},
+                                 {"largest_demanded_over_limit", ask},
+                                 {"share_of_steps_saturated", static_cast<double>(saturated) / n}};
+    }
+  }
+  return j;
+}
+
 }  // namespace
 
 nlohmann::json structure_summary(const SimulateOptions& o, const Model& model, const Results& r,
@@ -121,7 +210,7 @@ nlohmann::json structure_summary(const SimulateOptions& o, const Model& model, c
     j["cycles"] = {{"count", c.peak.size()},
                    {"mean_peak_N", c.peak.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.mean_peak)},
                    {"mean_period_s", c.peak.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.mean_period_s)}};
-    if (v > 0) {
+    if (v > 0 && !o.level_ice.extent_m.empty()) {  // against h/v in a level ice sheet
       // On the filtered load decimated to a tenth of the filter window (it holds nothing faster).
       const size_t every = std::max<size_t>(1, nw / 10);
       std::vector<double> coarse;
@@ -142,6 +231,8 @@ nlohmann::json structure_summary(const SimulateOptions& o, const Model& model, c
   const Stats hr = stats_of(rubble_heights(model, r, o.steady_start_s, radius));
   j["rubble_height_m"] = {{"mean", hr.mean}, {"max", hr.max}, {"within_m_of_axis", radius},
                           {"what", "the highest ice above the water line near the structure, per stored frame"}};
+  if (o.vessel.station_keeping.moored() || o.vessel.station_keeping.dp_held())
+    j["station_keeping"] = station_keeping_summary(o, model, series, first);
   return j;
 }
 

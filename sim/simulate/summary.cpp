@@ -459,7 +459,7 @@ nlohmann::json summarize(const SimulateOptions& o, const Model& model, const Res
   s["small_floe_overlaps"] = model.small_overlaps;
   s["fracture"] = fracture_summary(o, r);
   s["level_ice"] = level_ice_summary(o, model, r, series);
-  if (o.vessel.station_keeping.fixed()) s["structure"] = structure_summary(o, model, r, series);
+  if (o.vessel.station_keeping.held()) s["structure"] = structure_summary(o, model, r, series);
   const VesselParticulars& vp = model.vessel_info;
   s["vessel"] = {{"mass_kg", vp.mass_kg},
                  {"length_oa_m", vp.length_oa_m},

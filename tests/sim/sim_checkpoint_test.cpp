@@ -35,7 +35,7 @@ void seal(const fs::path& p, const std::string& magic, const std::string& payloa
 
 
 const char kRecordsMagic[] = "floesim-checkpoint-records/1\n";
-const char kCheckpointMagic[] = "floesim-checkpoint/5\n";
+const char kCheckpointMagic[] = "floesim-checkpoint/6\n";
 
 // Element `index` of the array `name` in a records chunk set to `value` (of the array's element type T), the chunk
 // re-sealed and checkpoint.bin re-sealed naming its new hash: the hashes all agree and the array sizes still add up.
@@ -220,7 +220,7 @@ TEST_F(Checkpoint, ResealedPieceBeyondAnyFieldIsRefused) {
 }
 
 // A run whose checkpoints take its series out of memory (what the simulate stage does, so that a long transit's
-// memory does not grow by 0.58 kB per step): it holds only the steps since its last checkpoint, and reads the rest
+// memory does not grow by 0.65 kB per step): it holds only the steps since its last checkpoint, and reads the rest
 // back from the chunks equal to the bit to the run that held them all; the results file written through them is the
 // same file, byte for byte, and so is the summary.
 TEST_F(Checkpoint, SpilledSeriesReadBackEqualTheSeriesHeldInMemory) {

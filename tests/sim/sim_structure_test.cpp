@@ -1,7 +1,9 @@
-// Fixed structures in drifting ice (issue #34): a vertical cylinder crushing a level ice sheet at the crushing
-// pressure over its width and clearing exactly the ice it sweeps (geometry by hand), the momentum a fixed structure
-// carries against the ice's (a momentum budget in a vacuum), an upward-breaking cone bending the sheet up and being
-// pushed down (PHYSICS.md §8.2.5's sign), the same bits on one thread and two, and bad input named.
+// Structures in drifting ice (issue #34): a vertical cylinder crushing a level ice sheet at the crushing pressure over
+// its width and clearing exactly the ice it sweeps (geometry by hand), the momentum a fixed structure carries against
+// the ice's (a momentum budget in a vacuum), an upward-breaking cone bending the sheet up and being pushed down
+// (PHYSICS.md §8.2.5's sign), a moored body's offset under a steady pull against §8.4.1's worked catenary figures, a
+// DP body back at its station within its thrust limits (§8.4.2), the same bits on one thread and two, and bad input
+// named.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -142,6 +144,91 @@ TEST(Structure, TheSameBitsOnOneThreadAndTwo) {
   EXPECT_EQ(loads(1), loads(2));
 }
 
+// A floating caisson, 30 m square and 6 m deep, on the 12-line spread of PHYSICS.md §8.4.1's worked example
+// (1 kN/m chain, 40 m above the seabed, 600 m long, 300 kN pretension, at 15 + 30 i degrees).
+SimulateOptions moored_caisson() {
+  SimulateOptions o;
+  o.vessel.station_keeping.mode = "moored";
+  for (int i = 0; i < 12; ++i) {
+    MooringLineOptions l;
+    l.azimuth_deg = 15 + 30 * i;
+    o.vessel.station_keeping.lines.push_back(l);
+  }
+  o.vessel.vcg_m = -2.0;
+  return o;
+}
+
+HullModel floating_caisson() {
+  StructureShapeOptions s;
+  s.shape = "caisson";
+  s.waterline_width_m = 30;
+  s.depth_m = 6;
+  s.height_m = 6;
+  return hull_model_from_parts(generate_structure(s));
+}
+
+// The reference point's offset from the station, earth frame (the run here is in the earth frame).
+Vec2 offset_of(const World& w) {
+  const Model& m = w.model();
+  const Vec3 ref = w.state().position[0] + w.state().orientation[0] * m.reference_point_body;
+  return (ref - m.station).head<2>();
+}
+
+TEST(Structure, AMooredBodyTakesTheCatenarysOffsetUnderASteadyPull) {
+  // §8.4.1: 1 MN gives 1.64 m (the linear stiffness's 1.79 m would be 9 % off). The pull grows over 150 s, ten
+  // natural periods (2 pi sqrt(m / K_xx) = 14 s), so the body follows it quasi-statically; then held for 150 s.
+  for (const double load : {1e6, 2e6}) {
+    SimulateOptions o = moored_caisson();
+    o.vessel.station_keeping.applied_force_n = {load, 0};
+    o.vessel.station_keeping.applied_force_ramp_s = 150;
+    const HullModel caisson = floating_caisson();
+    World world(build_model(FloeField{}, &caisson, o));
+    double sum = 0, pull = 0, lo = 1e9, hi = -1e9;
+    int n = 0;
+    for (int k = 1; k <= 30000; ++k) {
+      world.step();
+      if (k > 20000) {
+        const double x = offset_of(world).x();
+        sum += x, lo = std::min(lo, x), hi = std::max(hi, x), ++n;
+        pull += world.report().station_keeping.delivered[0];
+      }
+    }
+    const double expected = load == 1e6 ? 1.64 : 2.74;  // PHYSICS.md §8.4.1, to its printed digits
+    EXPECT_NEAR(sum / n, expected, 0.01) << load;
+    EXPECT_LT(hi - lo, 0.1 * expected) << "a small swing about it: the pull was taken on quasi-statically";
+    // The lines' mean pull balances the load: what the run recorded as the station keeping's force.
+    EXPECT_NEAR(pull / n, -load, 0.005 * load);
+  }
+}
+
+TEST(Structure, ADpBodyReturnsToItsStationWithinItsLimits) {
+  // §8.4.2: the caisson held by DP under a steady 0.5 MN pull; P and D alone would leave F / K_p, the integral takes
+  // it back to the station. The thrusters never deliver more than their limits.
+  SimulateOptions o;
+  o.vessel.station_keeping.mode = "dp";
+  o.vessel.vcg_m = -2.0;
+  o.vessel.station_keeping.applied_force_n = {5e5, 0};
+  o.vessel.station_keeping.dp.max_force_x_n = 8e5;
+  const HullModel caisson = floating_caisson();
+  World world(build_model(FloeField{}, &caisson, o));
+  const DpOptions& d = o.vessel.station_keeping.dp;
+  double largest = 0, late = 0;
+  int n = 0;
+  const long steps = std::lround(1200.0 / o.time_step_s);
+  for (long k = 1; k <= steps; ++k) {
+    world.step();
+    const StationKeeping& sk = world.report().station_keeping;
+    largest = std::max(largest, std::abs(sk.delivered[0]) / d.max_force_x_n);
+    largest = std::max(largest, std::abs(sk.delivered[1]) / d.max_force_y_n);
+    largest = std::max(largest, std::abs(sk.delivered[2]) / d.max_moment_z_nm);
+    if (k * o.time_step_s > 900) late += offset_of(world).x(), ++n;
+  }
+  const double kp = world.model().dp.surge.proportional;
+  EXPECT_GT(5e5 / kp, 1.0) << "without the integral the offset would be metres";
+  EXPECT_LT(std::abs(late / n), 0.02 * 5e5 / kp);
+  EXPECT_LE(largest, 1.0);
+}
+
 TEST(Structure, BadInputIsNamed) {
   SimulateOptions o = drifting_sheet(1.0, 0.2);
   o.level_ice.extent_m.clear();
@@ -153,6 +240,21 @@ TEST(Structure, BadInputIsNamed) {
   j = options_to_json(drifting_sheet(1.0, 0.2));
   j["vessel"]["station_keeping"]["mode"] = "floating";
   expect_error([&] { read_options<SimulateOptions>(j, "case.json"); }, {"station_keeping.mode"});
+  // Mooring: a line shorter than the water depth, a moored body without lines, negative DP figures.
+  j = options_to_json(moored_caisson());
+  j["vessel"]["station_keeping"]["lines"][3]["length_m"] = 30;
+  expect_error([&] { read_options<SimulateOptions>(j, "case.json"); },
+               {"station_keeping.lines[3].length_m", "fairlead_height_m"});
+  j = options_to_json(moored_caisson());
+  j["vessel"]["station_keeping"]["lines"] = Json::array();
+  expect_error([&] { read_options<SimulateOptions>(j, "case.json"); }, {"station_keeping.lines", "at least one"});
+  j = options_to_json(moored_caisson());
+  j["vessel"]["station_keeping"]["mode"] = "dp";
+  j["vessel"]["station_keeping"]["lines"] = Json::array();
+  j["vessel"]["station_keeping"]["dp"]["damping_ratio"] = -0.7;
+  j["vessel"]["station_keeping"]["dp"]["max_force_y_n"] = 0;
+  expect_error([&] { read_options<SimulateOptions>(j, "case.json"); },
+               {"station_keeping.dp.damping_ratio", "station_keeping.dp.max_force_y_n"});
 }
 
 }  // namespace
