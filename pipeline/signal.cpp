@@ -215,9 +215,12 @@ double dominant_period_s(const std::vector<double>& x, double dt_s, double min_p
   if (!(r(0) > 0)) return nan;
   std::vector<double> rk(hi + 2);
   for (size_t k = lo - 1; k <= hi + 1; ++k) rk[k] = r(k);
-  size_t best = lo;
+  // The largest peak inside the band: a lag whose autocorrelation is positive and at least its neighbours'. A
+  // series without a period there has none (its autocorrelation falls across the band, its largest value at an end).
+  size_t best = 0;
   for (size_t k = lo; k <= hi; ++k)
-    if (rk[k] > rk[best]) best = k;
+    if (rk[k] > 0 && rk[k] >= rk[k - 1] && rk[k] >= rk[k + 1] && (best == 0 || rk[k] > rk[best])) best = k;
+  if (best == 0) return nan;
   const double a = rk[best - 1], b = rk[best], c = rk[best + 1], d = a - 2 * b + c;
   const double shift = d < 0 ? 0.5 * (a - c) / d : 0.0;
   return dt_s * (static_cast<double>(best) + std::clamp(shift, -0.5, 0.5));

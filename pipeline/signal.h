@@ -76,9 +76,10 @@ struct LoadCycles {
 LoadCycles load_cycles(const std::vector<double>& x, double dt_s, double band_std = 0.1);
 
 // The dominant period of a series: the lag in [min_period_s, max_period_s] at which its autocorrelation (about its
-// mean; the biased estimate, which tapers with the lag so that a period wins over its multiples) is largest, refined
-// by a parabola through that lag and its neighbours. NaN when the series is constant or
-// shorter than two of the longest lag. O(n x lags).
+// mean; the biased estimate, which tapers with the lag so that a period wins over its multiples) has its largest
+// peak (positive, at least its neighbours), refined by a parabola through that lag and its neighbours. NaN when the
+// series is constant, shorter than two of the longest lag, or has no peak in the band (no period there: its
+// autocorrelation only falls across it). O(n x lags).
 double dominant_period_s(const std::vector<double>& x, double dt_s, double min_period_s, double max_period_s);
 
 // Sample step of a time column: (t_last - t_first) / (n - 1); Error if fewer than 2 samples, not increasing, or

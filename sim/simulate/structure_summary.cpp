@@ -1,6 +1,7 @@
 // summary.json "structure": what an engineer checks a fixed structure's ice load by (issue #34, PHYSICS.md §8).
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "pipeline/error.h"
 #include "pipeline/signal.h"
@@ -163,6 +164,36 @@ nlohmann::json station_keeping_summary(const SimulateOptions& o, const Model& mo
   return j;
 }
 
+// The load cycles of a filtered load (pipeline/signal.h load_cycles: the count, the mean of the per-cycle peaks, the
+// mean period) and its autocorrelation's dominant period; with a drift in a level ice sheet both periods over h/v
+// (PHYSICS.md §8.2.4's 4-12), the dominant one searched over 1-30 h/v.
+nlohmann::json cycles_json(const std::vector<double>& f, const SimulateOptions& o, size_t nw) {
+  auto number = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
+  nlohmann::json j;
+  if (f.empty()) return j;
+  const LoadCycles c = load_cycles(f, o.time_step_s);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  j["count"] = c.peak.size();
+  j["mean_peak_N"] = number(c.peak.empty() ? nan : c.mean_peak);
+  j["mean_period_s"] = number(c.peak.empty() ? nan : c.mean_period_s);
+  const double h = o.level_ice.thickness_m, v = o.drift.speed_mps;
+  if (v > 0 && !o.level_ice.extent_m.empty()) {
+    // On the filtered load decimated to a tenth of the filter window (it holds nothing faster).
+    const size_t every = std::max<size_t>(1, nw / 10);
+    std::vector<double> coarse;
+    for (size_t i = 0; i < f.size(); i += every) coarse.push_back(f[i]);
+    const double dt = every * o.time_step_s, span = dt * static_cast<double>(coarse.size());
+    const double lo = kPeriodBandLoHV * h / v, hi = std::min(kPeriodBandHiHV * h / v, span / 2);
+    const double p = lo < hi ? dominant_period_s(coarse, dt, lo, hi) : nan;
+    j["dominant_period_s"] = number(p);
+    j["dominant_period_band_s"] = {lo, hi};
+    j["period_over_h_per_v"] = {{"cycles", number(c.peak.empty() ? nan : c.mean_period_s * v / h)},
+                                {"dominant", number(p * v / h)},
+                                {"thickness_m", h}};
+  }
+  return j;
+}
+
 }  // namespace
 
 nlohmann::json structure_summary(const SimulateOptions& o, const Model& model, const Results& r,
@@ -202,29 +233,19 @@ nlohmann::json structure_summary(const SimulateOptions& o, const Model& model, c
   j["transverse_load_N"] = stats_json(stats_of(fy));
   j["vertical_load_N"] = stats_json(stats_of(fv));
   j["overturning_moment_y_Nm"] = stats_json(stats_of(my));
-  // 2. Load cycles of the filtered horizontal load: the mean of the per-cycle peaks and the mean period, and the
-  // autocorrelation's dominant period, against (4-12) h/v (PHYSICS.md §8.2.4).
-  const double h = o.level_ice.thickness_m, v = o.drift.speed_mps;
-  if (!fh_f.empty()) {
-    const LoadCycles c = load_cycles(fh_f, o.time_step_s);
-    j["cycles"] = {{"count", c.peak.size()},
-                   {"mean_peak_N", c.peak.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.mean_peak)},
-                   {"mean_period_s", c.peak.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.mean_period_s)}};
-    if (v > 0 && !o.level_ice.extent_m.empty()) {  // against h/v in a level ice sheet
-      // On the filtered load decimated to a tenth of the filter window (it holds nothing faster).
-      const size_t every = std::max<size_t>(1, nw / 10);
-      std::vector<double> coarse;
-      for (size_t i = 0; i < fh_f.size(); i += every) coarse.push_back(fh_f[i]);
-      const double dt = every * o.time_step_s, span = dt * static_cast<double>(coarse.size());
-      const double lo = kPeriodBandLoHV * h / v, hi = std::min(kPeriodBandHiHV * h / v, span / 2);
-      const double p = dominant_period_s(coarse, dt, lo, hi);
-      j["dominant_period_s"] = std::isfinite(p) ? nlohmann::json(p) : nlohmann::json(nullptr);
-      j["dominant_period_band_s"] = {lo, hi};
-      j["period_over_h_per_v"] = {
-          {"cycles", c.peak.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.mean_period_s * v / h)},
-          {"dominant", std::isfinite(p) ? nlohmann::json(p * v / h) : nlohmann::json(nullptr)},
-          {"thickness_m", h}};
-    }
+  // 2. Load cycles of the filtered horizontal load, and of its part from the level ice sheet (breaking its edge:
+  // the cycles of §8.2.4), each against (4-12) h/v.
+  j["cycles"] = cycles_json(fh_f, o, nw);
+  if (!o.level_ice.extent_m.empty()) {
+    std::vector<double> sheet;
+    const std::vector<double> li = series.get("ice_load_level_ice");
+    for (size_t i = first; i < steps; ++i) sheet.push_back(-li[6 * i]);
+    const std::vector<double> sheet_f = moving_average_full_windows(sheet, nw);
+    j["breaking"] = {{"what", "the part of the horizontal load from the level ice sheet's tiles (ice_load_level_ice): "
+                              "the structure breaking the sheet's edge, without the rubble and the broken pieces"},
+                     {"load_N", stats_json(stats_of(sheet))},
+                     {"load_filtered_N", stats_json(stats_of(sheet_f))},
+                     {"cycles", cycles_json(sheet_f, o, nw)}};
   }
   // 3. The rubble the run shows: the highest ice within the waterline width of the axis, per stored frame.
   const double radius = model.vessel_info.beam_wl_m;

@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
     if (help_config) {
       std::cout << "Parametric icebreaker (a config without \"file\" or \"structure\"):\n\n"
                 << floesim::options_doc(sim::HullGeneratorOptions{})
-                << "\nA structure (a config with \"structure\"; not yet a case's hull):\n\n"
+                << "\nA structure (a config with \"structure\"; a case's hull.structure):\n\n"
                 << floesim::options_doc(StructureHullConfig{})
                 << "\nA user's mesh (a config with \"file\", as a case's hull section):\n\n"
                 << floesim::options_doc(sim::HullImportOptions{});

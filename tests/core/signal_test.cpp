@@ -62,6 +62,12 @@ TEST(LoadCycles, HysteresisKeepsNoisyCyclesWhole) {
   EXPECT_GT(load_cycles(x, dt, 0.0).peak.size(), 40u);  // without the band the noise splits the cycles
   // A constant series has no period and no cycle.
   EXPECT_TRUE(std::isnan(dominant_period_s(std::vector<double>(5000, 2.0), dt, 1.0, 10.0)));
+  // Nor has a slow ramp in a band of short lags: its autocorrelation only falls across the band (its largest value
+  // at the band's lower end is no period). The sine above, searched from a tenth of its period, still has its own.
+  std::vector<double> ramp;
+  for (int i = 0; i < 20000; ++i) ramp.push_back(i * dt);
+  EXPECT_TRUE(std::isnan(dominant_period_s(ramp, dt, 1.0, 10.0)));
+  EXPECT_NEAR(dominant_period_s(x, dt, 0.73, 20.0), period, 2 * dt);
   EXPECT_TRUE(std::isnan(load_cycles(std::vector<double>(5000, 2.0), dt).mean_peak));
 }
 
