@@ -104,6 +104,23 @@ std::string scalar_rows(const Json& obj, const std::string& prefix = "") {
   return rows;
 }
 
+// Rows for every scalar of a JSON object and of the objects and arrays inside it, named by their path
+// ("cycles.mean_peak_N", "lines[3].fairlead_tension_N.max").
+std::string nested_rows(const Json& obj, const std::string& prefix = "") {
+  std::string rows = scalar_rows(obj, prefix);
+  for (auto it = obj.begin(); it != obj.end(); ++it) {
+    if (it.value().is_object()) rows += nested_rows(it.value(), prefix + it.key() + ".");
+    if (it.value().is_array())
+      for (size_t i = 0; i < it.value().size(); ++i) {
+        const Json& e = it.value()[i];
+        const std::string name = prefix + it.key() + "[" + std::to_string(i) + "]";
+        if (e.is_object()) rows += nested_rows(e, name + ".");
+        else rows += "<tr><th>" + html_escape(name) + "</th><td>" + scalar_text(e) + "</td></tr>\n";
+      }
+  }
+  return rows;
+}
+
 const Json* find(const Json& j, std::initializer_list<const char*> path) {
   const Json* p = &j;
   for (const char* k : path) {
@@ -501,11 +518,7 @@ void structure_section(std::ostream& body, const Json& summary) {
           "line, in N m; filtered: "
        << html_escape((*st).value("filter", Json::object()).value("kind", std::string()))
        << " over " << scalar_text((*st).value("filter", Json::object()).value("window_s", Json())) << " s.</p>\n"
-       << "<table id=\"structure\">\n" << scalar_rows(*st);
-  for (const char* k : {"horizontal_load_N", "horizontal_load_filtered_N", "transverse_load_N", "vertical_load_N",
-                        "overturning_moment_y_Nm", "cycles", "period_over_h_per_v", "rubble_height_m"})
-    if (const Json* q = find(*st, {k})) body << scalar_rows(*q, std::string(k) + ".");
-  body << "</table>\n";
+       << "<table id=\"structure\">\n" << nested_rows(*st) << "</table>\n";
 }
 
 // 3. Section "Video": embedded up to max_video_mb, else named beside the page; its size and embedding into rs.

@@ -812,6 +812,10 @@ std::vector<Polygon> add_vessel(const HullModel& hull, const std::vector<Floe>& 
   add_propellers(o, com, model);
   // A fixed structure stands where the hull frame puts it (its waterline at z = 0, not floated to its weight).
   place_vessel(b, hull, com, o.vessel.station_keeping.fixed() ? 0.0 : fl.dz, o, model);
+  // A structure's station: its reference point (the hull frame's origin) and heading at the start.
+  model.reference_point_body = -com;
+  model.station = b.initial_position + b.initial_orientation * model.reference_point_body;
+  model.station_heading_rad = o.vessel.heading_deg * kPi / 180;
   if (o.vessel.station_keeping.fixed()) {
     // A fixed structure: nothing moves it (its floating figures are reported, its stability does not matter).
     b.kinematic = true;
@@ -823,10 +827,6 @@ std::vector<Polygon> add_vessel(const HullModel& hull, const std::vector<Floe>& 
     return vessel_footprint(hull, model.bodies[0], com, floes, o);
   }
   metacentric_heights(b, sub.volume, o, vp);
-  // A moored or DP body's station: its reference point (the hull frame's origin) and heading at the start.
-  model.reference_point_body = -com;
-  model.station = b.initial_position + b.initial_orientation * model.reference_point_body;
-  model.station_heading_rad = o.vessel.heading_deg * kPi / 180;
   for (size_t i = 0; i < o.vessel.station_keeping.lines.size(); ++i) {
     try {
       model.mooring.push_back(mooring_leg(o.vessel.station_keeping.lines[i]));

@@ -247,7 +247,24 @@ nlohmann::json structure_summary(const SimulateOptions& o, const Model& model, c
                      {"load_filtered_N", stats_json(stats_of(sheet_f))},
                      {"cycles", cycles_json(sheet_f, o, nw)}};
   }
-  // 3. The rubble the run shows: the highest ice within the waterline width of the axis, per stored frame.
+  // 3. How far across the drift the ice broke, against the sheet's sides: the sides are held (fixed tiles), so they
+  // leave no artefact in the loads while no crack comes near them.
+  const std::vector<double>& e = o.level_ice.extent_m;
+  if (!e.empty() && o.drift.speed_mps > 0) {
+    const Vec2 d = o.drift.velocity().normalized(), across(-d.y(), d.x());
+    const Vec2 axis = model.station.head<2>();
+    double farthest = 0;
+    for (size_t k = 0; k < r.fracture_time_s.size(); ++k)
+      farthest = std::max(farthest, std::abs(across.dot(Vec2(r.fracture_point_m[3 * k], r.fracture_point_m[3 * k + 1]) -
+                                                          axis)));
+    double side = std::numeric_limits<double>::infinity();  // the nearer side of the sheet across the drift
+    for (const Vec2& c : {Vec2(e[0], e[1]), Vec2(e[2], e[1]), Vec2(e[2], e[3]), Vec2(e[0], e[3])})
+      side = std::min(side, std::abs(across.dot(c - axis)));
+    j["sheet_sides"] = {{"farthest_fracture_across_drift_m", farthest},
+                        {"nearer_side_across_drift_m", side},
+                        {"margin_m", side - farthest}};
+  }
+  // 4. The rubble the run shows: the highest ice within the waterline width of the axis, per stored frame.
   const double radius = model.vessel_info.beam_wl_m;
   const Stats hr = stats_of(rubble_heights(model, r, o.steady_start_s, radius));
   j["rubble_height_m"] = {{"mean", hr.mean}, {"max", hr.max}, {"within_m_of_axis", radius},

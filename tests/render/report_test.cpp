@@ -246,6 +246,25 @@ TEST_F(TinyRun, ReferenceErrorOnThePageAgainstAHandValue) {
             std::string::npos);
 }
 
+// A structure's summary gets a section of its own, every figure named by its path; a ship's run has none.
+TEST_F(TinyRun, AStructuresFiguresHaveASectionOfTheirOwn) {
+  ASSERT_EQ(ran_.code, 0) << ran_.text;
+  const fs::path run = copy_run("structure");
+  write_report(run, ReportOptions{}, root_ / "ship.html", Json::object());
+  EXPECT_EQ(read_text(root_ / "ship.html").find("<h2>Structure</h2>"), std::string::npos);
+  Json s = load_json_file(run / "sim/summary.json");
+  s["structure"] = {{"kind", "moored"},
+                    {"cycles", {{"mean_peak_N", 1.25e6}}},
+                    {"station_keeping", {{"lines", Json::array({{{"fairlead_tension_N", {{"max", 3.4e5}}}}})}}}};
+  std::ofstream(run / "sim/summary.json") << s.dump(2);
+  write_report(run, ReportOptions{}, root_ / "structure.html", Json::object());
+  const std::string html = read_text(root_ / "structure.html");
+  EXPECT_NE(html.find("<h2>Structure</h2>"), std::string::npos);
+  EXPECT_NE(html.find("<th>kind</th><td>moored</td>"), std::string::npos);
+  EXPECT_NE(html.find("<th>cycles.mean_peak_N</th><td>1.25e+06</td>"), std::string::npos);
+  EXPECT_NE(html.find("<th>station_keeping.lines[0].fairlead_tension_N.max</th><td>3.4e+05</td>"), std::string::npos);
+}
+
 TEST_F(TinyRun, MissingVideoIsSaidOnThePageAndInStdout) {
   ASSERT_EQ(ran_.code, 0) << ran_.text;
   const fs::path run = copy_run("novideo");
