@@ -57,10 +57,17 @@ World::World(Model built) : model_(std::move(built)), pool_(model_.settings.thre
   const size_t n = model.bodies.size();
   base_bodies_ = n;
   const EngineSettings& o = model.settings;
-  // Floes rest only in still water and air (a current or wind drives every floe, and in vacuum nothing holds
-  // them): only then do they start asleep at their hydrostatic equilibrium, and only then may they fall asleep.
+  // Floes rest only where nothing drives them faster than the sleep threshold: in still water (a current drives
+  // every floe), under air still enough that the drift it gives a free floe, u_a sqrt(rho_a C_a / (rho_w C_f)) (its
+  // top's air drag against its bottom's skin friction: 1.7 % of the air's speed for SAMS ice), stays below
+  // sleep.linear_mps (in a drift run the still air moves past the ice at the drift), and never in vacuum (nothing
+  // holds them). Only then do they start asleep at their hydrostatic equilibrium, and only then may they fall asleep.
+  const double cf = o.water.skin_friction_cf;
+  const double wind_drift =
+      cf > 0 ? model.wind.norm() * std::sqrt(o.wind.air_density_kg_m3 * o.ice.air_drag_ca / (o.water.density_kg_m3 * cf))
+             : std::numeric_limits<double>::infinity();
   sleep_allowed_ = o.sleep.enabled && o.water.enabled && model.current.squaredNorm() == 0 &&
-                   model.wind.squaredNorm() == 0;
+                   (model.wind.squaredNorm() == 0 || wind_drift < o.sleep.linear_mps);
   const bool start_asleep = sleep_allowed_;
   state_.position.resize(n);
   state_.orientation.resize(n);

@@ -256,6 +256,25 @@ TEST(Structure, ADpWorldSavedAndRestoredStepsOnBitForBit) {
   EXPECT_EQ(a.state().position[0], b->state().position[0]);
 }
 
+TEST(Structure, IceDriftingUnderStillAirRestsUntilTheStructureComes) {
+  // In the ice's frame the still air passes the ice at the drift: 0.5 m/s of it drives a free floe at 0.5 sqrt(1.3 x
+  // 0.0012 / (1025 x 0.005)) = 8.7 mm/s, below the 20 mm/s a floe sleeps under, so the field may rest; 2 m/s of wind
+  // against the drift (2.5 m/s past the ice: 43 mm/s) drives it, and nothing sleeps.
+  for (const double wind : {0.0, 2.0}) {
+    SimulateOptions o;
+    o.vessel.station_keeping.mode = "fixed";
+    o.drift.speed_mps = o.water.current_speed_mps = 0.5;
+    o.drift.direction_deg = o.water.current_direction_deg = 180;
+    o.wind.speed_mps = wind;
+    FloeField field;
+    field.floes.push_back(testing::rect_floe(1, 200, -10, 20, 20, 1.0));
+    const HullModel cone = structure("cone", 10);
+    World world(build_model(field, &cone, o));
+    for (int k = 0; k < 300; ++k) world.step();
+    EXPECT_EQ(world.state().awake[1], wind == 0 ? 0 : 1) << "wind " << wind;
+  }
+}
+
 TEST(Structure, BadInputIsNamed) {
   SimulateOptions o = drifting_sheet(1.0, 0.2);
   o.level_ice.extent_m.clear();
