@@ -112,11 +112,23 @@ nlohmann::json station_keeping_summary(const SimulateOptions& o, const Model& mo
   };
   const double ice = mean_along("ice_load"), water = mean_along("hydro_load"), wind = mean_along("wind_load");
   const double held = mean_along("propulsion_load");
+  // What the forces left over changed the body's momentum (with its added mass, body axes): over a window of a few
+  // natural periods the mean of a swinging body's inertia force is not quite zero.
+  const std::vector<double> vel = series.get("vessel_velocity_mps");
+  const Body& body = model.bodies[model.vessel];
+  auto momentum = [&](size_t i) {
+    const Quat q(quat[4 * i], quat[4 * i + 1], quat[4 * i + 2], quat[4 * i + 3]);
+    const Vec3 vb(vel[3 * i], vel[3 * i + 1], vel[3 * i + 2]);
+    return along.dot(q * (Vec3::Constant(body.mass_kg) + body.added_mass).cwiseProduct(vb));
+  };
+  const double window = o.time_step_s * n;
+  const double inertia = steps > first ? (momentum(steps - 1) - momentum(first)) / window : 0.0;
   j["force_balance_along_drift_N"] = {{"ice", ice},
                                       {"water", water},
                                       {"wind", wind},
                                       {"station_keeping", held},
                                       {"residual", ice + water + wind + held},
+                                      {"momentum_change_per_time", inertia},
                                       {"station_keeping_over_loads", -held / (ice + water + wind)}};
   // 2. The lines' tensions at the recorded offsets, or the thrusters' use of their limits.
   const StationKeepingOptions& sk = o.vessel.station_keeping;
