@@ -44,14 +44,15 @@
 //   /fracture/child_offset       [E+1]    int64     pieces of event k: child_id[offset[k] .. offset[k+1]-1]
 //   /fracture/child_id           [C]      int32     floe ids of the pieces that became bodies
 //   Layout "floesim-results/8" (this one) added the fracture mode 4, crushing, and the series station_offset,
-//   station_keeping_demanded and station_keeping_delivered (NaN when reading an earlier file). "/7" stores only the changed bodies
-//   in a frame and added the series ice_kinetic_energy (NaN when reading an earlier file); earlier layouts stored every alive body in every frame,
-//   which FrameReplay reads the same way. "/6" added the series ice_load_level_ice (NaN when reading an earlier file);
-//   "/5" added /geometry/floe_level_ice (all 0 when reading an earlier file); "/4" added /states/in_contact; "/3"
-//   added the solver series (relax sweeps and residual, subspace solves, capped steps, contact-law violations); "/2"
-//   added /fracture and the lineage datasets. "/1" to "/5" files are still read: a series a file lacks is filled as
-//   FieldSpec::since says (input floes only, no events; solver figures NaN: not recorded), /states/in_contact as
-//   all 0 (not recorded: no floe is shown in contact) and /geometry/floe_level_ice as all 0.
+//   station_keeping_demanded and station_keeping_delivered (NaN when reading an earlier file). "/7" stores only the
+//   changed bodies in a frame and added the series ice_kinetic_energy (NaN when reading an earlier file); earlier
+//   layouts stored every alive body in every frame, which FrameReplay reads the same way. "/6" added the series
+//   ice_load_level_ice (NaN when reading an earlier file); "/5" added /geometry/floe_level_ice (all 0 when reading an
+//   earlier file); "/4" added /states/in_contact; "/3" added the solver series (relax sweeps and residual, subspace
+//   solves, capped steps, contact-law violations); "/2" added /fracture and the lineage datasets. "/1" to "/7" files
+//   are still read: a series a file lacks is filled as FieldSpec::since says (input floes only, no events; solver
+//   figures NaN: not recorded), /states/in_contact as all 0 (not recorded: no floe is shown in contact) and
+//   /geometry/floe_level_ice as all 0.
 //   attribute "floesim" on the root: JSON text with layout version, time_step_s, duration_s,
 //   output_interval_s and the provenance.
 #pragma once

@@ -92,7 +92,8 @@ std::vector<FractureCut> find_clearings(const Model& model, const State& state, 
                                                   state.orientation[s], zc, zc);
         if (world.size() < 3) continue;
         Polygon local;
-        for (const Vec2& v : world) local.push_back((Rt.transpose() * Vec3(v.x() - xt.x(), v.y() - xt.y(), 0)).head<2>());
+        for (const Vec2& v : world)
+          local.push_back((Rt.transpose() * Vec3(v.x() - xt.x(), v.y() - xt.y(), 0)).head<2>());
         // The mean depth of the overlap: its area over its width across the pressing direction (a crescent of
         // depth d across a round front is d deep, though its horns reach back along the sides).
         double area = 0, across = 0;
@@ -105,7 +106,7 @@ std::vector<FractureCut> find_clearings(const Model& model, const State& state, 
         footprints.push_back(std::move(local));
       }
       if (depth <= clear) continue;
-      // 3. The tile less the footprints moved back by the kept depth; leftovers below (h/2)^2 are crushed too.
+      // 3. The tile less the footprints moved back by the kept depth; leftovers that are chips are crushed too.
       std::vector<Polygon> rest = {tile.outline};
       for (const Polygon& f : footprints) {
         Polygon cutter;

@@ -7,10 +7,11 @@
 // So, after the fracture stage: for each level-ice tile a fixed structure crushes (a crushing contact between the
 // two), the structure's section at the tile's mid-plane (each convex part cut by it) is compared with the tile.
 // Where it has pushed into the tile deeper than level_ice.clearing_depth_m (the overlap's mean depth: its area over
-// its width across the direction the structure presses, the contacts' normal impulses summed), the ice it overlaps there is cut out of the tile, with a fifth of that depth
-// left in contact: the section moved back by it along the pressing direction is subtracted. On a sloping face the
-// mid-plane is where the crushed edge's contact acts: above it the slope has left the ice, below it the ice still
-// presses, and a wedge breaks off by bending long before much is cleared.
+// its width across the direction the structure presses, the contacts' normal impulses summed), the ice it overlaps
+// there is cut out of the tile, with a fifth of that depth left in contact: the section moved back by it along the
+// pressing direction is subtracted. On a sloping face the mid-plane is where the crushed edge's contact acts: above
+// it the slope has left the ice, below it the ice still presses, and a wedge breaks off by bending long before much
+// is cleared.
 // The tile's rest stays fixed (what the sheet keeps); the cleared mass and any leftover that is a chip (is_chip) are
 // the crushed ice, recorded as a fracture event of mode crushing (kFractureCrushing) with that mass.
 // The edge left behind fits the structure's front, so the next steps' overlap is a crescent across the whole

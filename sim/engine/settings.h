@@ -327,7 +327,8 @@ struct VesselOptions {
     v.section("autopilot", autopilot, "heading hold");
     v.list("propellers", propellers,
            "the vessel's propellers, whose jets (PHYSICS.md 3.5) wash the floes; [] = no propeller wash");
-    v.section("station_keeping", station_keeping, "how the hull body is held: a ship's propulsion, or fixed (a structure)");
+    v.section("station_keeping", station_keeping,
+              "how the hull body is held: a ship's propulsion, or a structure fixed, moored or on DP");
     if (station_keeping.held() && !propellers.empty())
       v.problem("propellers", "a structure (station_keeping.mode " + station_keeping.mode + ", not propulsion) has no "
                 "propellers whose wash is modelled: remove them");

@@ -63,9 +63,9 @@ World::World(Model built) : model_(std::move(built)), pool_(model_.settings.thre
   // sleep.linear_mps (in a drift run the still air moves past the ice at the drift), and never in vacuum (nothing
   // holds them). Only then do they start asleep at their hydrostatic equilibrium, and only then may they fall asleep.
   const double cf = o.water.skin_friction_cf;
+  const double air_over_water = o.wind.air_density_kg_m3 * o.ice.air_drag_ca / (o.water.density_kg_m3 * cf);
   const double wind_drift =
-      cf > 0 ? model.wind.norm() * std::sqrt(o.wind.air_density_kg_m3 * o.ice.air_drag_ca / (o.water.density_kg_m3 * cf))
-             : std::numeric_limits<double>::infinity();
+      cf > 0 ? model.wind.norm() * std::sqrt(air_over_water) : std::numeric_limits<double>::infinity();
   sleep_allowed_ = o.sleep.enabled && o.water.enabled && model.current.squaredNorm() == 0 &&
                    (model.wind.squaredNorm() == 0 || wind_drift < o.sleep.linear_mps);
   const bool start_asleep = sleep_allowed_;

@@ -1,4 +1,4 @@
-// summary.json "structure": what an engineer checks a fixed structure's ice load by (issue #34, PHYSICS.md §8).
+// summary.json "structure": what an engineer checks a structure's ice load and station keeping by (issue #34, PHYSICS.md §8).
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -44,7 +44,6 @@ std::vector<double> rubble_heights(const Model& model, const Results& r, double 
   std::vector<double> heights;
   if (r.frames() == 0) return heights;
   const Vec3 com = model.vessel_info.centre_of_mass_hull;
-  std::vector<size_t> geometry(r.floe_id.size());
   FrameReplay replay(r, "the results");
   for (size_t f = 0; f < r.frames(); ++f) {
     replay.seek(f);
