@@ -1,4 +1,4 @@
-// summary.json "structure": what an engineer checks a structure's ice load and station keeping by (issue #34, PHYSICS.md §8).
+// summary.json "structure": what an engineer checks a structure's ice load and station keeping by (PHYSICS.md §8).
 #include <algorithm>
 #include <cmath>
 #include <limits>
