@@ -704,10 +704,10 @@ struct LevelIceOptions {
             "it several times the ice's characteristic length)",
             in_range(1, 1e4));
     v.field("clearing_depth_m", clearing_depth_m, "m",
-            "a structure (vessel.station_keeping.mode fixed) crushing into a tile: once its section in the ice's band "
-            "has pushed this far into the tile, the crushed ice is cleared (extruded: cut out of the tile along the "
-            "section, a fifth of this depth left in contact, its mass counted); without it a vertical structure "
-            "would tunnel into the sheet",
+            "a structure (vessel.station_keeping.mode fixed) crushing into a tile: once its section at the tile's "
+            "mid-plane overlaps the tile this deep on average (area over width), the crushed ice is cleared "
+            "(extruded: cut out of the tile along the section, a fifth of this depth left in contact, its mass "
+            "counted); without it a vertical structure would tunnel into the sheet",
             in_range(0.01, 10));
     for (size_t i = 1; i < thickness_profile.size(); ++i)
       if (!(thickness_profile[i].x_m > thickness_profile[i - 1].x_m))
