@@ -12,6 +12,13 @@ Check<double> positive() {
 Check<double> non_negative() {
   return [](const double& x) { return x >= 0 && std::isfinite(x) ? "" : std::string("must be >= 0"); };
 }
+Check<std::vector<double>> plane_point() {
+  return [](const std::vector<double>& p) {
+    if (p.size() != 2) return std::string("must be [x, y] (2 numbers)");
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1])) return std::string("must be finite numbers");
+    return std::string();
+  };
+}
 Check<double> in_range(double lo, double hi) {
   return [lo, hi](const double& x) {
     return x >= lo && x <= hi ? std::string()

@@ -38,6 +38,8 @@ Check<double> in_range(double lo, double hi);  // closed interval
 Check<int> positive_int();
 Check<int> int_in_range(int lo, int hi);
 Check<std::string> one_of(std::vector<std::string> choices);
+// A point in the plane: [x, y], two finite numbers.
+Check<std::vector<double>> plane_point();
 
 // Reads a JSON file; errors name the file and the line/column of a syntax error.
 Json load_json_file(const std::filesystem::path& file);

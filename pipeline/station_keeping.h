@@ -61,10 +61,7 @@ struct MooringLineOptions {
     v.field("fairlead_m", fairlead_m, "m",
             "[x, y] of the fairlead on the body, from its reference point (a structure's axis at the water line), "
             "body axes",
-            Check<std::vector<double>>([](const std::vector<double>& f) -> std::string {
-              if (f.size() != 2 || !std::isfinite(f[0]) || !std::isfinite(f[1])) return "must be [x, y] (2 numbers)";
-              return "";
-            }));
+            plane_point());
     if (length_m <= fairlead_height_m)
       v.problem("length_m", "must exceed fairlead_height_m: a line shorter than the depth cannot reach the seabed");
   }

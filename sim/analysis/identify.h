@@ -118,11 +118,7 @@ struct ImuOptions {
   void visit(V& v) {
     v.field("position_m", position_m, "m",
             "[x, y] of the IMU from the centre of gravity, body axes (x forward, y to port)",
-            Check<std::vector<double>>([](const std::vector<double>& p) -> std::string {
-              if (p.size() != 2) return "must be [x, y] (2 numbers)";
-              if (!std::isfinite(p[0]) || !std::isfinite(p[1])) return "must be finite numbers";
-              return "";
-            }));
+            plane_point());
   }
 };
 

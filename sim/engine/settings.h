@@ -234,10 +234,7 @@ struct StationKeepingOptions {
     v.field("applied_force_n", applied_force_n, "N",
             "moored, dp: a steady external pull [x, y] on the body's reference point, earth frame (a tug, or a "
             "pull test of the mooring)",
-            Check<std::vector<double>>([](const std::vector<double>& f) -> std::string {
-              if (f.size() != 2 || !std::isfinite(f[0]) || !std::isfinite(f[1])) return "must be [x, y] (2 numbers)";
-              return "";
-            }));
+            plane_point());
     v.field("applied_force_ramp_s", applied_force_ramp_s, "s",
             "the applied pull grows linearly from 0 over this time (a tug taking the strain; long against the "
             "body's natural period, the pull is quasi-static); 0 = at once",
