@@ -87,6 +87,26 @@ const char* fracture_mode_name(int32_t mode) {
               " (expected 0 input, 1 bending, 2 radial, 3 splitting, 4 crushing)");
 }
 
+const std::vector<StructureField>& structure_fields() {
+  static const std::vector<StructureField> fields = {
+      {"position_m", "m", "[3] its centre of mass, earth frame"},
+      {"quaternion_wxyz", "-", "[4] body-to-earth rotation"},
+      {"velocity_mps", "m/s", "[3] its centre of mass's velocity over the earth"},
+      {"ice_force_n", "N", "[3] the ice's force on it (every contact)"},
+      {"ice_moment_nm", "N m", "[3] the ice's moment about its reference point (its axis at the water line)"},
+      {"level_ice_force_n", "N", "[3] the part of ice_force_n from level ice tiles (breaking the sheet's edge)"},
+      {"water_force_n", "N", "[3] buoyancy, damping and the water's resistance (0 for a fixed structure)"},
+      {"station_keeping_force_n", "N", "[3] its mooring lines' or thrusters' force (0 for a fixed structure)"},
+      {"offset", "m, m, rad", "[3] its reference point's offset x, y from the station, its heading's change"},
+      {"station_keeping_demanded", "N, N, N m",
+       "[3] dp: the controller's demand (surge, sway, yaw; body axes) before its limits; moored: as delivered"},
+      {"station_keeping_delivered", "N, N, N m",
+       "[3] dp: the thrusters' force within their limits; moored: the spread's pull in the station's axes"},
+      {"line_tension_n", "N", "[lines] moored: each line's fairlead tension, in the order of its lines"},
+      {"part_force_n", "N", "[3 x parts] the ice's force on each of its convex parts (part k: columns 3k..3k+2)"}};
+  return fields;
+}
+
 size_t Results::steps() const {
   auto it = series.find("time_s");
   return it == series.end() ? 0 : it->second.size();
@@ -201,7 +221,7 @@ std::vector<T> read_ds(hid_t file_id, const std::string& name, size_t cols, cons
 // plot and render: /1 had no fracture (no /fracture, no lineage), /2 no solver series beyond sweeps and residual,
 // /3 no /states/in_contact, /4 no /geometry/floe_level_ice, /5 no ice_load_level_ice series, /6 every alive body
 // in every frame (which FrameReplay reads like the changed bodies of /7) and no ice_kinetic_energy series.
-constexpr int kLayoutVersion = 8;
+constexpr int kLayoutVersion = 9;
 constexpr const char* kLayoutPrefix = "floesim-results/";
 std::string layout_name(int version) { return kLayoutPrefix + std::to_string(version); }
 
@@ -354,8 +374,21 @@ void write_results(const std::filesystem::path& path, const Results& r, const Se
     FLOESIM_REQUIRE(fid.id >= 0, file, ": cannot create: ", h5_write_reason());
     H5Id gcpl(H5Pcreate(H5P_GROUP_CREATE), H5Pclose);
     H5Pset_obj_track_times(gcpl, false);
-    for (const char* g : {"/series", "/frames", "/states", "/geometry", "/fracture"}) {
+    for (const char* g : {"/series", "/frames", "/states", "/geometry", "/fracture", "/structures"}) {
       H5Id gid(H5Gcreate2(fid, g, H5P_DEFAULT, gcpl, H5P_DEFAULT), H5Gclose);
+    }
+    for (const nlohmann::json& st : r.attributes.value("structures", nlohmann::json::array())) {
+      const std::string name = st.at("name").get<std::string>(), g = "/structures/" + name;
+      H5Id gid(H5Gcreate2(fid, g.c_str(), H5P_DEFAULT, gcpl, H5P_DEFAULT), H5Gclose);
+      FLOESIM_REQUIRE(gid.id >= 0, file, ": cannot create ", g, ": ", h5_write_reason());
+      for (const auto& [field, cols] : st.at("columns").items()) {
+        const auto it = r.structure_series.find(name + "/" + field);
+        FLOESIM_REQUIRE(it != r.structure_series.end() && it->second.size() == n * cols.get<size_t>(), file,
+                        ": internal: structure series ", name, "/", field, " was not recorded for every step");
+        write_ds(fid, g + "/" + field, it->second, cols.get<size_t>(), file);
+      }
+      write_ds(fid, g + "/hull_vertices_m", r.structure_hull_vertices_m.at(name), 3, file);
+      write_ds(fid, g + "/hull_triangles", r.structure_hull_triangles.at(name), 3, file);
     }
     for (const auto& f : series_fields()) {  // one series in memory at a time (see SeriesSource)
       const std::vector<double> values = series.get(f.name);
@@ -505,6 +538,30 @@ Results read_results(const std::filesystem::path& path, bool with_states, const 
   });
   const std::string fracture = fracture_problem(r);
   FLOESIM_REQUIRE(fracture.empty(), file, ": ", fracture, " (a damaged file, or not written by floesim-simulate?)");
+  // The structures beside the vessel (layout /9).
+  if (version >= 9 && r.attributes.contains("structures")) {
+    const nlohmann::json& list = r.attributes["structures"];
+    FLOESIM_REQUIRE(list.is_array(), file, ": the attribute's \"structures\" is not a list");
+    for (const nlohmann::json& st : list) {
+      FLOESIM_REQUIRE(st.is_object() && st.contains("name") && st["name"].is_string() && st.contains("columns") &&
+                          st["columns"].is_object(),
+                      file, ": a structure of the attribute's \"structures\" has no name or columns");
+      const std::string name = st["name"].get<std::string>(), g = "/structures/" + name;
+      for (const auto& [field, cols] : st["columns"].items()) {
+        FLOESIM_REQUIRE(cols.is_number_unsigned() && cols.get<size_t>() > 0, file, ": ", g, "/", field,
+                        ": bad column count");
+        std::vector<double> v = read_ds<double>(fid, g + "/" + field, cols.get<size_t>(), file);
+        FLOESIM_REQUIRE(r.series_first_step != 0 || v.size() == n * cols.get<size_t>(), file, ": ", g, "/", field,
+                        " has ", v.size() / cols.get<size_t>(), " rows, the series ", n);
+        r.structure_series[name + "/" + field] = std::move(v);
+      }
+      r.structure_hull_vertices_m[name] = read_ds<double>(fid, g + "/hull_vertices_m", 3, file);
+      r.structure_hull_triangles[name] = read_ds<int32_t>(fid, g + "/hull_triangles", 3, file);
+      const int64_t nv = static_cast<int64_t>(r.structure_hull_vertices_m[name].size() / 3);
+      for (int32_t t : r.structure_hull_triangles[name])
+        FLOESIM_REQUIRE(t >= 0 && t < nv, file, ": ", g, "/hull_triangles names vertex ", t, ", but there are ", nv);
+    }
+  }
   return r;
 }
 

@@ -43,7 +43,13 @@
 //                                                   for a crushing event the crushed ice cleared
 //   /fracture/child_offset       [E+1]    int64     pieces of event k: child_id[offset[k] .. offset[k+1]-1]
 //   /fracture/child_id           [C]      int32     floe ids of the pieces that became bodies
-//   Layout "floesim-results/8" (this one) added the fracture mode 4, crushing, and the series station_offset,
+//   /structures/NAME/FIELD       [steps x c] float64   the structures beside the vessel (simulate.structures), one
+//                                                   group each, one row per step; the root attribute's "structures"
+//                                                   lists them: name, kind, reference point and each field's columns
+//                                                   (structure_fields below). Earth axes; NAME/hull_vertices_m
+//                                                   [V x 3] and NAME/hull_triangles [T x 3] its mesh in its body
+//                                                   frame (origin = centre of mass).
+//   Layout "floesim-results/9" (this one) added /structures. "/8" added the fracture mode 4, crushing, and the series station_offset,
 //   station_keeping_demanded and station_keeping_delivered (NaN when reading an earlier file). "/7" stores only the
 //   changed bodies in a frame and added the series ice_kinetic_energy (NaN when reading an earlier file); earlier
 //   layouts stored every alive body in every frame, which FrameReplay reads the same way. "/6" added the series
@@ -134,6 +140,12 @@ struct Results {
   std::vector<int64_t> fracture_child_offset = {0};  // size E+1
   std::vector<int32_t> fracture_child_id;
 
+  // The structures beside the vessel (layout /9): "NAME/FIELD" -> row-major [steps x cols], cols from
+  // attributes["structures"]; and each one's mesh.
+  std::map<std::string, std::vector<double>> structure_series;
+  std::map<std::string, std::vector<double>> structure_hull_vertices_m;  // NAME -> [V x 3]
+  std::map<std::string, std::vector<int32_t>> structure_hull_triangles;  // NAME -> [T x 3]
+
   nlohmann::json attributes = nlohmann::json::object();
 
   size_t steps() const;   // rows of /series/time_s
@@ -142,6 +154,15 @@ struct Results {
   void push(const std::string& name, std::initializer_list<double> row);
   const std::vector<double>& get(const std::string& name) const;  // Error if absent
 };
+
+// The per-step fields of a structure beside the vessel (/structures/NAME/FIELD): name, columns (0: as many as it
+// has lines or parts, see the doc), unit, doc. All earth axes; moments about its reference point.
+struct StructureField {
+  const char* name;
+  const char* unit;
+  const char* doc;
+};
+const std::vector<StructureField>& structure_fields();
 
 // The lineage and the fracture events checked for consistency (lengths, offsets, modes, time order, ids known to
 // /geometry), as write_results and read_results do; for code that builds Results in memory. Returns the first

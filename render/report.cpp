@@ -508,17 +508,24 @@ void fracture_section(std::ostream& body, const Json& summary) {
   }
 }
 
-// 3. Section "Structure", only for a fixed structure (summary.json "structure"): its loads raw and filtered, their
-// cycles and period, the rubble on it.
+// 3. Section "Structure" for a structure as the case's hull body (summary.json "structure") and one per structure
+// beside the vessel ("structures"): its loads raw and filtered, their cycles and period, the rubble on it, how it is
+// held.
 void structure_section(std::ostream& body, const Json& summary) {
-  const Json* st = find(summary, {"structure"});
-  if (!st) return;
-  body << "<h2>Structure</h2>\n<p>The ice's action on the structure, along the ice's drift (horizontal), across it "
-          "(transverse) and vertical, in N, and the overturning moment about the structure's axis at the water "
-          "line, in N m; filtered: "
-       << html_escape((*st).value("filter", Json::object()).value("kind", std::string()))
-       << " over " << scalar_text((*st).value("filter", Json::object()).value("window_s", Json())) << " s.</p>\n"
-       << "<table id=\"structure\">\n" << nested_rows(*st) << "</table>\n";
+  auto one = [&](const Json& st, const std::string& title, const std::string& id) {
+    body << "<h2>" << html_escape(title) << "</h2>\n<p>The ice's action on the structure, along the ice's drift "
+            "(horizontal), across it (transverse) and vertical, in N, and the overturning moment about the "
+            "structure's axis at the water line, in N m; filtered: "
+         << html_escape(st.value("filter", Json::object()).value("kind", std::string())) << " over "
+         << scalar_text(st.value("filter", Json::object()).value("window_s", Json())) << " s.</p>\n"
+         << "<table id=\"" << id << "\">\n" << nested_rows(st) << "</table>\n";
+  };
+  if (const Json* st = find(summary, {"structure"})) one(*st, "Structure", "structure");
+  if (const Json* list = find(summary, {"structures"}); list && list->is_array())
+    for (size_t k = 0; k < list->size(); ++k) {
+      const std::string name = (*list)[k].value("name", "structure " + std::to_string(k));
+      one((*list)[k], "Structure " + name, "structure-" + std::to_string(k));
+    }
 }
 
 // 3. Section "Video": embedded up to max_video_mb, else named beside the page; its size and embedding into rs.

@@ -172,6 +172,16 @@ struct SceneRenderer::Impl {
   std::vector<int64_t> vessel_row;      // per frame
   GLint hull_first = 0, hull_count = 0;
   double hull_radius = 0;
+  // The structures beside the vessel (results /structures): their meshes and pose series (earth frame, per step).
+  struct StructureMesh {
+    std::string name;
+    GLint first = 0, count = 0;
+    const std::vector<double>* position = nullptr;
+    const std::vector<double>* quaternion = nullptr;
+    Vec3 frame_velocity = Vec3::Zero();  // the run's frame over the earth: the frames' positions are in it
+  };
+  std::vector<StructureMesh> structures;
+  double steps_per_frame = 0;
   float sky[3], water[3], edge[3], contact[3];
   std::vector<SubView> views;
   std::unique_ptr<LoadStripChart> strip;  // null without strip_chart
@@ -303,8 +313,31 @@ struct SceneRenderer::Impl {
   // faces in the upper half are the deck. Winding is not trusted (meshes come from any tool): a neighbour wound the
   // other way points away and is left out, and two-sided lighting turns every normal towards the viewer.
   void build_hull() {
-    const auto& v = r.hull_vertices_m;
-    const auto& t = r.hull_triangles;
+    build_mesh(r.hull_vertices_m, r.hull_triangles, hull_first, hull_count, &hull_radius);
+    // The structures beside the vessel: each mesh and where its pose is in the results.
+    const nlohmann::json list = r.attributes.value("structures", nlohmann::json::array());
+    for (const nlohmann::json& st : list) {
+      StructureMesh m;
+      m.name = st.at("name").get<std::string>();
+      const std::vector<double> fv = st.value("run_frame_velocity_mps", std::vector<double>{0, 0, 0});
+      m.frame_velocity = Vec3(fv.at(0), fv.at(1), fv.at(2));
+      const auto pos = r.structure_series.find(m.name + "/position_m");
+      const auto quat = r.structure_series.find(m.name + "/quaternion_wxyz");
+      FLOESIM_REQUIRE(pos != r.structure_series.end() && quat != r.structure_series.end(), source, ": structure ",
+                      m.name, " has no pose series");
+      m.position = &pos->second;
+      m.quaternion = &quat->second;
+      build_mesh(r.structure_hull_vertices_m.at(m.name), r.structure_hull_triangles.at(m.name), m.first, m.count,
+                 nullptr);
+      structures.push_back(m);
+    }
+    const double dt = r.attributes.value("time_step_s", 0.0), every = r.attributes.value("output_interval_s", 0.0);
+    steps_per_frame = dt > 0 ? every / dt : 0;
+  }
+
+  // A mesh's triangles into the vertex buffer: [first, first + count).
+  void build_mesh(const std::vector<double>& v, const std::vector<int32_t>& t, GLint& first, GLint& count,
+                  double* radius) {
     FLOESIM_REQUIRE(v.size() % 3 == 0 && t.size() % 3 == 0, source, ": /geometry hull arrays have bad shapes");
     const size_t nv = v.size() / 3;
     float hull[3], deck[3];
@@ -314,7 +347,7 @@ struct SceneRenderer::Impl {
     for (size_t i = 0; i < nv; ++i) {
       zmin = std::min(zmin, v[3 * i + 2]);
       zmax = std::max(zmax, v[3 * i + 2]);
-      hull_radius = std::max(hull_radius, Vec3(v[3 * i], v[3 * i + 1], v[3 * i + 2]).norm());
+      if (radius) *radius = std::max(*radius, Vec3(v[3 * i], v[3 * i + 1], v[3 * i + 2]).norm());
     }
     const size_t nt = t.size() / 3;
     for (size_t k = 0; k < nt; ++k)
@@ -341,7 +374,7 @@ struct SceneRenderer::Impl {
     std::sort(corner.begin(), corner.end());
     // 3. Corners: smoothed normals within the crease angle.
     const double cos_crease = std::cos(kCreaseDeg * kPi / 180);
-    hull_first = vertex_count();
+    first = vertex_count();
     for (size_t k = 0; k < nt; ++k) {
       if (face[k].norm() <= 0) continue;  // internal, or a degenerate sliver: nothing to draw
       const Vec3 n = face[k].normalized();
@@ -359,7 +392,7 @@ struct SceneRenderer::Impl {
       const bool is_deck = std::abs(n.z()) > 0.8 && (p[0].z() + p[1].z() + p[2].z()) / 3 > (zmin + zmax) / 2;
       for (int j = 0; j < 3; ++j) vertex(p[j], c[j], is_deck ? deck : hull);
     }
-    hull_count = vertex_count() - hull_first;
+    count = vertex_count() - first;
   }
 
   void build_water_grid() {
@@ -613,6 +646,16 @@ struct SceneRenderer::Impl {
       const Mat4 mv = view * pose_matrix(vessel_quaternion(k), vp - origin);
       gl.LoadMatrixd(mv.data());
       gl.DrawArrays(GL_TRIANGLES, hull_first, hull_count);
+      // The structures at frame k's step (k + 1 output intervals), moved into the run's frame.
+      const size_t row = static_cast<size_t>(std::llround((static_cast<double>(k) + 1) * steps_per_frame)) - 1;
+      const double t = r.frame_time_s[k];
+      for (const StructureMesh& m : structures) {
+        if (m.count == 0 || 4 * row + 3 >= m.quaternion->size()) continue;
+        const Vec3 x = Vec3(&(*m.position)[3 * row]) - t * m.frame_velocity;
+        const Mat4 ms = view * pose_matrix(&(*m.quaternion)[4 * row], x - origin);
+        gl.LoadMatrixd(ms.data());
+        gl.DrawArrays(GL_TRIANGLES, m.first, m.count);
+      }
     }
     gl.DisableClientState(GL_COLOR_ARRAY);
     gl.DisableClientState(GL_NORMAL_ARRAY);

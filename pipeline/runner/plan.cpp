@@ -77,6 +77,7 @@ fs::path self_dir() {
 }
 
 std::string run_folder(const std::string& stage) {
+  if (stage.rfind("structure-", 0) == 0) return stage;  // a structure's mesh (case "structures"): its own folder
   static const std::map<std::string, std::string> folder = {{"synth", "image"},  {"digitise", "floes"},
                                                             {"hull", "hull"},    {"simulate", "sim"},
                                                             {"shipdata", "shipdata"}, {"identify", "identify"},
@@ -96,6 +97,9 @@ void absolute_case_files(Json& c, const fs::path& case_dir) {
   fix(at(c, "image"), "file");
   fix(at(c, "floes"), "file");
   fix(at(c, "hull"), "file");
+  if (Json* list = at(c, "structures"))
+    if (list->is_array())
+      for (Json& e : *list) fix(at(e, "hull"), "file");
   fix(at(c, "identify"), "measured");
   if (Json* s = at(c, "simulate"))
     if (Json* v = at(*s, "vessel")) fix(at(*v, "propulsion"), "thrust_file");
@@ -114,14 +118,14 @@ class CasePlanner {
   // 1. The case's top level: known keys only; floes from a photo or given directly.
   void check_top_level() const {
     FLOESIM_REQUIRE(c_.is_object(), cf_, ": the top level must be an object");
-    const std::vector<std::string> known = {"description", "image", "digitise", "floes",  "hull",
-                                            "simulate",    "identify", "render", "plot",   "report"};
+    const std::vector<std::string> known = {"description", "image",    "digitise", "floes", "hull",  "structures",
+                                            "simulate",    "identify", "render",   "plot",  "report"};
     for (auto it = c_.begin(); it != c_.end(); ++it) {
       bool ok = false;
       for (auto& k : known) ok = ok || k == it.key();
       FLOESIM_REQUIRE(ok, cf_, ": unknown key \"", it.key(),
-                      "\" (known: description, image, digitise, floes, hull, simulate, identify, render, plot, "
-                      "report)");
+                      "\" (known: description, image, digitise, floes, hull, structures, simulate, identify, "
+                      "render, plot, report)");
     }
     // Floes come from a photo (image + digitise) or directly from a floes GeoJSON the case owns ("floes": {"file"}).
     FLOESIM_REQUIRE(c_.contains("image") != c_.contains("floes"), cf_,
@@ -155,50 +159,83 @@ class CasePlanner {
   }
 
   // 3. The hull: a user's mesh placed and cut into convex parts, or the parametric icebreaker.
-  void plan_hull() {
-    const Json& h = require_object(c_, "hull", cf_);
+  void plan_hull() { hull_obj_ = plan_hull_stage(require_object(c_, "hull", cf_), "hull", "hull"); }
+
+  // 3. The structures beside the vessel (case "structures": [{"name", "hull": {...} as the case's hull, and the
+  // simulate options of a structure}]): each one's mesh by a stage of its own ("structure-NAME"), its options into
+  // simulate.structures with the mesh as its hull_file.
+  void plan_structures() {
+    if (!c_.contains("structures")) return;
+    const Json& list = c_["structures"];
+    FLOESIM_REQUIRE(list.is_array() && !list.empty(), cf_, ": structures must be a non-empty list of "
+                    "{\"name\", \"hull\": {...}, and the structure's simulate options}");
+    for (size_t k = 0; k < list.size(); ++k) {
+      const std::string key = "structures[" + std::to_string(k) + "]";
+      const Json& e = list[k];
+      FLOESIM_REQUIRE(e.is_object() && e.contains("name") && e["name"].is_string() && e.contains("hull"), cf_, ": ",
+                      key, " needs \"name\" (a string) and \"hull\" (as the case's hull: file, generate or "
+                      "structure)");
+      const std::string name = e["name"].get<std::string>();
+      FLOESIM_REQUIRE(!name.empty() && name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                                              "0123456789-_") == std::string::npos,
+                      cf_, ": ", key, ".name \"", name, "\" may hold only letters, digits, '-' and '_'");
+      FLOESIM_REQUIRE(!e.contains("hull_file"), cf_, ": ", key, ".hull_file is set by the runner from ", key,
+                      ".hull: remove it");
+      const fs::path obj = plan_hull_stage(require_object(e, "hull", cf_ + ": " + key), "structure-" + name,
+                                           key + ".hull");
+      Json options = e;
+      options.erase("hull");
+      options["hull_file"] = obj.string();
+      structures_.push_back(options);
+      structure_objs_.push_back(obj);
+    }
+  }
+
+  // A hull stage: floesim-hull makes `stage`/hull.obj from the hull section `h` (the case's "key").
+  fs::path plan_hull_stage(const Json& h, const std::string& stage, const std::string& key) {
+    const std::string folder = run_folder(stage);
     FLOESIM_REQUIRE(int(h.contains("generate")) + int(h.contains("file")) + int(h.contains("structure")) == 1, cf_,
-                    ": hull needs exactly one of \"file\" (an OBJ or any mesh assimp reads, with its placement "
+                    ": ", key, " needs exactly one of \"file\" (an OBJ or any mesh assimp reads, with its placement "
                     "options beside it), \"generate\" (options for floesim-hull's parametric icebreaker) or "
                     "\"structure\" (floesim-hull's structure from parameters: cone, cylinder, caisson)");
-    FLOESIM_REQUIRE(!h.contains("generate") || h.size() == 1, cf_,
-                    ": hull.generate takes no keys beside it (the placement options go with \"file\")");
-    FLOESIM_REQUIRE(!h.contains("structure") || h.size() == 1, cf_,
-                    ": hull.structure takes no keys beside it (the placement options go with \"file\")");
+    FLOESIM_REQUIRE(!h.contains("generate") || h.size() == 1, cf_, ": ", key,
+                    ".generate takes no keys beside it (the placement options go with \"file\")");
+    FLOESIM_REQUIRE(!h.contains("structure") || h.size() == 1, cf_, ": ", key,
+                    ".structure takes no keys beside it (the placement options go with \"file\")");
+    PlannedStage* st = nullptr;
     if (h.contains("structure")) {
       // A structure from parameters: floesim-hull's config is {"structure": {...}}.
-      PlannedStage* st = add("hull", "hull", "structure from parameters", Json{{"structure", h["structure"]}}, {},
-                             {"hull.obj"}, "floesim-hull");
-      hull_obj_ = st->outputs[0];
-      st->args = {"--config", st->config.string(), "--out", hull_obj_.string()};
-      plan_.artefacts.push_back({"hull", "hull/hull.obj", "the structure as convex parts, m (OBJ)"});
-      return;
+      st = add(stage, "hull", "structure from parameters", Json{{"structure", h["structure"]}}, {}, {"hull.obj"},
+               "floesim-hull");
+      plan_.artefacts.push_back({stage, folder + "/hull.obj", "the structure as convex parts, m (OBJ)"});
+    } else if (h.contains("generate")) {
+      st = add(stage, "hull.generate", "parametric icebreaker hull", h["generate"], {}, {"hull.obj"}, "floesim-hull");
+      plan_.artefacts.push_back({stage, folder + "/hull.obj", "hull as convex parts, m (OBJ)"});
+    } else {
+      // The user's mesh: floesim-hull places it (scale, up_direction, bow_direction, waterline_z_m, origin_m), cuts
+      // it into convex parts, reports what it did in hull.json and refuses a hull that does not float. Its settings
+      // are the hull section as it stands (the file's path made absolute), checked by the stage itself.
+      Json settings = h;
+      const fs::path mesh = case_input(h, "file", key);
+      settings["file"] = mesh.string();
+      st = add(stage, "hull", "user's hull mesh placed and cut into convex parts", settings, {mesh}, {"hull.obj"},
+               "floesim-hull");
+      plan_.artefacts.push_back({stage, folder + "/hull.obj", "hull as convex parts in the hull frame, m (OBJ)"});
     }
-    if (h.contains("generate")) {
-      PlannedStage* st =
-          add("hull", "hull.generate", "parametric icebreaker hull", h["generate"], {}, {"hull.obj"}, "floesim-hull");
-      hull_obj_ = st->outputs[0];
-      st->args = {"--config", st->config.string(), "--out", hull_obj_.string()};
-      plan_.artefacts.push_back({"hull", "hull/hull.obj", "hull as convex parts, m (OBJ)"});
-      return;
-    }
-    // The user's mesh: floesim-hull places it (scale, up_direction, bow_direction, waterline_z_m, origin_m), cuts it
-    // into convex parts, reports what it did in hull.json and refuses a hull that does not float. Its settings are
-    // the case's hull section as it stands (the file's path made absolute), checked by the stage itself.
-    Json settings = h;
-    const fs::path mesh = case_input(h, "file", "hull");
-    settings["file"] = mesh.string();
-    PlannedStage* st = add("hull", "hull", "user's hull mesh placed and cut into convex parts", settings, {mesh},
-                           {"hull.obj"}, "floesim-hull");
-    hull_obj_ = st->outputs[0];
-    st->args = {"--config", st->config.string(), "--out", hull_obj_.string()};
-    plan_.artefacts.push_back({"hull", "hull/hull.obj", "hull as convex parts in the hull frame, m (OBJ)"});
+    st->args = {"--config", st->config.string(), "--out", st->outputs[0].string()};
+    return st->outputs[0];
   }
 
   // 4. The simulation, with the thrust time series the case may name as one more input.
   void plan_simulate() {
     Json s = section("simulate");
     std::vector<fs::path> inputs = {floes_file_, hull_obj_};
+    if (!structures_.empty()) {
+      FLOESIM_REQUIRE(!s.contains("structures"), cf_, ": give the structures as the case's \"structures\" (each "
+                      "with its \"hull\"), not as simulate.structures");
+      s["structures"] = structures_;
+      inputs.insert(inputs.end(), structure_objs_.begin(), structure_objs_.end());
+    }
     // A thrust time series named in the case is an input too (its path made absolute for the stage).
     if (s.contains("vessel") && s["vessel"].is_object() && s["vessel"].contains("propulsion") &&
         s["vessel"]["propulsion"].is_object() && s["vessel"]["propulsion"].contains("thrust_file")) {
@@ -418,6 +455,8 @@ class CasePlanner {
   CasePlan plan_;
   std::map<fs::path, std::string> identity_;
   fs::path floes_file_, hull_obj_, identify_dir_, video_, plot_png_;
+  Json structures_ = Json::array();       // simulate.structures, from the case's "structures"
+  std::vector<fs::path> structure_objs_;  // their meshes
 };
 
 }  // namespace
@@ -428,6 +467,7 @@ CasePlan plan_case(const Json& c, const std::string& where, const fs::path& case
   p.check_top_level();
   p.plan_floes();
   p.plan_hull();
+  p.plan_structures();
   p.plan_simulate();
   p.plan_identify();
   p.plan_render(render);

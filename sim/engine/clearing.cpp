@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <set>
 
 #include "pipeline/error.h"
 #include "pipeline/results_io.h"
@@ -55,14 +56,15 @@ Polygon part_band_footprint(const ConvexPart& part, const Vec3& position, const 
   return pts.size() >= 3 ? convex_hull_2d(pts) : Polygon{};
 }
 
-std::vector<FractureCut> find_clearings(const Model& model, const State& state, const std::vector<Contact>& contacts) {
-  std::vector<FractureCut> cuts;
-  const int s = model.vessel;
-  if (s < 0 || !model.bodies[s].kinematic) return cuts;
+namespace {
+
+// The clearings by fixed hull body s, into cuts (tiles in cut_tiles are left alone; the ones cut join them).
+void clear_for(const Model& model, const State& state, const std::vector<Contact>& contacts, int s,
+               std::set<int>& cut_tiles, std::vector<FractureCut>& cuts) {
   // 1. The tiles the structure crushes, and how it presses on each.
   std::map<int, TilePress> press;
   for (const Contact& c : contacts) {
-    if (c.type != ContactType::crushing || c.body_a != s || c.pn <= 0) continue;
+    if (c.type != ContactType::crushing || c.body_a != s || c.pn <= 0 || cut_tiles.count(c.body_b)) continue;
     const Body& tile = model.bodies[c.body_b];
     if (tile.kind != BodyKind::floe || !tile.fixed || !state.alive[c.body_b]) continue;
     TilePress& p = press[c.body_b];
@@ -138,10 +140,20 @@ std::vector<FractureCut> find_clearings(const Model& model, const State& state, 
       e.width_m = std::max(width, h);
       e.brash_mass_kg = rho_i * h * crushed;
       cuts.push_back(std::move(cut));
+      cut_tiles.insert(b);
     } catch (const Error&) {
       // A cut the boolean operations cannot represent (a hole, a degenerate overlay): no clearing this step.
     }
   }
+}
+
+}  // namespace
+
+std::vector<FractureCut> find_clearings(const Model& model, const State& state, const std::vector<Contact>& contacts) {
+  std::vector<FractureCut> cuts;
+  std::set<int> cut_tiles;  // a tile two structures crush in one step is cleared by the first
+  for (int s = 0; s < model.hull_count(); ++s)
+    if (model.bodies[s].kinematic) clear_for(model, state, contacts, s, cut_tiles, cuts);
   return cuts;
 }
 

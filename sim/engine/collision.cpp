@@ -466,17 +466,18 @@ struct CollisionWorld::Impl {
   std::vector<ChunkRange> chunk_ranges;  // per chunk of the narrow phase (written by the thread that ran it)
 
   bool compliant_structure, compliant_ice;  // options.contact, per pair of body classes
+  int hull_count;                           // the vessel's and the structures' bodies, the model's first
 
   Impl(const Model& m, ThreadPool& p)
       : model(m),
         pool(p),
         scratch(p.threads()),
         compliant_structure(m.settings.contact.ice_structure == "compliant"),
-        compliant_ice(m.settings.contact.ice_ice == "compliant") {}
+        compliant_ice(m.settings.contact.ice_ice == "compliant"),
+        hull_count(m.hull_count()) {}
 
-  bool is_structure_pair(const PairCandidate& pc) const {
-    return pc.body_a == model.vessel || pc.body_b == model.vessel;
-  }
+  // A hull body's pair with ice: the hull bodies are the model's first, so the hull is always a.
+  bool is_structure_pair(const PairCandidate& pc) const { return pc.body_a < hull_count; }
   bool is_compliant(const PairCandidate& pc) const {
     // Domain walls are boundaries, not ice or a structure under test: always rigid.
     if (model.bodies[pc.body_a].kind == BodyKind::wall || model.bodies[pc.body_b].kind == BodyKind::wall)
@@ -536,8 +537,8 @@ struct CollisionWorld::Impl {
     const bool structure = is_structure_pair(pc0);
     const PatchSide side = structure ? PatchSide::a_is_structure : PatchSide::symmetric;
     PatchScratch& ps = sc.patch;
-    // 1. Each part pair's overlap as it is, about one local origin for the body pair. The vessel is body 0, so in
-    // a vessel-floe pair it is always a (the structure side of the patch).
+    // 1. Each part pair's overlap as it is, about one local origin for the body pair. The hull bodies are the
+    // model's first, so in a hull-floe pair the hull is always a (the structure side of the patch).
     const Vec3 origin = overlap_origin(world[pc0.part_a], world[pc0.part_b]);
     ps.surface.clear();
     ps.members.clear();
@@ -558,7 +559,7 @@ struct CollisionWorld::Impl {
     // of its surface's box: max(2 h, 1 m), the distance at which the fracture stage takes two contacts of a level
     // ice tile as one load (load_join_distance_m). So a contact never bridges a gap along the waterline (two hull
     // sections metres apart pressing in one direction stay two loads, each with its own width).
-    // The ice's thickness: b's against the vessel (body 0, always a), the thinner floe's between two floes.
+    // The ice's thickness: b's against a hull (always a), the thinner floe's between two floes.
     const double h = structure ? model.bodies[b].thickness_m
                                : std::min(model.bodies[a].thickness_m, model.bodies[b].thickness_m);
     const double join = load_join_distance_m(h);
@@ -788,11 +789,13 @@ struct CollisionWorld::Impl {
     for (const auto& sc : scratch) pairs.insert(pairs.end(), sc.candidates.begin(), sc.candidates.end());
   }
 
-  // A part pair of the broad phase is kept if the parts are of two bodies, one of them awake, with overlapping exact
+  // A part pair of the broad phase is kept if the parts are of two bodies, one of them awake, not both hull bodies
+  // (a ship and the structures do not touch one another: the loads recorded are the ice's), with overlapping exact
   // boxes (the tree's boxes are enlarged and depend on the history of the leaf; the exact boxes make the candidate
   // set a function of the current poses only).
   bool keeps(int b1, const Vec3& lo1, const Vec3& hi1, int b2, const Vec3& lo2, const Vec3& hi2) const {
     if (b1 == b2 || (!state->awake[b1] && !state->awake[b2])) return false;
+    if (b1 < hull_count && b2 < hull_count) return false;
     return !((lo1.array() > hi2.array()).any() || (lo2.array() > hi1.array()).any());
   }
   // Part p1 of body b1 and part p2 of body b2 as a candidate, the lower body first.
@@ -878,7 +881,7 @@ struct CollisionWorld::Impl {
     const PartWorld& wa = world[pc.part_a];
     const PartWorld& wb = world[pc.part_b];
     const double spec = model.settings.solver.speculative_m;
-    const bool structure = pc.body_a == model.vessel || pc.body_b == model.vessel;
+    const bool structure = is_structure_pair(pc);
     const double mu = structure ? model.settings.ice.mu_ice_structure : model.settings.ice.mu_ice_ice;
     auto emit = [&](const Vec3& p, const Vec3& n, double gap) {
       Contact c;

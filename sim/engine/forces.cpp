@@ -362,21 +362,27 @@ Wrench floe_wind_drag(const Model& m, const Body& b, const BodyKinematics& k, Fo
   return w;
 }
 
-Wrench vessel_resistance(const Model& m, const BodyKinematics& k) {
+HullRef vessel_ref(const Model& m) { return {m.vessel_info, m.settings.vessel, m.station}; }
+
+HullRef structure_ref(const Model& m, int k) {
+  return {m.structures[k].info, m.settings.structures[k].body, m.structures[k].station};
+}
+
+Wrench vessel_resistance(const Model& m, const HullRef& h, const BodyKinematics& k) {
   Wrench w;
   const Vec3 ex = k.R.col(0);
   const double u = (k.v - m.current).dot(ex);
-  w.force = -ittc57_resistance(u, ittc57_of(m.vessel_info, m.settings)) * ex;
+  w.force = -ittc57_resistance(u, ittc57_of(h.info, h.options, m.settings)) * ex;
   return w;
 }
 
-Wrench vessel_cross_flow(const Model& m, const BodyKinematics& k) {
+Wrench vessel_cross_flow(const Model& m, const HullRef& h, const BodyKinematics& k) {
   Wrench w;
-  const VesselParticulars& vp = m.vessel_info;
+  const VesselParticulars& vp = h.info;
   const Vec3 ey = k.R.col(1), ez = k.R.col(2);
   const double v = (k.v - m.current).dot(ey);  // sway velocity relative to the water
   const double r = k.w.dot(ez);               // yaw rate
-  const double c = 0.5 * m.settings.water.density_kg_m3 * m.settings.vessel.sway_drag_cd * vp.draught_m *
+  const double c = 0.5 * m.settings.water.density_kg_m3 * h.options.sway_drag_cd * vp.draught_m *
                    vp.strip_length_m;
   double fy = 0, mz = 0;
   for (double x : vp.strip_x_m) {
@@ -457,14 +463,15 @@ Wrench vessel_autopilot(const Model& m, const Body& b, const BodyKinematics& k, 
   return w;
 }
 
-Wrench station_keeping_force(const Model& m, const BodyKinematics& k, double time_s, double dt,
+Wrench station_keeping_force(const Model& m, const HullRef& h, const BodyKinematics& k, double time_s, double dt,
                              std::vector<double>* dp_memory, StationKeeping* out) {
-  const StationKeepingOptions& sk = m.settings.vessel.station_keeping;
-  const Vec3 ref = k.x + k.R * m.reference_point_body;  // the reference point, run frame
+  const StationKeepingOptions& sk = h.options.station_keeping;
+  const Station& st = h.station;
+  const Vec3 ref = k.x + k.R * st.reference_point_body;  // the reference point, run frame
   const Vec3 earth = ref + time_s * m.frame_velocity;
-  const Vec2 offset = (earth - m.station).head<2>();
+  const Vec2 offset = (earth - st.position).head<2>();
   const double psi = heading_of(k.R);
-  const double dpsi = std::remainder(psi - m.station_heading_rad, 2 * kPi);
+  const double dpsi = std::remainder(psi - st.heading_rad, 2 * kPi);
   out->offset = offset;
   out->heading_change_rad = dpsi;
   const double ramp = sk.applied_force_ramp_s > 0 ? std::min(1.0, time_s / sk.applied_force_ramp_s) : 1.0;
@@ -472,17 +479,19 @@ Wrench station_keeping_force(const Model& m, const BodyKinematics& k, double tim
   double moment_z = 0;
   if (sk.moored()) {
     // The legs are laid out in the station's axes: the offset turned into them, the pull turned back.
-    const double c0 = std::cos(m.station_heading_rad), s0 = std::sin(m.station_heading_rad);
+    const double c0 = std::cos(st.heading_rad), s0 = std::sin(st.heading_rad);
     const double dx = c0 * offset.x() + s0 * offset.y(), dy = -s0 * offset.x() + c0 * offset.y();
-    const SpreadState sp = spread_at_pose(m.mooring, dx, dy, dpsi);
+    const SpreadState sp = spread_at_pose(st.mooring, dx, dy, dpsi);
+    out->line_tension_n.clear();
+    for (const CatenaryState& l : sp.lines) out->line_tension_n.push_back(l.fairlead_tension_n);
     out->delivered[0] = out->demanded[0] = sp.force_x_n;
     out->delivered[1] = out->demanded[1] = sp.force_y_n;
     out->delivered[2] = out->demanded[2] = sp.moment_z_nm;
     force += Vec3(c0 * sp.force_x_n - s0 * sp.force_y_n, s0 * sp.force_x_n + c0 * sp.force_y_n, 0);
     moment_z = sp.moment_z_nm;
   } else if (sk.dp_held()) {
-    DpController dp(m.dp, m.station.x(), m.station.y(), m.station_heading_rad, m.station.x(), m.station.y(),
-                    m.station_heading_rad);
+    DpController dp(st.dp, st.position.x(), st.position.y(), st.heading_rad, st.position.x(), st.position.y(),
+                    st.heading_rad);
     if (!dp_memory->empty()) dp.set_memory(*dp_memory);
     const DpCommand c = dp.step(dt, earth.x(), earth.y(), psi);
     *dp_memory = dp.memory();

@@ -107,10 +107,19 @@ Wrench floe_water_drag_clipped(const Model& m, const Body& b, const BodyKinemati
                                const std::vector<PropellerJet>& jets = {});
 // Air skin drag on the part of the top face above water (wind on floes).
 Wrench floe_wind_drag(const Model& m, const Body& b, const BodyKinematics& k, ForceScratch& s);
+// What the forces on a hull body need beside its body: its particulars, options and station (the vessel's, or
+// structure k's).
+struct HullRef {
+  const VesselParticulars& info;
+  const VesselOptions& options;
+  const Station& station;
+};
+HullRef vessel_ref(const Model& m);
+HullRef structure_ref(const Model& m, int k);
 // ITTC-57 open-water resistance opposite the surge velocity relative to the water.
-Wrench vessel_resistance(const Model& m, const BodyKinematics& k);
+Wrench vessel_resistance(const Model& m, const HullRef& h, const BodyKinematics& k);
 // Cross-flow drag on strips along the waterline length: sway and yaw damping.
-Wrench vessel_cross_flow(const Model& m, const BodyKinematics& k);
+Wrench vessel_cross_flow(const Model& m, const HullRef& h, const BodyKinematics& k);
 // Fossen-type wind load from the relative wind.
 Wrench vessel_wind(const Model& m, const BodyKinematics& k);
 // Thrust along the body x axis at the centre of mass, by propulsion mode (bollard_pull: thrust_n is made, but the
@@ -121,7 +130,7 @@ Wrench vessel_propulsion(const Model& m, const BodyKinematics& k, double time_s,
 // Heading hold: PD yaw moment towards heading_ref, limited.
 Wrench vessel_autopilot(const Model& m, const Body& b, const BodyKinematics& k, double heading_ref);
 
-// A moored or DP body's station keeping (vessel.station_keeping, issue #34), from its pose at time t (the run's
+// A moored or DP hull body's station keeping (its station_keeping options, issue #34), from its pose at time t (the run's
 // frame; the earth frame's pose is x + frame_velocity t): the mooring legs' pull (spread_at_pose, quasi-static
 // catenaries, at the reference point's earth-frame offset from the station and the heading's change), or the DP
 // controller's delivered force (its observer and integral carry over in `dp_memory`, State::dp_memory), plus the
@@ -133,8 +142,9 @@ struct StationKeeping {
   double delivered[3] = {0, 0, 0};
   Vec2 offset = Vec2::Zero();  // the reference point's earth-frame offset from the station
   double heading_change_rad = 0;
+  std::vector<double> line_tension_n;  // moored: each line's fairlead tension, N (in the order of the lines)
 };
-Wrench station_keeping_force(const Model& m, const BodyKinematics& k, double time_s, double dt,
+Wrench station_keeping_force(const Model& m, const HullRef& h, const BodyKinematics& k, double time_s, double dt,
                              std::vector<double>* dp_memory, StationKeeping* out);
 
 // Heading of the body x axis in the horizontal plane (rad, CCW from +x).

@@ -548,12 +548,14 @@ void read_thrust_series(const std::string& file, std::vector<double>& time_s, st
   FLOESIM_REQUIRE(!time_s.empty(), file, ": no data rows after the header");
 }
 
-Ittc57 ittc57_of(const VesselParticulars& v, const EngineSettings& o) {
+Ittc57 ittc57_of(const VesselParticulars& v, const EngineSettings& o) { return ittc57_of(v, o.vessel, o); }
+
+Ittc57 ittc57_of(const VesselParticulars& v, const VesselOptions& vo, const EngineSettings& o) {
   Ittc57 c;
   c.length_wl_m = v.length_wl_m;
   c.wetted_surface_m2 = v.wetted_surface_m2;
-  c.form_factor_k = o.vessel.form_factor_k;
-  c.roughness_ca = o.vessel.roughness_ca;
+  c.form_factor_k = vo.form_factor_k;
+  c.roughness_ca = vo.roughness_ca;
   c.water_density_kg_m3 = o.water.density_kg_m3;
   c.kinematic_viscosity_m2ps = o.water.kinematic_viscosity_m2ps;
   return c;
@@ -630,22 +632,23 @@ int count_small_overlaps(const std::vector<FloeGeometry>& geo, const EngineSetti
   return small;
 }
 
-// How the vessel floats: its mass and the sinkage that carries it.
+// How a hull body floats: its mass and the sinkage that carries it.
 struct Flotation {
   double mass = 0;  // kg
   double dz = 0;    // the hull frame raised by dz, so that rho_w V_sub = mass (0 when the mass comes from the hull)
 };
 
-// 3. The vessel's mass (vessel.mass_kg, else the hull's displacement at z = 0) and the sinkage that floats it
+// 3. A hull body's mass (KEY.mass_kg, else the hull's displacement at z = 0) and the sinkage that floats it
 // (bisection); a hull without volume below z = 0, or one that cannot carry the mass, is an error.
-Flotation flotation(const TriMesh& surf, const EngineSettings& o) {
+Flotation flotation(const TriMesh& surf, const VesselOptions& vo, const std::string& key, const EngineSettings& o) {
   const double rho_w = o.water.density_kg_m3;
   const double m0 = rho_w * submerged_part(surf.vertices, surf.triangles, 0.0).volume;
-  FLOESIM_REQUIRE(m0 > 0, "hull: no volume below the waterline z = 0 (is z up and the waterline at z = 0?)");
-  const double mass = o.vessel.mass_kg > 0 ? o.vessel.mass_kg : m0;
+  FLOESIM_REQUIRE(m0 > 0, key, ": the hull has no volume below the waterline z = 0 (is z up and the waterline at "
+                  "z = 0?)");
+  const double mass = vo.mass_kg > 0 ? vo.mass_kg : m0;
   // Sinkage dz (hull frame raised by dz) so that rho_w V_sub = mass; 0 when the mass comes from the hull.
   double dz = 0;
-  if (o.vessel.mass_kg > 0) {
+  if (vo.mass_kg > 0) {
     double zmin = 1e300, zmax = -1e300;
     for (const Vec3& v : surf.vertices) {
       zmin = std::min(zmin, v.z());
@@ -653,7 +656,7 @@ Flotation flotation(const TriMesh& surf, const EngineSettings& o) {
     }
     double lo = -zmax, hi = -zmin;  // raised by -zmax: fully submerged; by -zmin: out of the water
     const double full = rho_w * mass_properties(surf).volume;
-    FLOESIM_REQUIRE(mass < full, "vessel.mass_kg = ", mass, " is more than the hull can carry (", full,
+    FLOESIM_REQUIRE(mass < full, key, ".mass_kg = ", mass, " is more than the hull can carry (", full,
                     " kg fully submerged)");
     for (int it = 0; it < 200; ++it) {
       const double mid = 0.5 * (lo + hi);
@@ -667,8 +670,8 @@ Flotation flotation(const TriMesh& surf, const EngineSettings& o) {
 
 // 3. The particulars of the floating hull into vp: waterline, wetted surface, displacement, mass, centre of mass
 // (hull frame), radii of gyration, strips about the centre of mass. Returns the submerged part.
-Submerged floating_particulars(const HullModel& hull, const Flotation& fl, const EngineSettings& o,
-                               VesselParticulars& vp) {
+Submerged floating_particulars(const HullModel& hull, const Flotation& fl, const VesselOptions& vo,
+                               const EngineSettings& o, VesselParticulars& vp) {
   const TriMesh floating = shifted(hull.surface, Vec3(0, 0, fl.dz));
   const Submerged sub = submerged_part(floating.vertices, floating.triangles, 0.0);
   waterline_particulars(floating, vp);
@@ -678,11 +681,11 @@ Submerged floating_particulars(const HullModel& hull, const Flotation& fl, const
   vp.displacement_m3 = sub.volume;
   vp.waterplane_area_m2 = sub.waterplane_area;
   vp.mass_kg = fl.mass;
-  vp.centre_of_mass_hull = Vec3(sub.centroid.x(), sub.centroid.y(), o.vessel.vcg_m);
+  vp.centre_of_mass_hull = Vec3(sub.centroid.x(), sub.centroid.y(), vo.vcg_m);
   const Vec3 com = vp.centre_of_mass_hull;  // hull frame
-  vp.radii_of_gyration_m = Vec3(o.vessel.kxx_m > 0 ? o.vessel.kxx_m : 0.38 * vp.beam_wl_m,
-                                o.vessel.kyy_m > 0 ? o.vessel.kyy_m : 0.25 * vp.length_oa_m,
-                                o.vessel.kzz_m > 0 ? o.vessel.kzz_m : 0.25 * vp.length_oa_m);
+  vp.radii_of_gyration_m = Vec3(vo.kxx_m > 0 ? vo.kxx_m : 0.38 * vp.beam_wl_m,
+                                vo.kyy_m > 0 ? vo.kyy_m : 0.25 * vp.length_oa_m,
+                                vo.kzz_m > 0 ? vo.kzz_m : 0.25 * vp.length_oa_m);
   for (double& x : vp.strip_x_m) x -= com.x();
   return sub;
 }
@@ -693,7 +696,7 @@ Submerged floating_particulars(const HullModel& hull, const Flotation& fl, const
 // plate's; Lewis 1929 forms of a full section of B/T ~ 3 carry a coefficient C of about 1-1.2 on it: the scale
 // option), so A33 = (pi/8) rho_w sum B^2 dx and A55 = (pi/8) rho_w sum B^2 x^2 dx about the centre of mass. Roll
 // keeps none (the roll period is not what the ice loads depend on).
-void set_vessel_added_mass(Body& b, const VesselParticulars& vp, const EngineSettings& o) {
+void set_vessel_added_mass(Body& b, const VesselParticulars& vp, const VesselOptions& vo, const EngineSettings& o) {
   if (o.water.enabled) {
     const double rho_w = o.water.density_kg_m3, mass = b.mass_kg;
     double a33 = 0, a55 = 0;
@@ -703,24 +706,24 @@ void set_vessel_added_mass(Body& b, const VesselParticulars& vp, const EngineSet
       a33 += strip;
       a55 += strip * x * x;
     }
-    const double s = o.vessel.heave_pitch_added_mass_scale;
-    set_added_mass(b, Vec3(o.vessel.surge_added_mass_ratio * mass, o.vessel.sway_added_mass_ratio * mass, s * a33),
-                   Vec3(0, s * a55, o.vessel.yaw_added_inertia_ratio * b.inertia(2, 2)));
+    const double s = vo.heave_pitch_added_mass_scale;
+    set_added_mass(b, Vec3(vo.surge_added_mass_ratio * mass, vo.sway_added_mass_ratio * mass, s * a33),
+                   Vec3(0, s * a55, vo.yaw_added_inertia_ratio * b.inertia(2, 2)));
   } else {
     set_added_mass(b, Vec3::Zero(), Vec3::Zero());
   }
 }
 
-// 3. The vessel's rigid body (id 0): mass, inertia from the radii of gyration or given outright
-// (vessel.inertia_kg_m2, body axes about the centre of mass; the radii reported are then those of its diagonal),
-// added mass.
-Body vessel_body(double mass, VesselParticulars& vp, const EngineSettings& o) {
+// 3. A hull body's rigid body (the vessel's id is 0, structure k's -1 - k): mass, inertia from the radii of gyration
+// or given outright (inertia_kg_m2, body axes about the centre of mass; the radii reported are then those of its
+// diagonal), added mass.
+Body vessel_body(double mass, VesselParticulars& vp, const VesselOptions& vo, int id, const EngineSettings& o) {
   Body b;
   b.kind = BodyKind::vessel;
-  b.id = 0;
+  b.id = id;
   b.mass_kg = mass;
   b.inv_mass = 1 / mass;
-  const std::vector<double>& Ig = o.vessel.inertia_kg_m2;
+  const std::vector<double>& Ig = vo.inertia_kg_m2;
   if (Ig.empty()) {
     b.inertia = mass * vp.radii_of_gyration_m.cwiseProduct(vp.radii_of_gyration_m).asDiagonal();
   } else {
@@ -730,7 +733,7 @@ Body vessel_body(double mass, VesselParticulars& vp, const EngineSettings& o) {
     vp.radii_of_gyration_m = (b.inertia.diagonal() / mass).cwiseSqrt();
   }
   b.inv_inertia = b.inertia.inverse();
-  set_vessel_added_mass(b, vp, o);
+  set_vessel_added_mass(b, vp, vo, o);
   return b;
 }
 
@@ -746,23 +749,24 @@ void add_propellers(const EngineSettings& o, const Vec3& com, Model& model) {
   }
 }
 
-// 3. Places the vessel body: buoyancy mesh and convex parts about the centre of mass, afloat at the sinkage dz,
-// turned to vessel.heading_deg, at (vessel.x_m, vessel.y_m); its parts are the model's first.
-void place_vessel(Body& b, const HullModel& hull, const Vec3& com, double dz, const EngineSettings& o, Model& model) {
+// 3. Places hull body `index`: buoyancy mesh and convex parts about the centre of mass, afloat at the sinkage dz,
+// turned to heading_deg, at (x_m, y_m); its parts follow the model's parts so far.
+void place_hull(Body& b, int index, const HullModel& hull, const Vec3& com, double dz, const VesselOptions& vo,
+                Model& model) {
   b.buoyancy_mesh = shifted(hull.surface, -com);
-  const double heading = o.vessel.heading_deg * kPi / 180;
+  const double heading = vo.heading_deg * kPi / 180;
   b.initial_orientation = Quat(Eigen::AngleAxisd(heading, Vec3::UnitZ()));
-  b.initial_position = Vec3(o.vessel.x_m, o.vessel.y_m, com.z() + dz);
-  b.first_part = 0;
+  b.initial_position = Vec3(vo.x_m, vo.y_m, com.z() + dz);
+  b.first_part = static_cast<int>(model.parts.size());
   b.part_count = static_cast<int>(hull.parts.size());
-  model.vessel = 0;
-  for (const TriMesh& p : hull.parts) model.parts.push_back(make_convex_part(shifted(p, -com), 0));
-  mark_shared_faces(model.parts, 0, b.part_count);
+  for (const TriMesh& p : hull.parts) model.parts.push_back(make_convex_part(shifted(p, -com), index));
+  mark_shared_faces(model.parts, b.first_part, b.part_count);
 }
 
 // 3. Metacentric heights from the clipped hull (the same buoyancy the simulation applies) into vp; a vessel unstable
 // in roll is an error.
-void metacentric_heights(const Body& b, double displacement_m3, const EngineSettings& o, VesselParticulars& vp) {
+void metacentric_heights(const Body& b, double displacement_m3, const VesselOptions& vo, const std::string& key,
+                         const EngineSettings& o, VesselParticulars& vp) {
   const double rho_w = o.water.density_kg_m3, g = o.water.gravity_mps2;
   const double rho_g = rho_w * g > 0 ? rho_w * g : rho_w * 9.81;
   const double k44 =
@@ -771,8 +775,8 @@ void metacentric_heights(const Body& b, double displacement_m3, const EngineSett
       rotational_stiffness(b.buoyancy_mesh, b.initial_position, b.initial_orientation, Vec3::UnitY(), rho_g);
   vp.gm_transverse_m = k44 / (rho_g * displacement_m3);
   vp.gm_longitudinal_m = k55 / (rho_g * displacement_m3);
-  FLOESIM_REQUIRE(vp.gm_transverse_m > 0, "vessel.vcg_m = ", o.vessel.vcg_m,
-                  " m makes the vessel unstable in roll (GM_T = ", vp.gm_transverse_m,
+  FLOESIM_REQUIRE(vp.gm_transverse_m > 0, key, ".vcg_m = ", vo.vcg_m,
+                  " m makes the body unstable in roll (GM_T = ", vp.gm_transverse_m,
                   " m): lower the centre of mass");
 }
 
@@ -799,24 +803,24 @@ std::vector<Polygon> vessel_footprint(const HullModel& hull, const Body& vb, con
   return footprint;
 }
 
-// 3. The vessel, the model's first body: floating position, mass, inertia, particulars, propellers, convex parts,
-// damping. Returns its footprint among the floes.
-std::vector<Polygon> add_vessel(const HullModel& hull, const std::vector<Floe>& floes, const EngineSettings& o,
-                                Model& model) {
-  FLOESIM_REQUIRE(!hull.parts.empty(), "hull: no convex parts");
-  const Flotation fl = flotation(hull.surface, o);
-  VesselParticulars& vp = model.vessel_info;
-  const Submerged sub = floating_particulars(hull, fl, o, vp);
+// 3. Hull body `index` (the vessel's, options `vo` under `key`, or a structure's): floating position, mass, inertia,
+// particulars into vp, convex parts, damping and its station into st. Returns its footprint among the floes.
+std::vector<Polygon> add_hull(const HullModel& hull, const VesselOptions& vo, const std::string& key, int index,
+                              int id, const std::vector<Floe>& floes, const EngineSettings& o, Model& model,
+                              VesselParticulars& vp, Station& st) {
+  FLOESIM_REQUIRE(!hull.parts.empty(), key, ": the hull has no convex parts");
+  FLOESIM_REQUIRE(index == static_cast<int>(model.bodies.size()), "internal: hull bodies come first");
+  const Flotation fl = flotation(hull.surface, vo, key, o);
+  const Submerged sub = floating_particulars(hull, fl, vo, o, vp);
   const Vec3 com = vp.centre_of_mass_hull;  // hull frame
-  Body b = vessel_body(fl.mass, vp, o);
-  add_propellers(o, com, model);
+  Body b = vessel_body(fl.mass, vp, vo, id, o);
   // A fixed structure stands where the hull frame puts it (its waterline at z = 0, not floated to its weight).
-  place_vessel(b, hull, com, o.vessel.station_keeping.fixed() ? 0.0 : fl.dz, o, model);
+  place_hull(b, index, hull, com, vo.station_keeping.fixed() ? 0.0 : fl.dz, vo, model);
   // A structure's station: its reference point (the hull frame's origin) and heading at the start.
-  model.reference_point_body = -com;
-  model.station = b.initial_position + b.initial_orientation * model.reference_point_body;
-  model.station_heading_rad = o.vessel.heading_deg * kPi / 180;
-  if (o.vessel.station_keeping.fixed()) {
+  st.reference_point_body = -com;
+  st.position = b.initial_position + b.initial_orientation * st.reference_point_body;
+  st.heading_rad = vo.heading_deg * kPi / 180;
+  if (vo.station_keeping.fixed()) {
     // A fixed structure: nothing moves it (its floating figures are reported, its stability does not matter).
     b.kinematic = true;
     b.inv_mass = 0;
@@ -824,31 +828,54 @@ std::vector<Polygon> add_vessel(const HullModel& hull, const std::vector<Floe>& 
     b.inv_mass_added.setZero();
     b.inv_inertia_added.setZero();
     model.bodies.push_back(std::move(b));
-    return vessel_footprint(hull, model.bodies[0], com, floes, o);
+    return vessel_footprint(hull, model.bodies[index], com, floes, o);
   }
-  metacentric_heights(b, sub.volume, o, vp);
-  for (size_t i = 0; i < o.vessel.station_keeping.lines.size(); ++i) {
+  metacentric_heights(b, sub.volume, vo, key, o, vp);
+  for (size_t i = 0; i < vo.station_keeping.lines.size(); ++i) {
     try {
-      model.mooring.push_back(mooring_leg(o.vessel.station_keeping.lines[i]));
+      st.mooring.push_back(mooring_leg(vo.station_keeping.lines[i]));
     } catch (const Error& e) {
-      throw Error("vessel.station_keeping.lines[" + std::to_string(i) + "]: " + e.what());
+      throw Error(key + ".station_keeping.lines[" + std::to_string(i) + "]: " + e.what());
     }
   }
-  if (o.vessel.station_keeping.dp_held()) {  // gains per degree of freedom from its mass with the added mass
-    const DpOptions& d = o.vessel.station_keeping.dp;
-    model.dp.surge = dp_gains(b.mass_kg + b.added_mass.x(), d.natural_period_s, d.damping_ratio);
-    model.dp.sway = dp_gains(b.mass_kg + b.added_mass.y(), d.natural_period_s, d.damping_ratio);
-    model.dp.yaw = dp_gains(b.inertia(2, 2) + b.added_inertia.z(), d.yaw_natural_period_s, d.damping_ratio);
-    model.dp.max_force_x_n = d.max_force_x_n;
-    model.dp.max_force_y_n = d.max_force_y_n;
-    model.dp.max_moment_z_nm = d.max_moment_z_nm;
-    model.dp.observer_time_constant_s = d.observer_time_constant_s;
+  if (vo.station_keeping.dp_held()) {  // gains per degree of freedom from its mass with the added mass
+    const DpOptions& d = vo.station_keeping.dp;
+    st.dp.surge = dp_gains(b.mass_kg + b.added_mass.x(), d.natural_period_s, d.damping_ratio);
+    st.dp.sway = dp_gains(b.mass_kg + b.added_mass.y(), d.natural_period_s, d.damping_ratio);
+    st.dp.yaw = dp_gains(b.inertia(2, 2) + b.added_inertia.z(), d.yaw_natural_period_s, d.damping_ratio);
+    st.dp.max_force_x_n = d.max_force_x_n;
+    st.dp.max_force_y_n = d.max_force_y_n;
+    st.dp.max_moment_z_nm = d.max_moment_z_nm;
+    st.dp.observer_time_constant_s = d.observer_time_constant_s;
   }
   if (o.water.enabled)
     set_damping(b, o, o.water.vessel_heave_damping_ratio, o.water.vessel_roll_damping_ratio,
                 o.water.vessel_pitch_damping_ratio);
   model.bodies.push_back(std::move(b));
-  return vessel_footprint(hull, model.bodies[0], com, floes, o);
+  return vessel_footprint(hull, model.bodies[index], com, floes, o);
+}
+
+// 3. The hull bodies, the model's first: the vessel (body 0, with its propellers) and the structures beside it.
+// Returns their footprints among the floes.
+std::vector<Polygon> add_hulls(const HullModel& hull, const std::vector<HullModel>& structures,
+                               const std::vector<Floe>& floes, const EngineSettings& o, Model& model) {
+  FLOESIM_REQUIRE(structures.size() == o.structures.size(), "internal: ", structures.size(),
+                  " structure meshes for ", o.structures.size(), " structures");
+  std::vector<Polygon> footprint = add_hull(hull, o.vessel, "vessel", 0, 0, floes, o, model, model.vessel_info,
+                                            model.station);
+  model.vessel = 0;
+  add_propellers(o, model.vessel_info.centre_of_mass_hull, model);
+  for (size_t k = 0; k < structures.size(); ++k) {
+    StructureBody sb;
+    sb.body = static_cast<int>(model.bodies.size());
+    const std::string key = "structures[" + std::to_string(k) + "] (" + o.structures[k].name + ")";
+    for (Polygon& p : add_hull(structures[k], o.structures[k].body, key, sb.body, -1 - static_cast<int>(k), floes, o,
+                               model, sb.info, sb.station))
+      footprint.push_back(std::move(p));
+    sb.part_count = model.bodies[sb.body].part_count;
+    model.structures.push_back(std::move(sb));
+  }
+  return footprint;
 }
 
 // 4. Whether a floe overlaps the vessel's footprint (boxes first, then the convex pieces).
@@ -969,7 +996,8 @@ void add_walls(const FloeField& field, bool has_vessel, const std::vector<Polygo
 
 }  // namespace
 
-Model build_model(const FloeField& field, const HullModel* hull, const EngineSettings& o) {
+Model build_model(const FloeField& field, const HullModel* hull, const EngineSettings& o,
+                  const std::vector<HullModel>& structures) {
   Model model;
   model.settings = o;
   const double g = o.water.gravity_mps2;
@@ -992,9 +1020,11 @@ Model build_model(const FloeField& field, const HullModel* hull, const EngineSet
   // 2. Floes must not overlap each other.
   model.small_overlaps += count_small_overlaps(geo, o);
 
-  // 3. The vessel: floating position, mass, inertia, particulars, convex parts; its footprint among the floes.
+  // 3. The hull bodies (the vessel, the structures): floating position, mass, inertia, particulars, convex parts;
+  // their footprint among the floes.
   std::vector<Polygon> footprint;
-  if (hull) footprint = add_vessel(*hull, floes, o, model);
+  FLOESIM_REQUIRE(hull || o.structures.empty(), "structures need the vessel's hull beside them");
+  if (hull) footprint = add_hulls(*hull, structures, floes, o, model);
 
   // 4. Floe bodies: slab of the floe's thickness, body frame at the centre of mass, at hydrostatic equilibrium.
   add_floe_bodies(geo, footprint, o, model);

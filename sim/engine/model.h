@@ -133,6 +133,26 @@ struct Propeller {
   double thrust_share = 0;
 };
 
+// Where a hull body held by station keeping (vessel.station_keeping or a structure's, issue #34) belongs: its
+// reference point (the hull frame's origin, a structure's axis at the water line) in the body frame, where it is and
+// how it heads at the station (the start; earth frame), and a moored body's mooring legs (fairleads from the
+// reference point, body axes at the station; anchors on the seabed relative to the station).
+struct Station {
+  Vec3 reference_point_body = Vec3::Zero();
+  Vec3 position = Vec3::Zero();
+  double heading_rad = 0;
+  std::vector<MooringLeg> mooring;
+  DpControllerSettings dp;  // a DP body's controller: gains from its mass and added mass, limits, observer
+};
+
+// A structure beside the vessel (settings.structures[k]): its body, what the hull model gives it and its station.
+struct StructureBody {
+  int body = -1;  // index into Model::bodies
+  VesselParticulars info;
+  Station station;
+  int part_count = 0;  // its convex parts: Model::parts[bodies[body].first_part ...]
+};
+
 struct Model {
   EngineSettings settings;  // the physics settings it was built with (sim/engine/settings.h)
   std::vector<Body> bodies;   // vessel first (if any), then the floes in input order
@@ -150,15 +170,9 @@ struct Model {
   std::vector<double> thrust_time_s, thrust_n;  // thrust_series mode
   std::vector<Propeller> propellers;            // their jets wash the floes (forces.h, PropellerJet)
 
-  // A structure held by station keeping (vessel.station_keeping, issue #34): its reference point (the hull frame's
-  // origin, a structure's axis at the water line) in the body frame, where it is and how it heads at the station (the
-  // start; earth frame), and a moored body's mooring legs (fairleads from the reference point, body axes at the
-  // station; anchors on the seabed relative to the station).
-  Vec3 reference_point_body = Vec3::Zero();
-  Vec3 station = Vec3::Zero();
-  double station_heading_rad = 0;
-  std::vector<MooringLeg> mooring;
-  DpControllerSettings dp;  // a DP body's controller: gains from its mass and added mass, limits, observer
+  Station station;  // the vessel's, when it is a structure (vessel.station_keeping held)
+  // The structures beside it (settings.structures, in order): bodies right after the vessel's, before the floes.
+  std::vector<StructureBody> structures;
 
   int wall_count = 0;                 // domain walls, the last bodies of the model as built
   // The bodies build_model made: the vessel, the input floes (and level ice tiles) and the walls. A world appends
@@ -167,17 +181,19 @@ struct Model {
   size_t built_bodies = 0;
   // Floe bodies in the table: the input floes of a built model; in a world's grown table, every piece too (dead or
   // alive).
-  int floe_count() const { return static_cast<int>(bodies.size()) - (vessel >= 0 ? 1 : 0) - wall_count; }
+  int floe_count() const { return static_cast<int>(bodies.size()) - hull_count() - wall_count; }
   // The input floes (and level ice tiles) alone, in a built model or a world's grown table alike.
-  int built_floe_count() const {
-    return static_cast<int>(built_bodies) - (vessel >= 0 ? 1 : 0) - wall_count;
-  }
+  int built_floe_count() const { return static_cast<int>(built_bodies) - hull_count() - wall_count; }
+  // The hull bodies, the model's first: the vessel's (if any) and the structures'.
+  int hull_count() const { return (vessel >= 0 ? 1 : 0) + static_cast<int>(structures.size()); }
 };
 
 // Builds the model. `hull` may be null (floes only). Checks the inputs (thickness, overlaps) and throws
 // floesim::Error naming the floe ids. Floes overlapping the vessel's initial footprint are removed. Domain walls
 // (options.domain) come last; a floe or the vessel overlapping one is an error.
-Model build_model(const FloeField& floes, const HullModel* hull, const EngineSettings& options);
+// `structures`: the meshes of options.structures, in order (their bodies follow the vessel's).
+Model build_model(const FloeField& floes, const HullModel* hull, const EngineSettings& options,
+                  const std::vector<HullModel>& structures = {});
 
 // Reads a thrust series CSV ("time_s,thrust_N" header, strictly increasing times); errors name the line.
 void read_thrust_series(const std::string& file, std::vector<double>& time_s, std::vector<double>& thrust_n);
@@ -185,6 +201,8 @@ void read_thrust_series(const std::string& file, std::vector<double>& time_s, st
 // The vessel's ITTC-57 open-water resistance line (sim/vessel/open_water.h) from its particulars and the settings'
 // water and form factor.
 Ittc57 ittc57_of(const VesselParticulars& v, const EngineSettings& o);
+// The same for any hull body with its options (a structure's: settings.structures[k].body).
+Ittc57 ittc57_of(const VesselParticulars& v, const VesselOptions& vo, const EngineSettings& o);
 
 // A floe body: a slab of thickness h over `outline` (CCW, body frame: centred on its area centroid, which is the
 // body origin), at hydrostatic equilibrium at plan position `centre`, with mass and inertia from polygon x h x

@@ -6,6 +6,7 @@
 // the wind is the direction it flows TO (oceanographic convention for both, so that a current of direction 0 and a
 // wind of direction 0 push a floe the same way).
 #pragma once
+#include <cctype>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -275,12 +276,32 @@ struct VesselOptions {
   StationKeepingOptions station_keeping;
   template <class V>
   void visit(V& v) {
+    visit_body(v);
+    v.field("initial_speed_mps", initial_speed_mps, "m/s", "initial forward speed", non_negative());
+    v.section("propulsion", propulsion, "how the vessel is driven");
+    v.section("autopilot", autopilot, "heading hold");
+    v.list("propellers", propellers,
+           "the vessel's propellers, whose jets (PHYSICS.md 3.5) wash the floes; [] = no propeller wash");
+    v.section("station_keeping", station_keeping,
+              "how the hull body is held: a ship's propulsion, or a structure fixed, moored or on DP");
+    if (station_keeping.held() && !propellers.empty())
+      v.problem("propellers", "a structure (station_keeping.mode " + station_keeping.mode + ", not propulsion) has no "
+                "propellers whose wash is modelled: remove them");
+    double shares = 0;
+    for (const PropellerOptions& p : propellers) shares += p.thrust_share;
+    if (shares > 1 + 1e-9)
+      v.problem("propellers", "thrust_share adds up to " + Json(shares).dump() + " (must be <= 1: the shares split "
+                "the propulsion thrust)");
+  }
+  // What any hull body has, a ship's or a structure's (simulate.structures): its placement, mass, inertia, added
+  // mass and the water's resistance to it.
+  template <class V>
+  void visit_body(V& v) {
     v.field("x_m", x_m, "m", "initial centre of mass, world x",
             in_range(-kMaxWorldCoordinateM, kMaxWorldCoordinateM));
     v.field("y_m", y_m, "m", "initial centre of mass, world y",
             in_range(-kMaxWorldCoordinateM, kMaxWorldCoordinateM));
     v.field("heading_deg", heading_deg, "deg", "course: direction of the bow, CCW from +x", in_range(-360, 360));
-    v.field("initial_speed_mps", initial_speed_mps, "m/s", "initial forward speed", non_negative());
     v.field("mass_kg", mass_kg, "kg", "vessel mass; 0 = rho_w x hull volume below the waterline", non_negative());
     v.field("vcg_m", vcg_m, "m", "height of the centre of mass in the hull frame (waterline at z = 0)");
     v.field("kxx_m", kxx_m, "m", "roll radius of gyration; 0 = 0.38 x waterline beam", non_negative());
@@ -320,20 +341,38 @@ struct VesselOptions {
             "A55 = (pi/8) rho_w integral B(x)^2 x^2 dx (strip theory, semicircular sections of the waterline beam "
             "B(x)); 0 = none",
             in_range(0, 5));
-    v.section("propulsion", propulsion, "how the vessel is driven");
-    v.section("autopilot", autopilot, "heading hold");
-    v.list("propellers", propellers,
-           "the vessel's propellers, whose jets (PHYSICS.md 3.5) wash the floes; [] = no propeller wash");
-    v.section("station_keeping", station_keeping,
-              "how the hull body is held: a ship's propulsion, or a structure fixed, moored or on DP");
-    if (station_keeping.held() && !propellers.empty())
-      v.problem("propellers", "a structure (station_keeping.mode " + station_keeping.mode + ", not propulsion) has no "
-                "propellers whose wash is modelled: remove them");
-    double shares = 0;
-    for (const PropellerOptions& p : propellers) shares += p.thrust_share;
-    if (shares > 1 + 1e-9)
-      v.problem("propellers", "thrust_share adds up to " + Json(shares).dump() + " (must be <= 1: the shares split "
-                "the propulsion thrust)");
+  }
+};
+
+// A structure beside the case's hull body (simulate.structures, issue #34): a hull body of its own, fixed, moored or
+// on DP, from a mesh already in its hull frame (bow +x, z up, waterline z = 0: floesim-hull's output). Its loads,
+// pose and station keeping are recorded under its name (pipeline/results_io.h, /structures). The wind on its part
+// above water is not modelled (the wind's areas are the case's hull body's).
+struct StructureOptions {
+  std::string name;
+  std::string hull_file;  // relative to the config file
+  VesselOptions body;     // its placement, mass and hydrodynamics (visit_body) and station_keeping
+  template <class V>
+  void visit(V& v) {
+    v.field("name", name, "-",
+            "the structure's name: its results group (/structures/NAME) and its part of the summary and report; "
+            "letters, digits, '-' and '_'",
+            Check<std::string>([](const std::string& n) -> std::string {
+              if (n.empty() || n.size() > 64) return "must have 1 to 64 characters";
+              for (char c : n)
+                if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_')
+                  return "may hold only letters, digits, '-' and '_'";
+              return "";
+            }));
+    v.field("hull_file", hull_file, "-",
+            "its mesh (OBJ, or any mesh assimp reads) in its hull frame: bow +x, z up, waterline z = 0, taken as the "
+            "file has it (floesim-hull's output); relative to the config file");
+    body.visit_body(v);
+    v.section("station_keeping", body.station_keeping, "how it is held: fixed, moored or dp");
+    if (hull_file.empty()) v.problem("hull_file", "must name the structure's mesh");
+    if (!body.station_keeping.held())
+      v.problem("station_keeping", "a structure is fixed, moored or dp (mode \"" + body.station_keeping.mode +
+                "\" drives a ship: that is the case's vessel)");
   }
 };
 
@@ -765,6 +804,7 @@ struct EngineSettings {
   HealthOptions health;
   LevelIceOptions level_ice;
   DriftOptions drift;
+  std::vector<StructureOptions> structures;  // hull bodies beside the vessel's (see StructureOptions)
 
   long reference_horizon_steps() const { return std::lround(solver.reference_horizon_s / time_step_s); }  // 0: none
 };

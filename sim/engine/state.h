@@ -113,6 +113,7 @@ struct State {
   double speed_error_integral = 0;      // m, integral of the speed error (PI thrust controller)
   double heading_ref_rad = 0;           // course held by the autopilot
   std::vector<double> dp_memory;        // a DP body's controller (DpController::memory; empty before its first step)
+  std::vector<std::vector<double>> structure_dp_memory;  // the same for each structure (Model::structures)
 };
 
 }  // namespace floesim::sim

@@ -99,6 +99,11 @@ World::World(Model built) : model_(std::move(built)), pool_(model_.settings.thre
     if (o.vessel.station_keeping.held()) state_.velocity[v] = -model.frame_velocity;  // at rest in the earth frame
     state_.heading_ref_rad = heading_of(R);
   }
+  for (const StructureBody& sb : model.structures) {  // awake, at rest in the earth frame
+    state_.awake[sb.body] = 1;
+    state_.velocity[sb.body] = -model.frame_velocity;
+  }
+  state_.structure_dp_memory.assign(model.structures.size(), {});
   // Inverse mass matrices (world) as the solver sees them; the forces stage refreshes those of awake bodies.
   solver_bodies_.inv_mass.assign(n, Mat3::Zero());
   solver_bodies_.inv_inertia_world.assign(n, Mat3::Zero());
@@ -130,6 +135,8 @@ void World::wake(int body) {
 
 std::string World::body_name(int body) const {
   if (body == model_.vessel) return "the vessel";
+  for (size_t k = 0; k < model_.structures.size(); ++k)
+    if (body == model_.structures[k].body) return "structure " + model_.settings.structures[k].name;
   return "floe id " + std::to_string(model_.bodies[body].id);
 }
 
@@ -235,22 +242,27 @@ void World::stage_forces() {
   };
   // The vessel on this thread (its controllers keep state).
   const int vessel = model_.vessel;
+  // A floating hull body's water loads (buoyancy, damping, resistance, cross flow).
+  auto hull_water = [&](const Body& body, const HullRef& h, const BodyKinematics& k) {
+    Wrench w;
+    if (!water) return w;
+    w += buoyancy_force(model_, body, k, scratch_[0]);
+    w += hydrostatic_damping(model_, body, k);
+    w += vessel_resistance(model_, h, k);
+    w += vessel_cross_flow(model_, h, k);
+    return w;
+  };
   if (vessel >= 0 && !model_.bodies[vessel].kinematic) {  // a fixed structure feels no force: it keeps its velocity
     const Body& body = model_.bodies[vessel];
     const BodyKinematics k = kinematics(vessel);
     Wrench total = gravity_force(model_, body);
-    if (water) {
-      report_.hydro_load += buoyancy_force(model_, body, k, scratch_[0]);
-      report_.hydro_load += hydrostatic_damping(model_, body, k);
-      report_.hydro_load += vessel_resistance(model_, k);
-      report_.hydro_load += vessel_cross_flow(model_, k);
-    }
+    report_.hydro_load = hull_water(body, vessel_ref(model_), k);
     report_.wind_load = vessel_wind(model_, k);
     if (model_.settings.vessel.station_keeping.held()) {
       // A moored or DP structure: its mooring lines or thrusters take the place of propulsion and steering (its
       // thrusters' wash is not modelled).
-      report_.propulsion_load =
-          station_keeping_force(model_, k, state_.time_s, dt, &state_.dp_memory, &report_.station_keeping);
+      report_.propulsion_load = station_keeping_force(model_, vessel_ref(model_), k, state_.time_s, dt,
+                                                      &state_.dp_memory, &report_.station_keeping);
     } else {
       report_.propulsion_load = vessel_propulsion(model_, k, state_.time_s, dt, state_.speed_error_integral,
                                                   report_.thrust_n);
@@ -264,13 +276,31 @@ void World::stage_forces() {
     total += report_.propulsion_load;
     advance(vessel, k, total);
   }
+  // The structures beside it: a moored or DP one as the vessel held above (no wind: see StructureOptions).
+  report_.structures.resize(model_.structures.size());
+  for (size_t s = 0; s < model_.structures.size(); ++s) {
+    const int b = model_.structures[s].body;
+    StructureReport& sr = report_.structures[s];
+    sr.hydro_load = sr.station_keeping_load = Wrench();
+    if (model_.bodies[b].kinematic) continue;
+    const Body& body = model_.bodies[b];
+    const BodyKinematics k = kinematics(b);
+    const HullRef h = structure_ref(model_, static_cast<int>(s));
+    sr.hydro_load = hull_water(body, h, k);
+    sr.station_keeping_load = station_keeping_force(model_, h, k, state_.time_s, dt,
+                                                    &state_.structure_dp_memory[s], &sr.station_keeping);
+    Wrench total = gravity_force(model_, body);
+    total += sr.hydro_load;
+    total += sr.station_keeping_load;
+    advance(b, k, total);
+  }
   // Floes in parallel: each writes only its own slots.
   const int n = static_cast<int>(awake_list_.size());
   pool_.parallel_for(n, [&](int begin, int end, int worker) {
     ForceScratch& s = scratch_[worker];
     for (int i = begin; i < end; ++i) {
       const int b = awake_list_[i];
-      if (b == vessel) continue;
+      if (b < model_.hull_count()) continue;
       const Body& body = model_.bodies[b];
       const BodyKinematics k = kinematics(b);
       Wrench w = gravity_force(model_, body);
@@ -325,6 +355,16 @@ void World::stage_relax() {
                                             &report_.ice_load_level_ice);
   report_.ice_load = report_.ice_load_rigid;
   report_.ice_load += report_.ice_load_compliant;
+  for (size_t s = 0; s < model_.structures.size(); ++s) {
+    StructureReport& sr = report_.structures[s];
+    sr.part_force_n.assign(model_.structures[s].part_count, Vec3::Zero());
+    Wrench rigid, compliant;
+    sr.ice_load_level_ice = Wrench();
+    sr.contacts = hull_ice_load(contacts_, model_.structures[s].body, &rigid, &compliant, &sr.ice_load_level_ice,
+                                &sr.part_force_n);
+    sr.ice_load = rigid;
+    sr.ice_load += compliant;
+  }
   // What the solver's settings change in the recorded load (solver.reference, a diagnostic).
   report_.surge_load_error_n = std::numeric_limits<double>::quiet_NaN();
   if (o.reference != "off" && branch_every_ == 0 && model_.vessel >= 0) {
@@ -363,21 +403,27 @@ double World::reference_surge_load(const Vec3& surge) {
 
 int World::vessel_ice_load(const std::vector<Contact>& contacts, Wrench* rigid, Wrench* compliant,
                            Wrench* level_ice) const {
-  // Contact loads on the vessel: impulse / dt, about its centre of mass (lever arms of the solve), split by contact
+  return hull_ice_load(contacts, model_.vessel, rigid, compliant, level_ice, nullptr);
+}
+
+int World::hull_ice_load(const std::vector<Contact>& contacts, int body, Wrench* rigid, Wrench* compliant,
+                         Wrench* level_ice, std::vector<Vec3>* part_force) const {
+  // Contact loads on the body: impulse / dt, about its centre of mass (lever arms of the solve), split by contact
   // law (the seed filters compliant loads over 0.5 s and rigid ones over 20 s, PHYSICS.md §5); and, if asked, the
-  // part from level ice tiles (breaking the sheet's edge, against clearing the pieces).
-  const int vessel = model_.vessel;
+  // part from level ice tiles (breaking the sheet's edge, against clearing the pieces) and each part's force.
   const double dt = model_.settings.time_step_s;
+  const int first_part = model_.bodies[body].first_part;
   int n = 0;
   for (const Contact& c : contacts) {
-    if (c.body_a != vessel && c.body_b != vessel) continue;
+    if (c.body_a != body && c.body_b != body) continue;
     ++n;
     const Vec3 p = (c.pn * c.normal + c.pt1 * c.t1 + c.pt2 * c.t2) / dt;  // on body b
     Wrench w;
-    if (c.body_b == vessel) w.add_at(p, c.rb);
+    if (c.body_b == body) w.add_at(p, c.rb);
     else w.add_at(-p, c.ra);
     *(c.type == ContactType::rigid ? rigid : compliant) += w;
-    if (level_ice && model_.bodies[c.body_a == vessel ? c.body_b : c.body_a].fixed) *level_ice += w;
+    if (level_ice && model_.bodies[c.body_a == body ? c.body_b : c.body_a].fixed) *level_ice += w;
+    if (part_force) (*part_force)[(c.body_a == body ? c.part_a : c.part_b) - first_part] += w.force;
   }
   return n;
 }
@@ -505,7 +551,7 @@ void World::stage_sleep() {
   const double dt = model_.settings.time_step_s;
   if (!std::isfinite(report_.solve.residual) || !std::isfinite(report_.relax.residual))
     fail(-1, "the contact solver diverged (residual is not finite)");
-  report_.awake_floes = static_cast<int>(awake_list_.size()) - (model_.vessel >= 0 ? 1 : 0);
+  report_.awake_floes = static_cast<int>(awake_list_.size()) - model_.hull_count();
   report_.floe_bodies = floes_alive_;
   for (int b : awake_list_) {
     if (!state_.alive[b]) continue;  // broke up in this step
@@ -517,7 +563,7 @@ void World::stage_sleep() {
       fail(b, "speed " + std::to_string(v.norm()) + " m/s exceeds health.max_speed_mps (energy blow-up)");
     if (w.norm() > h.max_angular_radps)
       fail(b, "angular speed " + std::to_string(w.norm()) + " rad/s exceeds health.max_angular_radps (blow-up)");
-    if (b == model_.vessel) continue;
+    if (b < model_.hull_count()) continue;
     const bool slow = v.norm() < s.linear_mps && w.norm() < s.angular_radps;
     state_.still_time_s[b] = slow ? state_.still_time_s[b] + dt : 0.0;
   }
@@ -539,26 +585,30 @@ void World::stage_sleep() {
   }
   for (int b : awake_list_) island_ok_[b] = 1;
   for (int b : awake_list_)
-    if (b == model_.vessel || state_.still_time_s[b] < s.time_s) island_ok_[find(b)] = 0;
+    if (b < model_.hull_count() || state_.still_time_s[b] < s.time_s) island_ok_[find(b)] = 0;
   // Far astern (sleep.freeze_astern_m): asleep at any speed; the island rule above no longer applies to it.
-  // Astern is behind the vessel's bow, or behind a fixed structure's motion through the ice (downstream of it in
-  // the earth frame); a structure at rest in the ice has no astern.
-  const int vessel = model_.vessel;
-  bool freeze = s.freeze_astern_m > 0 && vessel >= 0;
-  Vec3 heading = Vec3::UnitX();
-  if (freeze && model_.bodies[vessel].kinematic) {
-    const Vec3 v(state_.velocity[vessel].x(), state_.velocity[vessel].y(), 0);
-    freeze = v.norm() > 0;
-    if (freeze) heading = v.normalized();
-  } else if (freeze) {
-    heading = state_.orientation[vessel] * Vec3::UnitX();
+  // Astern is behind a ship's bow, or behind a structure's motion through the ice (downstream of it in the earth
+  // frame: against the drift); a structure at rest in the ice has no astern. A body is frozen when it is far astern
+  // of every hull body.
+  const int hulls = model_.hull_count();
+  std::vector<Vec3> astern_dir(hulls, Vec3::Zero());  // zero: this hull has no astern (nothing is astern of all)
+  const Vec3 through_ice = -Vec3(model_.frame_velocity.x(), model_.frame_velocity.y(), 0);
+  for (int hb = 0; hb < hulls; ++hb) {
+    const bool ship = hb == model_.vessel && !model_.settings.vessel.station_keeping.held();
+    if (ship) astern_dir[hb] = state_.orientation[hb] * Vec3::UnitX();
+    else if (through_ice.norm() > 0) astern_dir[hb] = through_ice.normalized();
   }
   auto far_astern = [&](int b) {
-    const Vec3 d = state_.position[b] - state_.position[vessel];
-    return d.dot(heading) < 0 && d.head<2>().norm() > s.freeze_astern_m;
+    for (int hb = 0; hb < hulls; ++hb) {
+      const Vec3 d = state_.position[b] - state_.position[hb];
+      if (astern_dir[hb].squaredNorm() == 0 || d.dot(astern_dir[hb]) >= 0 || d.head<2>().norm() <= s.freeze_astern_m)
+        return false;
+    }
+    return true;
   };
+  const bool freeze = s.freeze_astern_m > 0 && hulls > 0;
   for (int b : awake_list_) {
-    if (b == model_.vessel || !state_.alive[b]) continue;
+    if (b < hulls || !state_.alive[b]) continue;
     if (!island_ok_[find(b)] && !(freeze && far_astern(b))) continue;
     state_.awake[b] = 0;
     state_.velocity[b].setZero();
@@ -677,6 +727,8 @@ void World::save(ByteWriter& w) const {
   w.pod(s.speed_error_integral);
   w.pod(s.heading_ref_rad);
   w.vec(s.dp_memory);
+  w.size(s.structure_dp_memory.size());
+  for (const std::vector<double>& m : s.structure_dp_memory) w.vec(m);
   // 3. What else carries over: mass matrices as the solver saw them, jets, the fracture record, moved bodies.
   put_mat3s(w, solver_bodies_.inv_mass);
   put_mat3s(w, solver_bodies_.inv_inertia_world);
@@ -826,6 +878,15 @@ std::unique_ptr<World> World::restore(const Model& base, ByteReader& r) {
   s.dp_memory = r.vec<double>();
   FLOESIM_REQUIRE(s.dp_memory.empty() || s.dp_memory.size() == static_cast<size_t>(DpController::kMemory), r.what(),
                   ": damaged (a DP controller's memory of ", s.dp_memory.size(), " values)");
+  s.structure_dp_memory.resize(r.size());
+  FLOESIM_REQUIRE(s.structure_dp_memory.size() == w->model_.structures.size(), r.what(), ": damaged (",
+                  s.structure_dp_memory.size(), " structures' DP memories for ", w->model_.structures.size(),
+                  " structures)");
+  for (std::vector<double>& m : s.structure_dp_memory) {
+    m = r.vec<double>();
+    FLOESIM_REQUIRE(m.empty() || m.size() == static_cast<size_t>(DpController::kMemory), r.what(),
+                    ": damaged (a DP controller's memory of ", m.size(), " values)");
+  }
   // 3. The rest.
   get_mat3s(r, w->solver_bodies_.inv_mass);
   require_bodies(r, w->solver_bodies_.inv_mass.size(), n, "inverse masses");

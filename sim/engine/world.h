@@ -38,6 +38,16 @@ namespace floesim::sim {
 enum Stage { kCollide, kForces, kSolve, kIntegrate, kRelax, kFracture, kSleep, kStageCount };
 const char* stage_name(int stage);
 
+// The loads on a structure beside the vessel in one step (world frame, about its centre of mass) and how it is held.
+struct StructureReport {
+  int contacts = 0;
+  Wrench ice_load;            // every contact
+  Wrench ice_load_level_ice;  // the part from level ice tiles
+  Wrench hydro_load, station_keeping_load;
+  StationKeeping station_keeping;
+  std::vector<Vec3> part_force_n;  // the ice's force on each of its convex parts (in the order of its parts)
+};
+
 // What one step did and the loads on the vessel (world frame, about its centre of mass).
 struct StepReport {
   int contacts = 0, vessel_contacts = 0;
@@ -54,6 +64,7 @@ struct StepReport {
   Wrench hydro_load, wind_load, propulsion_load;  // propulsion_load: a moored or DP body's station keeping
   double thrust_n = 0;
   StationKeeping station_keeping;  // a moored or DP body: its offset, heading change, demanded and delivered force
+  std::vector<StructureReport> structures;  // Model::structures, in order
 };
 
 class World {
@@ -118,6 +129,10 @@ class World {
   // level ice tiles if `level_ice` is given; returns how many contacts touch it.
   int vessel_ice_load(const std::vector<Contact>& contacts, Wrench* rigid, Wrench* compliant,
                       Wrench* level_ice = nullptr) const;
+  // The same for any hull body (the vessel's or a structure's), and the force on each of its parts (part_force, if
+  // given: sized to its part count).
+  int hull_ice_load(const std::vector<Contact>& contacts, int body, Wrench* rigid, Wrench* compliant,
+                    Wrench* level_ice, std::vector<Vec3>* part_force) const;
   // Replaces the floe of `cut` by its pieces (bodies appended at the floe's pose and velocity field) and records
   // the event.
   void apply_fracture(FractureCut& cut);

@@ -20,12 +20,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kCheckpointMagic = "floesim-checkpoint/6\n";
+constexpr const char* kCheckpointMagic = "floesim-checkpoint/7\n";
 constexpr const char* kRecordsMagic = "floesim-checkpoint-records/1\n";
 constexpr size_t kHashChars = 64;  // SHA-256, hex
 
 // The arrays the recorder appends to at every step or frame, in a fixed order: every series of the layout, then the
-// frames and their body states. A checkpoint stores their tails since the previous one.
+// frames and their body states, then the structures' series (by name). A checkpoint stores their tails since the previous one.
 template <class R, class F>
 void for_each_recorded(R& r, F&& f) {
   for (const FieldSpec& s : series_fields()) f(s.name, r.series.at(s.name));
@@ -35,6 +35,7 @@ void for_each_recorded(R& r, F&& f) {
   f("state_position_m", r.state_position_m);
   f("state_quaternion", r.state_quaternion);
   f("state_in_contact", r.state_in_contact);
+  for (auto& [name, v] : r.structure_series) f(name.c_str(), v);  // kept whole, as the frames
 }
 
 // The recorded arrays that are series: the first ones of for_each_recorded.

@@ -49,6 +49,14 @@ struct SimulateOptions : EngineSettings {
     v.section("hull", hull, "how the hull file is loaded (non-convex meshes)");
     v.section("level_ice", level_ice, "a level ice sheet, broken by the fracture module (issue #10)");
     v.section("drift", drift, "the ice's drift toward a structure: the run is computed in the ice's frame");
+    v.list("structures", structures,
+           "structures beside the vessel (fixed, moored or dp), each a hull body of its own with its loads, pose and "
+           "station keeping recorded under its name: [{\"name\", \"hull_file\", placement and mass as the "
+           "vessel's, \"station_keeping\"}]");
+    for (size_t i = 0; i < structures.size(); ++i)
+      for (size_t j = 0; j < i; ++j)
+        if (structures[i].name == structures[j].name)
+          v.problem("structures", "two structures are named \"" + structures[i].name + "\": names must differ");
     // Cross-field checks: whole numbers of steps, statistics window inside the run.
     if (time_step_s > 0 && duration_s > 0) {
       const double n = duration_s / time_step_s;

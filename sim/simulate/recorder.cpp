@@ -87,6 +87,24 @@ constexpr LoadSeries kLoadSeries[] = {
 // A body's id in the results layout: 0 for the vessel, its floe id otherwise.
 int32_t results_id(const Body& b) { return b.kind == BodyKind::vessel ? 0 : b.id; }
 
+// A structure beside the vessel: recorded under /structures, not in the frames.
+bool is_structure(const Model& m, size_t b) {
+  return static_cast<int>(b) < m.hull_count() && static_cast<int>(b) != m.vessel;
+}
+
+// Each field's columns for structure k (structure_fields order).
+std::vector<size_t> structure_columns(const SimulateOptions& o, size_t k) {
+  std::vector<size_t> cols;
+  for (const StructureField& f : structure_fields()) {
+    const std::string name = f.name;
+    if (name == "quaternion_wxyz") cols.push_back(4);
+    else if (name == "line_tension_n") cols.push_back(o.structures[k].body.station_keeping.lines.size());
+    else if (name == "part_force_n") cols.push_back(0);  // set from the model in attach()
+    else cols.push_back(3);
+  }
+  return cols;
+}
+
 // Kinetic energy of the floes and pieces (translation and rotation, without added mass); sleeping and fixed bodies
 // have none.
 double ice_kinetic_energy(const World& w) {
@@ -113,7 +131,7 @@ class Recorder::StoredStates {
     const Model& m = w.model();
     std::map<int32_t, size_t> index;
     for (size_t b = 0; b < m.bodies.size(); ++b)
-      if (m.bodies[b].kind != BodyKind::wall) index[results_id(m.bodies[b])] = b;
+      if (m.bodies[b].kind != BodyKind::wall && !is_structure(m, b)) index[results_id(m.bodies[b])] = b;
     last_.resize(m.bodies.size());
     for (size_t row = 0; row < r.state_body_id.size(); ++row) {
       const auto it = index.find(r.state_body_id[row]);
@@ -143,7 +161,8 @@ class Recorder::StoredStates {
 };
 
 
-Recorder::Recorder(const SimulateOptions& o, Results& r, long rows_held) : o_(o), r_(r), every_(o.output_every()) {
+Recorder::Recorder(const SimulateOptions& o, const Model& model, Results& r, long rows_held)
+    : o_(o), r_(r), every_(o.output_every()) {
   // One reservation up front (for the whole run, or for one checkpoint interval when the checkpoints take the
   // series out of memory).
   std::map<std::string, std::vector<double>*> col;
@@ -166,11 +185,90 @@ Recorder::Recorder(const SimulateOptions& o, Results& r, long rows_held) : o_(o)
   // The states grow with the ice that moves (a frame stores only what changed: no reservation by field size).
   r.frame_offset.push_back(0);
   r.frame_time_s.reserve(static_cast<size_t>(o.steps() / every_));
+  add_structures(model);
 }
 
 Recorder::~Recorder() = default;
 
 void Recorder::attach(const World& w) { stored_ = std::make_unique<StoredStates>(w, r_); }
+
+void Recorder::add_structures(const Model& m) {
+  // The structures' series (kept whole: a checkpoint carries them as it does the frames) and their list.
+  nlohmann::json list = nlohmann::json::array();
+  c_structures_.clear();
+  for (size_t k = 0; k < m.structures.size(); ++k) {
+    const StructureOptions& so = o_.structures[k];
+    std::vector<size_t> cols = structure_columns(o_, k);
+    nlohmann::json columns = nlohmann::json::object();
+    std::vector<std::vector<double>*> c;
+    for (size_t i = 0; i < cols.size(); ++i) {
+      const std::string field = structure_fields()[i].name;
+      if (field == "part_force_n") cols[i] = 3 * static_cast<size_t>(m.structures[k].part_count);
+      if (cols[i] == 0) {  // no lines: no field
+        c.push_back(nullptr);
+        continue;
+      }
+      columns[field] = cols[i];
+      std::vector<double>& v = r_.structure_series[so.name + "/" + field];
+      v.reserve(static_cast<size_t>(o_.steps()) * cols[i]);
+      c.push_back(&v);
+    }
+    c_structures_.push_back(std::move(c));
+    const Station& st = m.structures[k].station;
+    list.push_back({{"name", so.name},
+                    {"kind", so.body.station_keeping.mode},
+                    {"reference_point_body_m", {st.reference_point_body.x(), st.reference_point_body.y(),
+                                                st.reference_point_body.z()}},
+                    {"station_m", {st.position.x(), st.position.y(), st.position.z()}},
+                    {"station_heading_deg", st.heading_rad * 180 / kPi},
+                    {"waterline_width_m", m.structures[k].info.beam_wl_m},
+                    {"parts", m.structures[k].part_count},
+                    {"run_frame_velocity_mps", {m.frame_velocity.x(), m.frame_velocity.y(), m.frame_velocity.z()}},
+                    {"columns", columns}});
+  }
+  if (!m.structures.empty()) r_.attributes["structures"] = list;
+}
+
+void Recorder::record_structures(const World& w) {
+  const Model& m = w.model();
+  const State& s = w.state();
+  const StepReport& rep = w.report();
+  for (size_t k = 0; k < m.structures.size(); ++k) {
+    const int b = m.structures[k].body;
+    const StructureReport& sr = rep.structures[k];
+    const Vec3 x = s.position[b] + s.time_s * m.frame_velocity;  // earth frame
+    const Vec3 v = s.velocity[b] + m.frame_velocity;
+    const Quat& q = s.orientation[b];
+    const Vec3 ref = s.orientation[b] * m.structures[k].station.reference_point_body;  // from the centre of mass
+    const Vec3 moment = sr.ice_load.torque - ref.cross(sr.ice_load.force);
+    const StationKeeping& sk = sr.station_keeping;
+    std::vector<std::vector<double>*>& c = c_structures_[k];
+    size_t i = 0;
+    auto put = [&](std::initializer_list<double> row) {
+      if (c[i]) c[i]->insert(c[i]->end(), row);
+      ++i;
+    };
+    put({x.x(), x.y(), x.z()});
+    put({q.w(), q.x(), q.y(), q.z()});
+    put({v.x(), v.y(), v.z()});
+    put({sr.ice_load.force.x(), sr.ice_load.force.y(), sr.ice_load.force.z()});
+    put({moment.x(), moment.y(), moment.z()});
+    put({sr.ice_load_level_ice.force.x(), sr.ice_load_level_ice.force.y(), sr.ice_load_level_ice.force.z()});
+    put({sr.hydro_load.force.x(), sr.hydro_load.force.y(), sr.hydro_load.force.z()});
+    put({sr.station_keeping_load.force.x(), sr.station_keeping_load.force.y(), sr.station_keeping_load.force.z()});
+    put({sk.offset.x(), sk.offset.y(), sk.heading_change_rad});
+    put({sk.demanded[0], sk.demanded[1], sk.demanded[2]});
+    put({sk.delivered[0], sk.delivered[1], sk.delivered[2]});
+    if (c[i]) {  // line tensions (a moored structure's, every step)
+      FLOESIM_REQUIRE(sk.line_tension_n.size() * 1 == o_.structures[k].body.station_keeping.lines.size(),
+                      "internal: structure ", o_.structures[k].name, " reported ", sk.line_tension_n.size(),
+                      " line tensions");
+      c[i]->insert(c[i]->end(), sk.line_tension_n.begin(), sk.line_tension_n.end());
+    }
+    ++i;
+    for (const Vec3& f : sr.part_force_n) c[i]->insert(c[i]->end(), {f.x(), f.y(), f.z()});
+  }
+}
 
 void Recorder::record_step(const World& w, long k) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -193,6 +291,7 @@ void Recorder::record_step(const World& w, long k) {
   c_offset_->insert(c_offset_->end(), {sk.offset.x(), sk.offset.y(), sk.heading_change_rad});
   c_demanded_->insert(c_demanded_->end(), {sk.demanded[0], sk.demanded[1], sk.demanded[2]});
   c_delivered_->insert(c_delivered_->end(), {sk.delivered[0], sk.delivered[1], sk.delivered[2]});
+  record_structures(w);
   // 2. The run's sums.
   sums_.awake += rep.awake_floes;
   sums_.contacts += rep.contacts;
@@ -213,7 +312,8 @@ void Recorder::record_step(const World& w, long k) {
       if (c.pn > 0 && (c.body_a == v || c.body_b == v)) pressed_[size_t(c.body_a == v ? c.body_b : c.body_a)] = 1;
     for (size_t b = 0; b < wm.bodies.size(); ++b) {
       const Body& body = wm.bodies[b];
-      if (body.kind == BodyKind::wall || !s.alive[b]) continue;  // walls are fixed: not in the results layout
+      // Walls are fixed: not in the results layout; the structures are in /structures.
+      if (body.kind == BodyKind::wall || !s.alive[b] || is_structure(wm, b)) continue;
       if (!stored_->changed(b, s.position[b], s.orientation[b], pressed_[b]) && body.kind != BodyKind::vessel)
         continue;
       r_.state_body_id.push_back(results_id(body));
@@ -252,6 +352,15 @@ void Recorder::finish(const World& w) {
   const TriMesh& hull = wm.bodies[wm.vessel].buoyancy_mesh;
   for (const Vec3& p : hull.vertices) r.hull_vertices_m.insert(r.hull_vertices_m.end(), {p.x(), p.y(), p.z()});
   for (const auto& t : hull.triangles) r.hull_triangles.insert(r.hull_triangles.end(), {t[0], t[1], t[2]});
+  for (size_t k = 0; k < wm.structures.size(); ++k) {
+    const TriMesh& mesh = wm.bodies[wm.structures[k].body].buoyancy_mesh;
+    std::vector<double>& v = r.structure_hull_vertices_m[o_.structures[k].name];
+    std::vector<int32_t>& t = r.structure_hull_triangles[o_.structures[k].name];
+    v.clear();
+    t.clear();
+    for (const Vec3& p : mesh.vertices) v.insert(v.end(), {p.x(), p.y(), p.z()});
+    for (const auto& tri : mesh.triangles) t.insert(t.end(), {tri[0], tri[1], tri[2]});
+  }
 
   r.attributes["time_step_s"] = o_.time_step_s;
   r.attributes["duration_s"] = o_.duration_s;

@@ -23,8 +23,9 @@ struct RecorderSums {
 
 class Recorder {
  public:
-  // Reserves the series columns of `r` for `rows_held` steps and its frames for the whole run.
-  Recorder(const SimulateOptions& o, Results& r, long rows_held);
+  // Reserves the series columns of `r` for `rows_held` steps and its frames for the whole run, and the series of
+  // the model's structures (and lists them in r's attributes).
+  Recorder(const SimulateOptions& o, const Model& model, Results& r, long rows_held);
   ~Recorder();
 
   // Takes up the bodies' last stored states from the results (none for a fresh run; every row up to the checkpoint
@@ -42,6 +43,8 @@ class Recorder {
   RecorderSums& sums() { return sums_; }
 
  private:
+  void add_structures(const Model& m);     // their series (empty) and list, from the constructor
+  void record_structures(const World& w);  // the step's row of each structure's series
   class StoredStates;
   const SimulateOptions& o_;
   Results& r_;
@@ -52,6 +55,8 @@ class Recorder {
   std::vector<std::vector<double>*> c_loads_;   // the wrench series, in the order of kLoadSeries
   std::vector<std::vector<double>*> c_scalar_;  // the scalar series, in the order of kScalarSeries
   std::vector<int8_t> pressed_;                 // per body: pressed against the vessel in this step (frames only)
+  // The structures beside the vessel: per structure, its fields' columns in the order of structure_fields().
+  std::vector<std::vector<std::vector<double>*>> c_structures_;
   std::unique_ptr<StoredStates> stored_;  // from attach()
   RecorderSums sums_;
 };

@@ -66,7 +66,7 @@ Results simulate(const SimulateOptions& o, Model model, RunStats& stats, std::os
   const long steps = o.steps(), checkpoint_every = o.checkpoint_every();
   const bool spill = checkpoints && checkpoints->spill_series && checkpoint_every > 0;
   Results r;
-  Recorder recorder(o, r, spill ? std::min(steps, checkpoint_every) : steps);
+  Recorder recorder(o, model, r, spill ? std::min(steps, checkpoint_every) : steps);
   RecorderSums& sums = recorder.sums();
 
   // 1. The world: fresh, or continued from a checkpoint (sim/simulate/checkpoint.h) with the results recorded up
@@ -141,7 +141,23 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
                 "waterline z = 0): place a CAD mesh with the hull options (case \"hull\": {\"file\", \"waterline_z_m\", "
                 "\"up_direction\", \"bow_direction\", \"scale\"}, or floesim-hull) first");
   }
-  Model model = build_model(field, &hull, o);
+  // The structures beside it: meshes in their hull frames as the files have them, relative to the config file.
+  std::vector<HullModel> structures;
+  for (size_t k = 0; k < o.structures.size(); ++k) {
+    fs::path f = o.structures[k].hull_file;
+    if (f.is_relative()) f = config_file.parent_path() / f;
+    o.structures[k].hull_file = f.string();
+    inputs.push_back({"structure " + o.structures[k].name, f});
+    const std::string key = config_file.string() + ": structures[" + std::to_string(k) + "].hull_file";
+    FLOESIM_REQUIRE(fs::is_regular_file(f), key, ": ", f.string(), " does not exist");
+    try {
+      structures.push_back(load_hull(f, HullLoadOptions{}));
+      require_floating(structures.back(), f.string());
+    } catch (const Error& e) {
+      throw Error(key + ": " + e.what());
+    }
+  }
+  Model model = build_model(field, &hull, o, structures);
 
   std::ostringstream out;
   out << "floesim-simulate: " << model.floe_count() << " floes in " << model.parts.size() << " convex parts ("

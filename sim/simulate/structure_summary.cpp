@@ -40,19 +40,16 @@ nlohmann::json stats_json(const Stats& s) {
 
 // The highest ice within `radius` of the structure's axis at each stored frame of the steady part (the rubble and
 // ride-up pile, PHYSICS.md §8.2's h_r, measured from the water line): every alive floe's slab corners, posed.
-std::vector<double> rubble_heights(const Model& model, const Results& r, double from_s, double radius) {
+// `axis_at(frame)`: the structure's axis at the water line at that frame, in the frames' (the run's) frame.
+template <class AxisAt>
+std::vector<double> rubble_heights(const Results& r, double from_s, double radius, AxisAt&& axis_at) {
   std::vector<double> heights;
   if (r.frames() == 0) return heights;
-  const Vec3 com = model.vessel_info.centre_of_mass_hull;
   FrameReplay replay(r, "the results");
   for (size_t f = 0; f < r.frames(); ++f) {
     replay.seek(f);
     if (r.frame_time_s[f] < from_s) continue;
-    const int64_t vr = replay.vessel_row();
-    const Vec3 xs(r.state_position_m[3 * vr], r.state_position_m[3 * vr + 1], r.state_position_m[3 * vr + 2]);
-    const Quat qs(r.state_quaternion[4 * vr], r.state_quaternion[4 * vr + 1], r.state_quaternion[4 * vr + 2],
-                  r.state_quaternion[4 * vr + 3]);
-    const Vec3 axis = xs - qs * com;  // the hull frame's origin: the structure's axis at the water line
+    const Vec3 axis = axis_at(replay, f);
     double top = 0;                   // open water: nothing above the water line
     const std::vector<int64_t>& rows = replay.rows();
     const std::vector<int32_t>& floes = replay.floes();
@@ -96,7 +93,7 @@ nlohmann::json station_keeping_summary(const SimulateOptions& o, const Model& mo
   j["heading_change_deg"] = stats_json(stats_of(dpsi));
   // 1. The balance along the drift (or the station's x axis without one): each load turned into the earth frame.
   const Vec2 drift = o.drift.velocity();
-  const double a = model.station_heading_rad;
+  const double a = model.station.heading_rad;
   const Vec3 along = drift.norm() > 0 ? Vec3(drift.x(), drift.y(), 0).normalized() : Vec3(std::cos(a), std::sin(a), 0);
   const std::vector<double> quat = series.get("vessel_quaternion_wxyz");
   const double n = static_cast<double>(steps - first);
@@ -133,11 +130,11 @@ nlohmann::json station_keeping_summary(const SimulateOptions& o, const Model& mo
   const StationKeepingOptions& sk = o.vessel.station_keeping;
   if (sk.moored()) {
     const double c0 = std::cos(a), s0 = std::sin(a);
-    std::vector<Stats> h(model.mooring.size()), t(model.mooring.size());
-    std::vector<std::vector<double>> hs(model.mooring.size()), ts(model.mooring.size());
+    std::vector<Stats> h(model.station.mooring.size()), t(model.station.mooring.size());
+    std::vector<std::vector<double>> hs(model.station.mooring.size()), ts(model.station.mooring.size());
     for (size_t i = first; i < steps; ++i) {
       const double ex = off[3 * i], ey = off[3 * i + 1];
-      const SpreadState sp = spread_at_pose(model.mooring, c0 * ex + s0 * ey, -s0 * ex + c0 * ey, off[3 * i + 2]);
+      const SpreadState sp = spread_at_pose(model.station.mooring, c0 * ex + s0 * ey, -s0 * ex + c0 * ey, off[3 * i + 2]);
       for (size_t l = 0; l < sp.lines.size(); ++l) {
         hs[l].push_back(sp.lines[l].horizontal_tension_n);
         ts[l].push_back(sp.lines[l].fairlead_tension_n);
@@ -205,7 +202,151 @@ nlohmann::json cycles_json(const std::vector<double>& f, const SimulateOptions& 
   return j;
 }
 
+// The steady part's first step: the first at or after steady_start_s.
+size_t steady_first(const SimulateOptions& o, const SeriesSource& series) {
+  const std::vector<double> t = series.get("time_s");
+  size_t first = 0;
+  while (first < t.size() && t[first] < o.steady_start_s - 0.5 * o.time_step_s) ++first;
+  return first;
+}
+
 }  // namespace
+
+nlohmann::json listed_structure_summary(const SimulateOptions& o, const Model& model, const Results& r,
+                                        const SeriesSource& series, size_t k) {
+  const StructureOptions& so = o.structures[k];
+  const StructureBody& sb = model.structures[k];
+  const size_t steps = series.steps(), first = steady_first(o, series);
+  auto field = [&](const char* f) -> const std::vector<double>& {
+    const auto it = r.structure_series.find(so.name + "/" + f);
+    FLOESIM_REQUIRE(it != r.structure_series.end(), "internal: no series ", so.name, "/", f);
+    return it->second;
+  };
+  const std::vector<double>& ice = field("ice_force_n");
+  const std::vector<double>& mom = field("ice_moment_nm");
+  const std::vector<double>& sheet_series = field("level_ice_force_n");
+  // 1. The load in the structure's axes (its heading at the station: x into the ice that comes), earth axes turned.
+  const double a = sb.station.heading_rad, c = std::cos(a), s = std::sin(a);
+  std::vector<double> fh, fy, fv, my, sheet;
+  for (size_t i = first; i < steps; ++i) {
+    fh.push_back(-(c * ice[3 * i] + s * ice[3 * i + 1]));
+    fy.push_back(-s * ice[3 * i] + c * ice[3 * i + 1]);
+    fv.push_back(ice[3 * i + 2]);
+    my.push_back(-s * mom[3 * i] + c * mom[3 * i + 1]);
+    sheet.push_back(-(c * sheet_series[3 * i] + s * sheet_series[3 * i + 1]));
+  }
+  const size_t nw = window_samples(kFilterS, o.time_step_s);
+  const std::vector<double> fh_f = moving_average_full_windows(fh, nw);
+  nlohmann::json j;
+  j["name"] = so.name;
+  j["kind"] = so.body.station_keeping.mode;
+  j["reference_point"] = "the structure's axis at the water line (the hull frame's origin)";
+  j["axes"] = "the structure's at its station: x along its heading (into the ice that comes), z up";
+  j["filter"] = {{"kind", "centred moving average of the compliant contacts' load (PHYSICS.md 5)"},
+                 {"window_s", kFilterS}};
+  j["steady_part"] = {{"from_s", o.steady_start_s}, {"to_s", o.duration_s}, {"samples", fh.size()}};
+  j["horizontal_load_N"] = stats_json(stats_of(fh));
+  j["horizontal_load_filtered_N"] = stats_json(stats_of(fh_f));
+  j["transverse_load_N"] = stats_json(stats_of(fy));
+  j["vertical_load_N"] = stats_json(stats_of(fv));
+  j["overturning_moment_y_Nm"] = stats_json(stats_of(my));
+  j["cycles"] = cycles_json(fh_f, o, nw);
+  if (!o.level_ice.extent_m.empty()) {
+    const std::vector<double> sheet_f = moving_average_full_windows(sheet, nw);
+    j["breaking"] = {{"what", "the part of the horizontal load from the level ice sheet's tiles"},
+                     {"load_N", stats_json(stats_of(sheet))},
+                     {"load_filtered_N", stats_json(stats_of(sheet_f))},
+                     {"cycles", cycles_json(sheet_f, o, nw)}};
+  }
+  // 2. Each part's share: the mean of its horizontal load along x and the largest filtered.
+  {
+    const std::vector<double>& parts = field("part_force_n");
+    nlohmann::json list = nlohmann::json::array();
+    for (int p = 0; p < sb.part_count; ++p) {
+      std::vector<double> h;
+      for (size_t i = first; i < steps; ++i) {
+        const size_t at = (3 * static_cast<size_t>(sb.part_count)) * i + 3 * p;
+        h.push_back(-(c * parts[at] + s * parts[at + 1]));
+      }
+      const Stats sh = stats_of(h), sf = stats_of(moving_average_full_windows(h, nw));
+      list.push_back({{"part", p}, {"horizontal_load_mean_N", sh.mean}, {"horizontal_load_filtered_max_N", sf.max}});
+    }
+    j["parts"] = list;
+  }
+  // 3. The rubble: the highest ice within the waterline width of its axis, per stored frame.
+  const std::vector<double>& pos = field("position_m");
+  const std::vector<double>& quat = field("quaternion_wxyz");
+  const double every = o.output_interval_s / o.time_step_s, radius = sb.info.beam_wl_m;
+  const Stats hr = stats_of(rubble_heights(r, o.steady_start_s, radius, [&](const FrameReplay&, size_t f) {
+    const size_t i = static_cast<size_t>(std::lround((static_cast<double>(f) + 1) * every)) - 1;  // its step's row
+    const Quat q(quat[4 * i], quat[4 * i + 1], quat[4 * i + 2], quat[4 * i + 3]);
+    const Vec3 x = Vec3(pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]) - r.frame_time_s[f] * model.frame_velocity;
+    return Vec3(x + q * sb.station.reference_point_body);
+  }));
+  j["rubble_height_m"] = {{"mean", hr.mean}, {"max", hr.max}, {"within_m_of_axis", radius}};
+  // 4. How it is held: offsets, the force balance along the drift, the lines' tensions or the thrusters' use.
+  const StationKeepingOptions& sk = so.body.station_keeping;
+  if (sk.moored() || sk.dp_held()) {
+    nlohmann::json h;
+    const std::vector<double>& off = field("offset");
+    std::vector<double> dx, dy, dist, dpsi;
+    for (size_t i = first; i < steps; ++i) {
+      dx.push_back(off[3 * i]);
+      dy.push_back(off[3 * i + 1]);
+      dist.push_back(std::hypot(off[3 * i], off[3 * i + 1]));
+      dpsi.push_back(off[3 * i + 2] * 180 / kPi);
+    }
+    h["offset_x_m"] = stats_json(stats_of(dx));
+    h["offset_y_m"] = stats_json(stats_of(dy));
+    h["offset_m"] = stats_json(stats_of(dist));
+    h["heading_change_deg"] = stats_json(stats_of(dpsi));
+    const Vec2 drift = o.drift.velocity();
+    const Vec3 along = drift.norm() > 0 ? Vec3(drift.x(), drift.y(), 0).normalized() : Vec3(c, s, 0);
+    const double n = static_cast<double>(steps - first);
+    auto mean_along = [&](const std::vector<double>& f) {
+      double sum = 0;
+      for (size_t i = first; i < steps; ++i) sum += along.dot(Vec3(f[3 * i], f[3 * i + 1], f[3 * i + 2]));
+      return sum / n;
+    };
+    const double ice_m = mean_along(ice), water = mean_along(field("water_force_n"));
+    const double held = mean_along(field("station_keeping_force_n"));
+    h["force_balance_along_drift_N"] = {{"ice", ice_m},
+                                        {"water", water},
+                                        {"station_keeping", held},
+                                        {"residual", ice_m + water + held},
+                                        {"station_keeping_over_loads", -held / (ice_m + water)}};
+    if (sk.moored()) {
+      const std::vector<double>& t = field("line_tension_n");
+      const size_t L = sk.lines.size();
+      nlohmann::json lines = nlohmann::json::array();
+      double largest = 0;
+      for (size_t l = 0; l < L; ++l) {
+        std::vector<double> tl;
+        for (size_t i = first; i < steps; ++i) tl.push_back(t[L * i + l]);
+        const Stats st = stats_of(tl);
+        largest = std::max(largest, st.max);
+        lines.push_back({{"azimuth_deg", sk.lines[l].azimuth_deg}, {"fairlead_tension_N", stats_json(st)}});
+      }
+      h["lines"] = lines;
+      h["largest_fairlead_tension_N"] = largest;
+    } else {
+      const std::vector<double>& dem = field("station_keeping_demanded");
+      const std::vector<double>& del = field("station_keeping_delivered");
+      const double limit[3] = {sk.dp.max_force_x_n, sk.dp.max_force_y_n, sk.dp.max_moment_z_nm};
+      const char* axis[3] = {"surge", "sway", "yaw"};
+      for (int q = 0; q < 3; ++q) {
+        double use = 0, ask = 0;
+        for (size_t i = first; i < steps; ++i) {
+          use = std::max(use, std::abs(del[3 * i + q]) / limit[q]);
+          ask = std::max(ask, std::abs(dem[3 * i + q]) / limit[q]);
+        }
+        h["thrusters"][axis[q]] = {{"largest_delivered_over_limit", use}, {"largest_demanded_over_limit", ask}};
+      }
+    }
+    j["station_keeping"] = h;
+  }
+  return j;
+}
 
 nlohmann::json structure_summary(const SimulateOptions& o, const Model& model, const Results& r,
                                  const SeriesSource& series) {
@@ -263,7 +404,7 @@ nlohmann::json structure_summary(const SimulateOptions& o, const Model& model, c
   const std::vector<double>& e = o.level_ice.extent_m;
   if (!e.empty() && o.drift.speed_mps > 0) {
     const Vec2 d = o.drift.velocity().normalized(), across(-d.y(), d.x());
-    const Vec2 axis = model.station.head<2>();
+    const Vec2 axis = model.station.position.head<2>();
     double farthest = 0;
     for (size_t k = 0; k < r.fracture_time_s.size(); ++k)
       farthest = std::max(farthest, std::abs(across.dot(Vec2(r.fracture_point_m[3 * k], r.fracture_point_m[3 * k + 1]) -
@@ -277,7 +418,13 @@ nlohmann::json structure_summary(const SimulateOptions& o, const Model& model, c
   }
   // 4. The rubble the run shows: the highest ice within the waterline width of the axis, per stored frame.
   const double radius = model.vessel_info.beam_wl_m;
-  const Stats hr = stats_of(rubble_heights(model, r, o.steady_start_s, radius));
+  const Stats hr = stats_of(rubble_heights(r, o.steady_start_s, radius, [&](const FrameReplay& replay, size_t) {
+    const int64_t vr = replay.vessel_row();
+    const Vec3 xs(r.state_position_m[3 * vr], r.state_position_m[3 * vr + 1], r.state_position_m[3 * vr + 2]);
+    const Quat qs(r.state_quaternion[4 * vr], r.state_quaternion[4 * vr + 1], r.state_quaternion[4 * vr + 2],
+                  r.state_quaternion[4 * vr + 3]);
+    return Vec3(xs - qs * com);  // the hull frame's origin: the structure's axis at the water line
+  }));
   j["rubble_height_m"] = {{"mean", hr.mean}, {"max", hr.max}, {"within_m_of_axis", radius},
                           {"what", "the highest ice above the water line near the structure, per stored frame"}};
   if (o.vessel.station_keeping.moored() || o.vessel.station_keeping.dp_held())

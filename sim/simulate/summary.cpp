@@ -460,6 +460,11 @@ nlohmann::json summarize(const SimulateOptions& o, const Model& model, const Res
   s["fracture"] = fracture_summary(o, r);
   s["level_ice"] = level_ice_summary(o, model, r, series);
   if (o.vessel.station_keeping.held()) s["structure"] = structure_summary(o, model, r, series);
+  if (!model.structures.empty()) {
+    s["structures"] = nlohmann::json::array();
+    for (size_t k = 0; k < model.structures.size(); ++k)
+      s["structures"].push_back(listed_structure_summary(o, model, r, series, k));
+  }
   const VesselParticulars& vp = model.vessel_info;
   s["vessel"] = {{"mass_kg", vp.mass_kg},
                  {"length_oa_m", vp.length_oa_m},

@@ -30,5 +30,9 @@ nlohmann::json level_ice_summary(const SimulateOptions& o, const Model& model, c
 // period against h/v; the rubble height the run shows near the structure (for Croasdale's F_H, §8.2).
 nlohmann::json structure_summary(const SimulateOptions& o, const Model& model, const Results& results,
                                  const SeriesSource& series);
+// summary.json "structures"[k]: the same for structure k beside the vessel (simulate.structures), from its series
+// (/structures/NAME), with each part's share of the horizontal load and each mooring line's recorded tension.
+nlohmann::json listed_structure_summary(const SimulateOptions& o, const Model& model, const Results& results,
+                                        const SeriesSource& series, size_t k);
 
 }  // namespace floesim::sim

@@ -2,8 +2,9 @@
 // its width and clearing exactly the ice it sweeps (geometry by hand), the momentum a fixed structure carries against
 // the ice's (a momentum budget in a vacuum), an upward-breaking cone bending the sheet up and being pushed down
 // (PHYSICS.md §8.2.5's sign), a moored body's offset under a steady pull against §8.4.1's worked catenary figures, a
-// DP body back at its station within its thrust limits (§8.4.2), the same bits on one thread and two, and bad input
-// named.
+// DP body back at its station within its thrust limits (§8.4.2), structures beside the vessel (each carrying its
+// floe's momentum, its parts' forces adding up; a moored one at the catenary's offset), the same bits on one thread
+// and two, and bad input named.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -171,8 +172,8 @@ HullModel floating_caisson() {
 // The reference point's offset from the station, earth frame (the run here is in the earth frame).
 Vec2 offset_of(const World& w) {
   const Model& m = w.model();
-  const Vec3 ref = w.state().position[0] + w.state().orientation[0] * m.reference_point_body;
-  return (ref - m.station).head<2>();
+  const Vec3 ref = w.state().position[0] + w.state().orientation[0] * m.station.reference_point_body;
+  return (ref - m.station.position).head<2>();
 }
 
 TEST(Structure, AMooredBodyTakesTheCatenarysOffsetUnderASteadyPull) {
@@ -202,6 +203,87 @@ TEST(Structure, AMooredBodyTakesTheCatenarysOffsetUnderASteadyPull) {
   }
 }
 
+// A structure beside the vessel (options.structures): the vessel a fixed caisson far off, out of the way.
+StructureOptions listed(const std::string& name, const std::string& mode, double x, double y) {
+  StructureOptions s;
+  s.name = name;
+  s.body.station_keeping.mode = mode;
+  s.body.x_m = x;
+  s.body.y_m = y;
+  return s;
+}
+
+TEST(Structure, TwoStructuresBesideTheVesselEachCarryTheMomentumOfTheFloeThatHitsThem) {
+  // A vacuum without gravity, as above: each caisson takes what its floe loses, and its parts' forces add up to it.
+  SimulateOptions o;
+  o.vessel.station_keeping.mode = "fixed";
+  o.vessel.y_m = -300;
+  o.water.enabled = false;
+  o.water.gravity_mps2 = 0;
+  o.fracture.enabled = false;
+  o.sleep.enabled = false;
+  o.structures = {listed("west", "fixed", 0, 0), listed("east", "fixed", 0, 60)};
+  FloeField field;
+  field.floes.push_back(testing::rect_floe(1, 6, -8, 20, 14, 1.0));
+  field.floes.push_back(testing::rect_floe(2, 6, 52, 20, 14, 1.0));
+  const HullModel caisson = structure("caisson", 10);
+  World world(build_model(field, &caisson, o, {caisson, caisson}));
+  const Model& m = world.model();
+  ASSERT_EQ(m.structures.size(), 2u);
+  const int floes[2] = {3, 4};  // after the vessel (0) and the two structures (1, 2)
+  world.mutable_state().velocity[floes[0]] = Vec3(-1.0, 0.2, 0);
+  world.mutable_state().velocity[floes[1]] = Vec3(-0.5, -0.1, 0);
+  Vec3 p0[2], impulse[2] = {Vec3::Zero(), Vec3::Zero()};
+  for (int i = 0; i < 2; ++i) p0[i] = m.bodies[floes[i]].mass_kg * world.state().velocity[floes[i]];
+  for (int k = 0; k < 1500; ++k) {
+    world.step();
+    for (int i = 0; i < 2; ++i) {
+      const StructureReport& sr = world.report().structures[i];
+      impulse[i] += o.time_step_s * sr.ice_load.force;
+      Vec3 parts = Vec3::Zero();
+      for (const Vec3& f : sr.part_force_n) parts += f;
+      EXPECT_LT((parts - sr.ice_load.force).norm(), 1e-9 * (1 + sr.ice_load.force.norm()));
+    }
+    EXPECT_EQ(world.report().ice_load.force, Vec3::Zero());  // the vessel, far off, is touched by nothing
+  }
+  for (int i = 0; i < 2; ++i) {
+    const Vec3 p1 = m.bodies[floes[i]].mass_kg * world.state().velocity[floes[i]];
+    ASSERT_GT((p0[i] - p1).norm(), 0.5 * p0[i].norm()) << i;
+    EXPECT_LT((impulse[i] + (p1 - p0[i])).norm(), 1e-9 * p0[i].norm()) << i;
+    const int b = m.structures[i].body;
+    EXPECT_EQ(world.state().position[b], m.bodies[b].initial_position);
+  }
+}
+
+TEST(Structure, AMooredStructureBesideTheVesselTakesTheCatenarysOffsetUnderASteadyPull) {
+  // As the moored body above, held as a structure beside the vessel: §8.4.1's 1.64 m under 1 MN, its recorded line
+  // tensions those of the spread at its offset.
+  SimulateOptions base = moored_caisson();
+  SimulateOptions o;
+  o.vessel.station_keeping.mode = "fixed";
+  o.vessel.y_m = -300;
+  StructureOptions s = listed("floater", "moored", 0, 0);
+  s.body.station_keeping = base.vessel.station_keeping;
+  s.body.station_keeping.applied_force_n = {1e6, 0};
+  s.body.station_keeping.applied_force_ramp_s = 150;
+  s.body.vcg_m = -2.0;
+  o.structures = {s};
+  const HullModel caisson = floating_caisson(), far = structure("caisson", 10);
+  World world(build_model(FloeField{}, &far, o, {caisson}));
+  double sum = 0;
+  int n = 0;
+  for (int k = 1; k <= 30000; ++k) {
+    world.step();
+    if (k > 20000) sum += world.report().structures[0].station_keeping.offset.x(), ++n;
+  }
+  EXPECT_NEAR(sum / n, 1.64, 0.01);
+  const StationKeeping& sk = world.report().structures[0].station_keeping;
+  const SpreadState sp = spread_at_pose(world.model().structures[0].station.mooring, sk.offset.x(), sk.offset.y(),
+                                        sk.heading_change_rad);
+  ASSERT_EQ(sk.line_tension_n.size(), 12u);
+  for (size_t l = 0; l < 12; ++l) EXPECT_DOUBLE_EQ(sk.line_tension_n[l], sp.lines[l].fairlead_tension_n) << l;
+}
+
 TEST(Structure, ADpBodyReturnsToItsStationWithinItsLimits) {
   // §8.4.2: the caisson held by DP under a steady 0.5 MN pull; P and D alone would leave F / K_p, the integral takes
   // it back to the station. The thrusters never deliver more than their limits.
@@ -224,7 +306,7 @@ TEST(Structure, ADpBodyReturnsToItsStationWithinItsLimits) {
     largest = std::max(largest, std::abs(sk.delivered[2]) / d.max_moment_z_nm);
     if (k * o.time_step_s > 900) late += offset_of(world).x(), ++n;
   }
-  const double kp = world.model().dp.surge.proportional;
+  const double kp = world.model().station.dp.surge.proportional;
   EXPECT_GT(5e5 / kp, 1.0) << "without the integral the offset would be metres";
   EXPECT_LT(std::abs(late / n), 0.02 * 5e5 / kp);
   EXPECT_LE(largest, 1.0);
