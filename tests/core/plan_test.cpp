@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <algorithm>
 #include <fstream>
 
 #include "pipeline/error.h"
@@ -36,5 +37,45 @@ TEST(Plan, CaseFilesMustBeRegularFiles) {
   std::ofstream(dir / "floes.geojson") << "{}";
   std::ofstream(dir / "hull.obj") << "";
   EXPECT_EQ(plan_error({{"floes", {{"file", "floes.geojson"}}}, {"hull", {{"file", "hull.obj"}}}}, dir), "");
+  fs::remove_all(dir);
+}
+
+// A case's structures: each gets a hull stage of its own and its options, with that stage's mesh, in the simulate
+// stage's structures; a structure without a name or hull, or with a hull_file of its own, is named.
+TEST(Plan, EachStructureGetsItsHullStageAndItsSimulateEntry) {
+  const fs::path dir = fs::temp_directory_path() / "floesim_plan_structures";
+  fs::create_directories(dir);
+  std::ofstream(dir / "floes.geojson") << "{}";
+  const nlohmann::json cone = {{"structure", {{"shape", "cone"}}}};
+  nlohmann::json c = {{"floes", {{"file", "floes.geojson"}}},
+                      {"hull", {{"generate", nlohmann::json::object()}}},
+                      {"structures", {{{"name", "pier"}, {"hull", cone}, {"x_m", 50.0},
+                                       {"station_keeping", {{"mode", "fixed"}}}}}}};
+  runner::StageLayout layout;
+  layout.dir = [](const std::string& s, const std::string&) { return fs::path("/run") / s; };
+  layout.config = [](const std::string& s, const std::string&) { return fs::path("/run/config") / (s + ".json"); };
+  const runner::CasePlan p = runner::plan_case(c, "case.json", dir, "/bin", layout);
+  const runner::PlannedStage* hull = nullptr;
+  const runner::PlannedStage* sim = nullptr;
+  for (const runner::PlannedStage& s : p.stages) {
+    if (s.name == "structure-pier") hull = &s;
+    if (s.name == "simulate") sim = &s;
+  }
+  ASSERT_TRUE(hull && sim);
+  EXPECT_EQ(hull->outputs.at(0), fs::path("/run/structure-pier/hull.obj"));
+  const nlohmann::json settings = nlohmann::json::parse(sim->config_text);
+  EXPECT_EQ(settings["structures"][0]["hull_file"], "/run/structure-pier/hull.obj");
+  EXPECT_EQ(settings["structures"][0]["x_m"], 50.0);
+  EXPECT_FALSE(settings["structures"][0].contains("hull"));
+  EXPECT_NE(std::find(sim->inputs.begin(), sim->inputs.end(), hull->outputs[0]), sim->inputs.end());
+
+  c["structures"][0].erase("hull");
+  EXPECT_NE(plan_error(c, dir).find("structures[0] needs \"name\" (a string) and \"hull\""), std::string::npos);
+  c["structures"][0]["hull"] = cone;
+  c["structures"][0]["hull_file"] = "x.obj";
+  EXPECT_NE(plan_error(c, dir).find("structures[0].hull_file is set by the runner"), std::string::npos);
+  c["structures"][0].erase("hull_file");
+  c["structures"][0]["name"] = "a/b";
+  EXPECT_NE(plan_error(c, dir).find("structures[0].name \"a/b\" may hold only"), std::string::npos);
   fs::remove_all(dir);
 }

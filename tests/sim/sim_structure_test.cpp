@@ -383,6 +383,19 @@ TEST(Structure, BadInputIsNamed) {
   j["vessel"]["station_keeping"]["dp"]["max_force_y_n"] = 0;
   expect_error([&] { read_options<SimulateOptions>(j, "case.json"); },
                {"station_keeping.dp.damping_ratio", "station_keeping.dp.max_force_y_n"});
+  // Structures beside the vessel: one driven as a ship, two of one name, one without a mesh or with a bad name, and
+  // meshes that do not match the list.
+  j = options_to_json(drifting_sheet(1.0, 0.2));
+  j["structures"] = Json::array({Json{{"name", "a"}, {"hull_file", "a.obj"}, {"station_keeping", {{"mode", "fixed"}}}},
+                                 Json{{"name", "a"}, {"hull_file", "b.obj"}, {"station_keeping", {{"mode", "fixed"}}}},
+                                 Json{{"name", "c"}, {"hull_file", "c.obj"}}, Json{{"name", "d e"}, {"hull_file", ""},
+                                 {"station_keeping", {{"mode", "dp"}}}}});
+  expect_error([&] { read_options<SimulateOptions>(j, "case.json"); },
+               {"two structures are named \"a\"", "structures[2].station_keeping", "drives a ship",
+                "structures[3].name", "structures[3].hull_file"});
+  SimulateOptions two = drifting_sheet(1.0, 0.2);
+  two.structures = {listed("a", "fixed", 0, 40), listed("b", "fixed", 0, -40)};
+  expect_error([&] { build_model(FloeField{}, &cone, two, {cone}); }, {"1 structure meshes for 2 structures"});
 }
 
 }  // namespace
