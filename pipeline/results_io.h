@@ -43,7 +43,8 @@
 //                                                   for a crushing event the crushed ice cleared
 //   /fracture/child_offset       [E+1]    int64     pieces of event k: child_id[offset[k] .. offset[k+1]-1]
 //   /fracture/child_id           [C]      int32     floe ids of the pieces that became bodies
-//   /structures/NAME/FIELD       [steps x c] float64   the structures beside the vessel (simulate.structures), one
+//   /structures/NAME/FIELD       [steps x c] float64   the structures: the vessel's hull body when it is one (NAME
+//                                                   "vessel") and those beside it (simulate.structures), one
 //                                                   group each, one row per step; the root attribute's "structures"
 //                                                   lists them: name, kind, reference point and each field's columns
 //                                                   (structure_fields below). Earth axes; NAME/hull_vertices_m

@@ -317,6 +317,7 @@ struct SceneRenderer::Impl {
     // The structures beside the vessel: each mesh and where its pose is in the results.
     const nlohmann::json list = r.attributes.value("structures", nlohmann::json::array());
     for (const nlohmann::json& st : list) {
+      if (st.value("body", std::string()) == "vessel") continue;  // the case's hull body: drawn as the hull
       StructureMesh m;
       m.name = st.at("name").get<std::string>();
       const std::vector<double> fv = st.value("run_frame_velocity_mps", std::vector<double>{0, 0, 0});

@@ -359,6 +359,7 @@ struct StructureOptions {
             "letters, digits, '-' and '_'",
             Check<std::string>([](const std::string& n) -> std::string {
               if (n.empty() || n.size() > 64) return "must have 1 to 64 characters";
+              if (n == "vessel") return "\"vessel\" names the vessel's own results group: choose another name";
               for (char c : n)
                 if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_')
                   return "may hold only letters, digits, '-' and '_'";

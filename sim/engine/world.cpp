@@ -351,8 +351,13 @@ void World::stage_relax() {
                                    o.relax_iterations, o.tolerance_mps, &pool_);
   store_impulses(model_, state_, contacts_);
   report_.contacts = static_cast<int>(contacts_.size());
-  report_.vessel_contacts = vessel_ice_load(contacts_, &report_.ice_load_rigid, &report_.ice_load_compliant,
-                                            &report_.ice_load_level_ice);
+  std::vector<Vec3>* parts = nullptr;  // a structure's parts' loads (a ship's are not recorded)
+  if (model_.vessel >= 0 && model_.settings.vessel.station_keeping.held()) {
+    report_.vessel_part_force_n.assign(model_.bodies[model_.vessel].part_count, Vec3::Zero());
+    parts = &report_.vessel_part_force_n;
+  }
+  report_.vessel_contacts = hull_ice_load(contacts_, model_.vessel, &report_.ice_load_rigid,
+                                          &report_.ice_load_compliant, &report_.ice_load_level_ice, parts);
   report_.ice_load = report_.ice_load_rigid;
   report_.ice_load += report_.ice_load_compliant;
   for (size_t s = 0; s < model_.structures.size(); ++s) {
@@ -412,6 +417,7 @@ int World::hull_ice_load(const std::vector<Contact>& contacts, int body, Wrench*
   // law (the seed filters compliant loads over 0.5 s and rigid ones over 20 s, PHYSICS.md §5); and, if asked, the
   // part from level ice tiles (breaking the sheet's edge, against clearing the pieces) and each part's force.
   const double dt = model_.settings.time_step_s;
+  if (body < 0) return 0;  // no vessel (floes alone)
   const int first_part = model_.bodies[body].first_part;
   int n = 0;
   for (const Contact& c : contacts) {

@@ -65,6 +65,7 @@ struct StepReport {
   double thrust_n = 0;
   StationKeeping station_keeping;  // a moored or DP body: its offset, heading change, demanded and delivered force
   std::vector<StructureReport> structures;  // Model::structures, in order
+  std::vector<Vec3> vessel_part_force_n;    // a held vessel's (a structure's): the ice's force on each convex part
 };
 
 class World {

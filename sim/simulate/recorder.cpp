@@ -92,17 +92,26 @@ bool is_structure(const Model& m, size_t b) {
   return static_cast<int>(b) < m.hull_count() && static_cast<int>(b) != m.vessel;
 }
 
-// Each field's columns for structure k (structure_fields order).
-std::vector<size_t> structure_columns(const SimulateOptions& o, size_t k) {
-  std::vector<size_t> cols;
-  for (const StructureField& f : structure_fields()) {
-    const std::string name = f.name;
-    if (name == "quaternion_wxyz") cols.push_back(4);
-    else if (name == "line_tension_n") cols.push_back(o.structures[k].body.station_keeping.lines.size());
-    else if (name == "part_force_n") cols.push_back(0);  // set from the model in attach()
-    else cols.push_back(3);
-  }
-  return cols;
+// A structure recorded under /structures: the case's hull body when it is held (named "vessel"), then each structure
+// beside it (Model::structures, under its own name).
+struct RecordedStructure {
+  std::string name;
+  int body = -1;
+  int index = -1;  // into Model::structures and StepReport::structures; -1: the vessel's hull body
+  const StationKeepingOptions* keeping = nullptr;
+  const Station* station = nullptr;
+  double waterline_width_m = 0;
+};
+
+std::vector<RecordedStructure> recorded_structures(const SimulateOptions& o, const Model& m) {
+  std::vector<RecordedStructure> list;
+  if (m.vessel >= 0 && o.vessel.station_keeping.held())
+    list.push_back({"vessel", m.vessel, -1, &o.vessel.station_keeping, &m.station, m.vessel_info.beam_wl_m});
+  for (size_t k = 0; k < m.structures.size(); ++k)
+    list.push_back({o.structures[k].name, m.structures[k].body, static_cast<int>(k),
+                    &o.structures[k].body.station_keeping, &m.structures[k].station,
+                    m.structures[k].info.beam_wl_m});
+  return list;
 }
 
 // Kinetic energy of the floes and pieces (translation and rotation, without added mass); sleeping and fixed bodies
@@ -196,53 +205,63 @@ void Recorder::add_structures(const Model& m) {
   // The structures' series (kept whole: a checkpoint carries them as it does the frames) and their list.
   nlohmann::json list = nlohmann::json::array();
   c_structures_.clear();
-  for (size_t k = 0; k < m.structures.size(); ++k) {
-    const StructureOptions& so = o_.structures[k];
-    std::vector<size_t> cols = structure_columns(o_, k);
+  for (const RecordedStructure& rs : recorded_structures(o_, m)) {
+    const int parts = m.bodies[rs.body].part_count;
     nlohmann::json columns = nlohmann::json::object();
     std::vector<std::vector<double>*> c;
-    for (size_t i = 0; i < cols.size(); ++i) {
-      const std::string field = structure_fields()[i].name;
-      if (field == "part_force_n") cols[i] = 3 * static_cast<size_t>(m.structures[k].part_count);
-      if (cols[i] == 0) {  // no lines: no field
+    for (const StructureField& f : structure_fields()) {
+      const std::string field = f.name;
+      size_t cols = 3;
+      if (field == "quaternion_wxyz") cols = 4;
+      if (field == "line_tension_n") cols = rs.keeping->lines.size();  // none: no field
+      if (field == "part_force_n") cols = 3 * static_cast<size_t>(parts);
+      if (cols == 0) {
         c.push_back(nullptr);
         continue;
       }
-      columns[field] = cols[i];
-      std::vector<double>& v = r_.structure_series[so.name + "/" + field];
-      v.reserve(static_cast<size_t>(o_.steps()) * cols[i]);
+      columns[field] = cols;
+      std::vector<double>& v = r_.structure_series[rs.name + "/" + field];
+      v.reserve(static_cast<size_t>(o_.steps()) * cols);
       c.push_back(&v);
     }
     c_structures_.push_back(std::move(c));
-    const Station& st = m.structures[k].station;
-    list.push_back({{"name", so.name},
-                    {"kind", so.body.station_keeping.mode},
+    const Station& st = *rs.station;
+    list.push_back({{"name", rs.name},
+                    {"body", rs.index < 0 ? "vessel" : "structure"},
+                    {"kind", rs.keeping->mode},
                     {"reference_point_body_m", {st.reference_point_body.x(), st.reference_point_body.y(),
                                                 st.reference_point_body.z()}},
                     {"station_m", {st.position.x(), st.position.y(), st.position.z()}},
                     {"station_heading_deg", st.heading_rad * 180 / kPi},
-                    {"waterline_width_m", m.structures[k].info.beam_wl_m},
-                    {"parts", m.structures[k].part_count},
+                    {"waterline_width_m", rs.waterline_width_m},
+                    {"parts", parts},
                     {"run_frame_velocity_mps", {m.frame_velocity.x(), m.frame_velocity.y(), m.frame_velocity.z()}},
                     {"columns", columns}});
   }
-  if (!m.structures.empty()) r_.attributes["structures"] = list;
+  if (!list.empty()) r_.attributes["structures"] = list;
 }
 
 void Recorder::record_structures(const World& w) {
   const Model& m = w.model();
   const State& s = w.state();
   const StepReport& rep = w.report();
-  for (size_t k = 0; k < m.structures.size(); ++k) {
-    const int b = m.structures[k].body;
-    const StructureReport& sr = rep.structures[k];
+  size_t at = 0;
+  for (const RecordedStructure& rs : recorded_structures(o_, m)) {
+    const int b = rs.body;
+    // The vessel's hull body reports its loads as the vessel's; a structure beside it in its own report.
+    const StructureReport* sr = rs.index >= 0 ? &rep.structures[rs.index] : nullptr;
+    const Wrench& ice = sr ? sr->ice_load : rep.ice_load;
+    const Wrench& level_ice = sr ? sr->ice_load_level_ice : rep.ice_load_level_ice;
+    const Wrench& water = sr ? sr->hydro_load : rep.hydro_load;
+    const Wrench& keeping = sr ? sr->station_keeping_load : rep.propulsion_load;
+    const StationKeeping& sk = sr ? sr->station_keeping : rep.station_keeping;
+    const std::vector<Vec3>& parts = sr ? sr->part_force_n : rep.vessel_part_force_n;
     const Vec3 x = s.position[b] + s.time_s * m.frame_velocity;  // earth frame
     const Vec3 v = s.velocity[b] + m.frame_velocity;
     const Quat& q = s.orientation[b];
-    const Vec3 ref = s.orientation[b] * m.structures[k].station.reference_point_body;  // from the centre of mass
-    const Vec3 moment = sr.ice_load.torque - ref.cross(sr.ice_load.force);
-    const StationKeeping& sk = sr.station_keeping;
-    std::vector<std::vector<double>*>& c = c_structures_[k];
+    const Vec3 ref = q * rs.station->reference_point_body;  // from the centre of mass
+    const Vec3 moment = ice.torque - ref.cross(ice.force);
+    std::vector<std::vector<double>*>& c = c_structures_[at++];
     size_t i = 0;
     auto put = [&](std::initializer_list<double> row) {
       if (c[i]) c[i]->insert(c[i]->end(), row);
@@ -251,22 +270,23 @@ void Recorder::record_structures(const World& w) {
     put({x.x(), x.y(), x.z()});
     put({q.w(), q.x(), q.y(), q.z()});
     put({v.x(), v.y(), v.z()});
-    put({sr.ice_load.force.x(), sr.ice_load.force.y(), sr.ice_load.force.z()});
+    put({ice.force.x(), ice.force.y(), ice.force.z()});
     put({moment.x(), moment.y(), moment.z()});
-    put({sr.ice_load_level_ice.force.x(), sr.ice_load_level_ice.force.y(), sr.ice_load_level_ice.force.z()});
-    put({sr.hydro_load.force.x(), sr.hydro_load.force.y(), sr.hydro_load.force.z()});
-    put({sr.station_keeping_load.force.x(), sr.station_keeping_load.force.y(), sr.station_keeping_load.force.z()});
+    put({level_ice.force.x(), level_ice.force.y(), level_ice.force.z()});
+    put({water.force.x(), water.force.y(), water.force.z()});
+    put({keeping.force.x(), keeping.force.y(), keeping.force.z()});
     put({sk.offset.x(), sk.offset.y(), sk.heading_change_rad});
     put({sk.demanded[0], sk.demanded[1], sk.demanded[2]});
     put({sk.delivered[0], sk.delivered[1], sk.delivered[2]});
     if (c[i]) {  // line tensions (a moored structure's, every step)
-      FLOESIM_REQUIRE(sk.line_tension_n.size() * 1 == o_.structures[k].body.station_keeping.lines.size(),
-                      "internal: structure ", o_.structures[k].name, " reported ", sk.line_tension_n.size(),
-                      " line tensions");
+      FLOESIM_REQUIRE(sk.line_tension_n.size() == rs.keeping->lines.size(), "internal: structure ", rs.name,
+                      " reported ", sk.line_tension_n.size(), " line tensions");
       c[i]->insert(c[i]->end(), sk.line_tension_n.begin(), sk.line_tension_n.end());
     }
     ++i;
-    for (const Vec3& f : sr.part_force_n) c[i]->insert(c[i]->end(), {f.x(), f.y(), f.z()});
+    FLOESIM_REQUIRE(parts.size() == static_cast<size_t>(m.bodies[b].part_count), "internal: structure ", rs.name,
+                    " reported the forces of ", parts.size(), " parts");
+    for (const Vec3& f : parts) c[i]->insert(c[i]->end(), {f.x(), f.y(), f.z()});
   }
 }
 
@@ -352,10 +372,10 @@ void Recorder::finish(const World& w) {
   const TriMesh& hull = wm.bodies[wm.vessel].buoyancy_mesh;
   for (const Vec3& p : hull.vertices) r.hull_vertices_m.insert(r.hull_vertices_m.end(), {p.x(), p.y(), p.z()});
   for (const auto& t : hull.triangles) r.hull_triangles.insert(r.hull_triangles.end(), {t[0], t[1], t[2]});
-  for (size_t k = 0; k < wm.structures.size(); ++k) {
-    const TriMesh& mesh = wm.bodies[wm.structures[k].body].buoyancy_mesh;
-    std::vector<double>& v = r.structure_hull_vertices_m[o_.structures[k].name];
-    std::vector<int32_t>& t = r.structure_hull_triangles[o_.structures[k].name];
+  for (const RecordedStructure& rs : recorded_structures(o_, wm)) {
+    const TriMesh& mesh = wm.bodies[rs.body].buoyancy_mesh;
+    std::vector<double>& v = r.structure_hull_vertices_m[rs.name];
+    std::vector<int32_t>& t = r.structure_hull_triangles[rs.name];
     v.clear();
     t.clear();
     for (const Vec3& p : mesh.vertices) v.insert(v.end(), {p.x(), p.y(), p.z()});

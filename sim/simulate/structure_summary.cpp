@@ -202,6 +202,29 @@ nlohmann::json cycles_json(const std::vector<double>& f, const SimulateOptions& 
   return j;
 }
 
+// Each convex part's share of the horizontal load (x along `heading_rad`, into the ice) from a structure's
+// part_force_n series: its mean, its mean share of the whole and its largest filtered value.
+nlohmann::json parts_json(const std::vector<double>& parts, int count, double heading_rad, size_t first, size_t steps,
+                          size_t nw) {
+  const double c = std::cos(heading_rad), s = std::sin(heading_rad);
+  const size_t n = 3 * static_cast<size_t>(count);
+  double total = 0;
+  std::vector<Stats> mean(count);
+  std::vector<std::vector<double>> h(count);
+  for (int p = 0; p < count; ++p)
+    for (size_t i = first; i < steps; ++i) h[p].push_back(-(c * parts[n * i + 3 * p] + s * parts[n * i + 3 * p + 1]));
+  for (int p = 0; p < count; ++p) total += stats_of(h[p]).mean;
+  nlohmann::json list = nlohmann::json::array();
+  for (int p = 0; p < count; ++p) {
+    const Stats sh = stats_of(h[p]), sf = stats_of(moving_average_full_windows(h[p], nw));
+    list.push_back({{"part", p},
+                    {"horizontal_load_mean_N", sh.mean},
+                    {"share_of_mean", total != 0 ? sh.mean / total : 0.0},
+                    {"horizontal_load_filtered_max_N", sf.max}});
+  }
+  return list;
+}
+
 // The steady part's first step: the first at or after steady_start_s.
 size_t steady_first(const SimulateOptions& o, const SeriesSource& series) {
   const std::vector<double> t = series.get("time_s");
@@ -258,21 +281,8 @@ nlohmann::json listed_structure_summary(const SimulateOptions& o, const Model& m
                      {"load_filtered_N", stats_json(stats_of(sheet_f))},
                      {"cycles", cycles_json(sheet_f, o, nw)}};
   }
-  // 2. Each part's share: the mean of its horizontal load along x and the largest filtered.
-  {
-    const std::vector<double>& parts = field("part_force_n");
-    nlohmann::json list = nlohmann::json::array();
-    for (int p = 0; p < sb.part_count; ++p) {
-      std::vector<double> h;
-      for (size_t i = first; i < steps; ++i) {
-        const size_t at = (3 * static_cast<size_t>(sb.part_count)) * i + 3 * p;
-        h.push_back(-(c * parts[at] + s * parts[at + 1]));
-      }
-      const Stats sh = stats_of(h), sf = stats_of(moving_average_full_windows(h, nw));
-      list.push_back({{"part", p}, {"horizontal_load_mean_N", sh.mean}, {"horizontal_load_filtered_max_N", sf.max}});
-    }
-    j["parts"] = list;
-  }
+  // 2. Each part's share.
+  j["parts"] = parts_json(field("part_force_n"), sb.part_count, a, first, steps, nw);
   // 3. The rubble: the highest ice within the waterline width of its axis, per stored frame.
   const std::vector<double>& pos = field("position_m");
   const std::vector<double>& quat = field("quaternion_wxyz");
@@ -427,6 +437,10 @@ nlohmann::json structure_summary(const SimulateOptions& o, const Model& model, c
   }));
   j["rubble_height_m"] = {{"mean", hr.mean}, {"max", hr.max}, {"within_m_of_axis", radius},
                           {"what", "the highest ice above the water line near the structure, per stored frame"}};
+  // 5. Each convex part's share (the frustum and the neck of a cone), from its recorded loads.
+  if (const auto it = r.structure_series.find("vessel/part_force_n"); it != r.structure_series.end())
+    j["parts"] = parts_json(it->second, model.bodies[model.vessel].part_count, model.station.heading_rad, first, steps,
+                            nw);
   if (o.vessel.station_keeping.moored() || o.vessel.station_keeping.dp_held())
     j["station_keeping"] = station_keeping_summary(o, model, series, first);
   return j;

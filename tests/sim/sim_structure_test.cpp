@@ -116,9 +116,16 @@ TEST(Structure, AnUpwardBreakingConeBendsTheSheetUpAndIsPushedDown) {
   const HullModel cone = structure("cone", 10);
   World world(build_model(FloeField{}, &cone, o));
   double fz = 0;
+  const int parts = world.model().bodies[0].part_count;
   for (int k = 0; k < 3000; ++k) {
     world.step();
-    fz += world.report().ice_load.force.z();
+    const StepReport& rep = world.report();
+    fz += rep.ice_load.force.z();
+    // Its parts' loads add up to its load.
+    ASSERT_EQ(rep.vessel_part_force_n.size(), static_cast<size_t>(parts));
+    Vec3 sum = Vec3::Zero();
+    for (const Vec3& f : rep.vessel_part_force_n) sum += f;
+    EXPECT_LT((sum - rep.ice_load.force).norm(), 1e-9 * (1 + rep.ice_load.force.norm()));
   }
   int bending = 0;
   for (const FractureEvent& e : world.fracture_events())
