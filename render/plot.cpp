@@ -9,6 +9,7 @@
 #include "pipeline/atomic_file.h"
 #include "pipeline/csv.h"
 #include "pipeline/error.h"
+#include "pipeline/geometry2d.h"
 #include "pipeline/provenance.h"
 #include "render/gnuplot.h"
 #include "pipeline/signal.h"
@@ -393,11 +394,92 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const f
   return s;
 }
 
+std::vector<std::string> plot_structure_loads(const fs::path& results, const fs::path& config,
+                                              const fs::path& out_dir) {
+  return plot_structure_loads(read_results(results, /*with_states=*/false), read_plot_options(config), out_dir);
+}
+
 SurgeLoadSummary plot_surge_load(const fs::path& results, const fs::path& config, const fs::path& out_dir) {
   const PlotOptions o = read_plot_options(config);
   const Results r = read_results(results, /*with_states=*/false);
   const auto prov = make_provenance("floesim-plot", {{"results", results}, {"config", config}}, options_to_json(o));
   return plot_surge_load(r, o, out_dir, prov, results.string());
+}
+
+std::vector<std::string> plot_structure_loads(const Results& r, const PlotOptions& o, const fs::path& out_dir) {
+  std::vector<std::string> written;
+  const nlohmann::json list = r.attributes.value("structures", nlohmann::json::array());
+  if (list.empty()) return written;
+  const std::vector<double>& t = r.get("time_s");
+  FLOESIM_REQUIRE(t.size() >= 2, "the results hold ", t.size(), " steps; at least 2 are needed for a plot");
+  const double dt = t[1] - t[0];
+  const size_t nw = window_samples(0.5, dt);  // the compliant contacts' filter (PHYSICS.md 5)
+  ensure_directory(out_dir);
+  for (const nlohmann::json& st : list) {
+    const std::string name = st.at("name").get<std::string>();
+    const auto it = r.structure_series.find(name + "/ice_force_n");
+    FLOESIM_REQUIRE(it != r.structure_series.end() && it->second.size() == 3 * t.size(), "the results' structure ",
+                    name, " has no ice_force_n for every step");
+    // 1. The horizontal load along the structure's heading at its station (the ice's action along the drift on a
+    // structure facing it) and the vertical load, raw and through the 0.5 s centred moving average.
+    const double a = st.value("station_heading_deg", 0.0) * kPi / 180, c = std::cos(a), sn = std::sin(a);
+    std::vector<double> h(t.size()), v(t.size());
+    double typical = 0;
+    for (size_t i = 0; i < t.size(); ++i) {
+      h[i] = -(c * it->second[3 * i] + sn * it->second[3 * i + 1]);
+      v[i] = it->second[3 * i + 2];
+      typical = std::max({typical, std::abs(h[i]), std::abs(v[i])});
+    }
+    const ForceUnit unit = force_unit_for(typical);
+    for (double& x : h) x /= unit.newtons;
+    for (double& x : v) x /= unit.newtons;
+    // Only the samples whose whole window lies in the run (as the surge load's plot).
+    const auto [f0, f1] = full_window_range(t.size(), nw);
+    const std::vector<double> hc = moving_average_centred(h, nw), vc = moving_average_centred(v, nw);
+    const std::vector<double> hf(hc.begin() + static_cast<long>(f0), hc.begin() + static_cast<long>(f1));
+    const std::vector<double> vf(vc.begin() + static_cast<long>(f0), vc.begin() + static_cast<long>(f1));
+    // 2. Data and script; gnuplot draws both images.
+    const std::string stem = "structure_" + name + "_load";
+    AtomicFile png(out_dir / (stem + ".png")), svg(out_dir / (stem + ".svg"));
+    AtomicFile data(out_dir / (stem + ".plot-data.txt")), script(out_dir / (stem + ".plot.gp")),
+        log(out_dir / (stem + ".gnuplot.log"));
+    {
+      std::ostringstream os;
+      write_decimated(os, t, h, static_cast<size_t>(o.width_px));
+      os << "\n\n";
+      const std::vector<double> tf(t.begin() + static_cast<long>(f0), t.begin() + static_cast<long>(f1));
+      write_decimated(os, tf, hf, static_cast<size_t>(o.width_px));
+      os << "\n\n";
+      write_decimated(os, tf, vf, static_cast<size_t>(o.width_px));
+      write_file_checked(data.tmp(), os.str(), data.path());
+    }
+    {
+      std::ostringstream gp;
+      gp << "set encoding utf8\n"
+         << "set terminal pngcairo size " << o.width_px << "," << o.height_px
+         << " enhanced font 'DejaVu Sans,11' linewidth 1.0\n"
+         << "set output " << quoted(png.tmp().string()) << "\n"
+         << "set title " << quoted("Ice load on " + name + " (" + st.value("kind", std::string()) + ")")
+         << " noenhanced font ',14'\n"
+         << "set xlabel 'Time (s)'\nset ylabel 'Load (" << unit.name << ")'\n"
+         << "set border lc rgb '#404040'\nset grid xtics ytics lc rgb '#d9d9d9' lw 1 dt 1\n"
+         << "set key outside below center horizontal samplen 2.5 width 2\n"
+         << "set xrange [" << fmt("%.9g", t.front()) << ":" << fmt("%.9g", t.back()) << "]\n"
+         << "plot " << quoted(data.tmp().string())
+         << " index 0 using 1:2 with lines lc rgb '#a6c8e6' lw 1 title 'horizontal, each step', \\\n"
+         << "  '' index 1 using 1:2 with lines lc rgb '#2f7fc1' lw 2 title 'horizontal, 0.5 s moving average', \\\n"
+         << "  '' index 2 using 1:2 with lines lc rgb '#d1232a' lw 1.5 title 'vertical (up), 0.5 s moving average'\n"
+         << "set terminal svg size " << o.width_px << "," << o.height_px
+         << " dynamic enhanced font 'DejaVu Sans,11' background rgb 'white'\n"
+         << "set output " << quoted(svg.tmp().string()) << "\nreplot\nunset output\n";
+      write_file_checked(script.tmp(), gp.str(), script.path());
+    }
+    run_gnuplot(script.tmp(), log.tmp(), {png.tmp(), svg.tmp()}, png.path().string());
+    png.commit();
+    svg.commit();
+    written.push_back(stem);
+  }
+  return written;
 }
 
 IdentifiedPlotSummary plot_identified_load(const fs::path& identify_dir, const PlotOptions& o,

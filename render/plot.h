@@ -71,6 +71,16 @@ SurgeLoadSummary plot_surge_load(const Results& r, const PlotOptions& o, const s
 SurgeLoadSummary plot_surge_load(const std::filesystem::path& results, const std::filesystem::path& config,
                                  const std::filesystem::path& out_dir);
 
+// Each structure's ice load (results /structures: the vessel's hull body when it is a structure, and those beside
+// it): the horizontal load along its heading at its station, raw and through the 0.5 s centred moving average of the
+// compliant contacts (PHYSICS.md 5), and the vertical load through the same, against time. Writes
+// DIR/structure_NAME_load.{png,svg}, each only when complete; returns the stems written.
+std::vector<std::string> plot_structure_loads(const Results& r, const PlotOptions& o,
+                                              const std::filesystem::path& out_dir);
+std::vector<std::string> plot_structure_loads(const std::filesystem::path& results,
+                                              const std::filesystem::path& config,
+                                              const std::filesystem::path& out_dir);
+
 // The identified ice load of floesim-identify (its folder: identified.csv and identified.json) against time at its
 // output rate: the identified resistance and, when the measured data carried a known load (a simulated ship's), that
 // load averaged over the same intervals; each with its mean over the identification's mean window. The comparison

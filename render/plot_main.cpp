@@ -32,6 +32,8 @@ int main(int argc, char** argv) {
               << "resistance " << floesim::load_text(1000.0 * s.mean_kN, s.display_unit) << " over t >= " << s.steady_start_s << " s (" << s.contact_model
               << " contacts, " << s.window_s << " s moving average); " << s.fracture_events << " fracture events, "
               << s.vessel_splitting_events + s.vessel_bending_radial_events << " at the vessel\n";
+    for (const std::string& stem : floesim::render::plot_structure_loads(results, config, out))
+      std::cout << "wrote " << out << "/" << stem << ".{png,svg}\n";
     if (!identified.empty()) {
       const auto p = floesim::render::plot_identified_load(identified, floesim::render::read_plot_options(config),
                                                            out);

@@ -509,22 +509,28 @@ void fracture_section(std::ostream& body, const Json& summary) {
 }
 
 // 3. Section "Structure" for a structure as the case's hull body (summary.json "structure") and one per structure
-// beside the vessel ("structures"): its loads raw and filtered, their cycles and period, the rubble on it, how it is
-// held.
-void structure_section(std::ostream& body, const Json& summary) {
-  auto one = [&](const Json& st, const std::string& title, const std::string& id) {
-    body << "<h2>" << html_escape(title) << "</h2>\n<p>The ice's action on the structure, along the ice's drift "
+// beside the vessel ("structures"): its load plot, its loads raw and filtered, their cycles and period, the rubble on
+// it, how it is held.
+void structure_section(std::ostream& body, const fs::path& run_dir, const Json& summary, Page& pg) {
+  auto one = [&](const Json& st, const std::string& title, const std::string& id, const std::string& group) {
+    body << "<h2>" << html_escape(title) << "</h2>\n";
+    const std::string plot = "plots/structure_" + group + "_load.png";
+    if (pg.have(plot, "structure load plot"))
+      body << "<figure>" << pg.img(run_dir / plot, "plot", "ice load on " + group)
+           << "<figcaption>The ice's horizontal load along the structure's heading and its vertical load, each step "
+              "and through the 0.5 s moving average.</figcaption></figure>\n";
+    body << "<p>The ice's action on the structure, along the ice's drift "
             "(horizontal), across it (transverse) and vertical, in N, and the overturning moment about the "
             "structure's axis at the water line, in N m; filtered: "
          << html_escape(st.value("filter", Json::object()).value("kind", std::string())) << " over "
          << scalar_text(st.value("filter", Json::object()).value("window_s", Json())) << " s.</p>\n"
          << "<table id=\"" << id << "\">\n" << nested_rows(st) << "</table>\n";
   };
-  if (const Json* st = find(summary, {"structure"})) one(*st, "Structure", "structure");
+  if (const Json* st = find(summary, {"structure"})) one(*st, "Structure", "structure", "vessel");
   if (const Json* list = find(summary, {"structures"}); list && list->is_array())
     for (size_t k = 0; k < list->size(); ++k) {
       const std::string name = (*list)[k].value("name", "structure " + std::to_string(k));
-      one((*list)[k], "Structure " + name, "structure-" + std::to_string(k));
+      one((*list)[k], "Structure " + name, "structure-" + std::to_string(k), name);
     }
 }
 
@@ -597,7 +603,7 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
   identified_section(body, run_dir, pg, rs);
   ice_field_section(body, run_dir, pg);
   hull_section(body, run_dir, summary, pg);
-  structure_section(body, summary);
+  structure_section(body, run_dir, summary, pg);
   fracture_section(body, summary);
   video_section(body, run_dir, o, pg, rs);
   settings_section(body, run_dir, summary, pg);

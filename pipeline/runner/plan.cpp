@@ -292,6 +292,15 @@ class CasePlanner {
     Json p = section("plot");
     std::vector<fs::path> inputs = {plan_.results};
     std::vector<std::string> outputs = {"surge_ice_load.png", "surge_ice_load.svg", "fracture_events.csv"};
+    // Each structure's load plot: the vessel's hull body when it is one ("vessel"), and the structures beside it.
+    std::vector<std::string> structures;
+    const Json sim = section("simulate");
+    if (sim.contains("vessel") && sim["vessel"].is_object() && sim["vessel"].contains("station_keeping") &&
+        sim["vessel"]["station_keeping"].is_object() &&
+        sim["vessel"]["station_keeping"].value("mode", std::string("propulsion")) != "propulsion")
+      structures.push_back("vessel");
+    for (const Json& e : structures_) structures.push_back(e["name"].get<std::string>());
+    for (const std::string& name : structures) outputs.push_back("structure_" + name + "_load.png");
     if (!identify_dir_.empty()) {
       inputs.push_back(identify_dir_ / "identified.csv");
       inputs.push_back(identify_dir_ / "identified.json");
@@ -310,6 +319,9 @@ class CasePlanner {
     plan_.artefacts.push_back({"plot", "plots/surge_ice_load.svg", "the same (SVG)"});
     plan_.artefacts.push_back(
         {"plot", "plots/fracture_events.csv", "every fracture event: time, mode, floe, force, children"});
+    for (const std::string& name : structures)
+      plan_.artefacts.push_back({"plot", "plots/structure_" + name + "_load.png",
+                                 "the ice's horizontal and vertical load on " + name + ", raw and filtered (PNG)"});
   }
 
   // 7. The report: one self-contained page over the run folder (only a run's: it reads the folder's layout). It
