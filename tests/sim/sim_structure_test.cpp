@@ -13,6 +13,7 @@
 #include "pipeline/error.h"
 #include "pipeline/options.h"
 #include "pipeline/results_io.h"
+#include "sim/simulate/simulate.h"
 #include "sim_fixtures.h"
 
 namespace floesim::sim {
@@ -343,6 +344,36 @@ TEST(Structure, ADpWorldSavedAndRestoredStepsOnBitForBit) {
       ASSERT_EQ(a.report().station_keeping.delivered[i], b->report().station_keeping.delivered[i]) << k;
   }
   EXPECT_EQ(a.state().position[0], b->state().position[0]);
+}
+
+TEST(Structure, ARunWithAStructureBesideTheVesselResumesToTheSameBits) {
+  // A DP caisson beside the vessel pulled by a tug: its controller's memory and its series carry over a checkpoint,
+  // so a run resumed from it records exactly what the whole run did.
+  SimulateOptions o;
+  o.vessel.station_keeping.mode = "fixed";
+  o.vessel.y_m = -300;
+  o.duration_s = 1.0;
+  o.output_interval_s = 0.1;
+  o.checkpoint_interval_s = 0.5;
+  StructureOptions s = listed("tugged", "dp", 0, 0);
+  s.body.vcg_m = -2.0;
+  s.body.station_keeping.applied_force_n = {3e5, 2e5};
+  o.structures = {s};
+  const HullModel caisson = floating_caisson(), far = structure("caisson", 10);
+  const Model model = build_model(FloeField{}, &far, o, {caisson});
+  const std::filesystem::path dir = testing::temp_dir("structure_resume") / "checkpoint";
+  CheckpointPlan plan{dir, {{"program", "sim_structure_test"}}, false};
+  RunStats stats;
+  const Results whole = simulate(o, model, stats, nullptr, &plan);
+  ASSERT_EQ(stats.checkpoints, 1);  // at 0.5 s
+  plan.resume = true;
+  const Results resumed = simulate(o, model, stats, nullptr, &plan);
+  EXPECT_EQ(stats.resumed_at_step, 50);
+  ASSERT_EQ(whole.structure_series.count("tugged/station_keeping_delivered"), 1u);
+  EXPECT_EQ(whole.structure_series.at("tugged/offset").size(), 3u * 100);
+  EXPECT_EQ(resumed.structure_series, whole.structure_series);
+  EXPECT_EQ(resumed.attributes["structures"], whole.attributes["structures"]);
+  std::filesystem::remove_all(dir.parent_path());
 }
 
 TEST(Structure, IceDriftingUnderStillAirRestsUntilTheStructureComes) {
