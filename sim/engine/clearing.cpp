@@ -153,7 +153,7 @@ std::vector<FractureCut> find_clearings(const Model& model, const State& state, 
   std::vector<FractureCut> cuts;
   std::set<int> cut_tiles;  // a tile two structures crush in one step is cleared by the first
   for (int s = 0; s < model.hull_count(); ++s)
-    if (model.bodies[s].kinematic) clear_for(model, state, contacts, s, cut_tiles, cuts);
+    if (model.bodies[s].clears_ice) clear_for(model, state, contacts, s, cut_tiles, cuts);
   return cuts;
 }
 

@@ -489,6 +489,15 @@ Wrench station_keeping_force(const Model& m, const HullRef& h, const BodyKinemat
     out->delivered[2] = out->demanded[2] = sp.moment_z_nm;
     force += Vec3(c0 * sp.force_x_n - s0 * sp.force_y_n, s0 * sp.force_x_n + c0 * sp.force_y_n, 0);
     moment_z = sp.moment_z_nm;
+  } else if (sk.compliant_held()) {
+    // The first mode's spring and damper on the horizontal offset and velocity over the earth; in the station's
+    // axes as the mooring's pull.
+    const Vec3 v_earth = k.v + m.frame_velocity;
+    const Vec2 f = -st.spring_npm * offset - st.damper_nspm * v_earth.head<2>();
+    const double c0 = std::cos(st.heading_rad), s0 = std::sin(st.heading_rad);
+    out->delivered[0] = out->demanded[0] = c0 * f.x() + s0 * f.y();
+    out->delivered[1] = out->demanded[1] = -s0 * f.x() + c0 * f.y();
+    force += Vec3(f.x(), f.y(), 0);
   } else if (sk.dp_held()) {
     DpController dp(st.dp, st.position.x(), st.position.y(), st.heading_rad, st.position.x(), st.position.y(),
                     st.heading_rad);

@@ -814,8 +814,11 @@ std::vector<Polygon> add_hull(const HullModel& hull, const VesselOptions& vo, co
   const Submerged sub = floating_particulars(hull, fl, vo, o, vp);
   const Vec3 com = vp.centre_of_mass_hull;  // hull frame
   Body b = vessel_body(fl.mass, vp, vo, id, o);
-  // A fixed structure stands where the hull frame puts it (its waterline at z = 0, not floated to its weight).
-  place_hull(b, index, hull, com, vo.station_keeping.fixed() ? 0.0 : fl.dz, vo, model);
+  // A fixed or compliant structure stands where the hull frame puts it (its waterline at z = 0, not floated to its
+  // weight).
+  const bool founded = vo.station_keeping.fixed() || vo.station_keeping.compliant_held();
+  place_hull(b, index, hull, com, founded ? 0.0 : fl.dz, vo, model);
+  b.clears_ice = founded;
   // A structure's station: its reference point (the hull frame's origin) and heading at the start.
   st.reference_point_body = -com;
   st.position = b.initial_position + b.initial_orientation * st.reference_point_body;
@@ -827,6 +830,23 @@ std::vector<Polygon> add_hull(const HullModel& hull, const VesselOptions& vo, co
     b.inv_inertia.setZero();
     b.inv_mass_added.setZero();
     b.inv_inertia_added.setZero();
+    model.bodies.push_back(std::move(b));
+    return vessel_footprint(hull, model.bodies[index], com, floes, o);
+  }
+  if (vo.station_keeping.compliant_held()) {
+    // Its first mode: the modal mass on a horizontal spring and damper; it neither heaves nor turns, and the water's
+    // buoyancy and drag on it are in what holds it (its foundation), not modelled apart.
+    const CompliantOptions& c = vo.station_keeping.compliant;
+    const double m = c.modal_mass_kg, wn = 2 * kPi * c.natural_frequency_hz;
+    b.mass_kg = m;
+    b.inv_mass = 1 / m;
+    b.added_mass.setZero();
+    b.added_inertia.setZero();
+    b.inv_mass_added = Vec3(1 / m, 1 / m, 0);
+    b.inv_inertia.setZero();
+    b.inv_inertia_added.setZero();
+    st.spring_npm = m * wn * wn;
+    st.damper_nspm = 2 * c.damping_ratio * m * wn;
     model.bodies.push_back(std::move(b));
     return vessel_footprint(hull, model.bodies[index], com, floes, o);
   }

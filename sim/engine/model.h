@@ -110,6 +110,9 @@ struct Body {
   // the drift in the ice's frame) and nothing moves it: inverse masses 0, no forces, always awake (it touches the
   // ice it reaches); its contact impulses are the load it carries.
   bool kinematic = false;
+  // A structure whose crushed ice is cleared from the level ice it presses into (sim/engine/clearing.h): a fixed or a
+  // compliant (bottom-founded) one.
+  bool clears_ice = false;
 };
 
 // What the vessel model needs of the hull, computed from the mesh at the design waterline (z = 0).
@@ -143,6 +146,7 @@ struct Station {
   double heading_rad = 0;
   std::vector<MooringLeg> mooring;
   DpControllerSettings dp;  // a DP body's controller: gains from its mass and added mass, limits, observer
+  double spring_npm = 0, damper_nspm = 0;  // a compliant body's first mode: k = m w_n^2, c = 2 zeta m w_n
 };
 
 // A structure beside the vessel (settings.structures[k]): its body, what the hull model gives it and its station.

@@ -211,12 +211,29 @@ struct DpOptions {
 
 // How the hull body is held (issue #34). A ship is driven by its propulsion; a structure is "fixed" (it does not move
 // in the earth frame: in a run with drift, in the ice's frame it moves at minus the drift; kinematic, infinite
-// mass), "moored" (it floats, held by a spread of catenary mooring lines, §8.4.1) or "dp" (it floats, held by a
-// dynamic-positioning controller, §8.4.2). The station is where the body starts.
+// mass), "moored" (it floats, held by a spread of catenary mooring lines, §8.4.1), "dp" (it floats, held by a
+// dynamic-positioning controller, §8.4.2) or "compliant" (bottom-founded, its first mode a horizontal spring and
+// damper, §8.3). The station is where the body starts.
+// A compliant structure's first mode (PHYSICS.md 8.3): a rigid body of the modal mass on a horizontal spring and damper
+// about its station, k = m (2 pi f_n)^2, c = 2 zeta m 2 pi f_n; it neither floats nor turns nor heaves.
+struct CompliantOptions {
+  double modal_mass_kg = 1e6;
+  double natural_frequency_hz = 0.33;
+  double damping_ratio = 0.02;
+  template <class V>
+  void visit(V& v) {
+    v.field("modal_mass_kg", modal_mass_kg, "kg", "the first mode's modal mass", positive());
+    v.field("natural_frequency_hz", natural_frequency_hz, "Hz", "the first mode's natural frequency f_n",
+            in_range(0.01, 10));
+    v.field("damping_ratio", damping_ratio, "-", "the first mode's damping, fraction of critical", in_range(0, 1));
+  }
+};
+
 struct StationKeepingOptions {
-  std::string mode = "propulsion";  // propulsion | fixed | moored | dp
+  std::string mode = "propulsion";  // propulsion | fixed | moored | dp | compliant
   std::vector<MooringLineOptions> lines;       // moored
   DpOptions dp;
+  CompliantOptions compliant;
   std::vector<double> applied_force_n = {0, 0};  // moored, dp: a steady pull, earth frame
   double applied_force_ramp_s = 0;               // the pull grows linearly over this time (0: at once)
   template <class V>
@@ -225,13 +242,16 @@ struct StationKeepingOptions {
             "propulsion (a ship, driven by vessel.propulsion and steered by vessel.autopilot), fixed (a structure "
             "that does not move in the earth frame: a bridge pier, a lighthouse, a platform on the seabed), moored "
             "(a floating structure held by the mooring lines of station_keeping.lines) or dp (held by the "
-            "dynamic-positioning controller of station_keeping.dp); for all but propulsion the vessel's propulsion, "
-            "autopilot and initial speed do not apply, and the station is where the body starts",
-            one_of({"propulsion", "fixed", "moored", "dp"}));
+            "dynamic-positioning controller of station_keeping.dp) or compliant (a bottom-founded structure whose "
+            "first mode sways: on the horizontal spring and damper of station_keeping.compliant); for all but "
+            "propulsion the vessel's propulsion, autopilot and initial speed do not apply, and the station is where "
+            "the body starts",
+            one_of({"propulsion", "fixed", "moored", "dp", "compliant"}));
     v.list("lines", lines,
            "moored: the mooring lines, each a catenary with a grounded part (PHYSICS.md 8.4.1) from its fairlead on "
            "the body to its anchor on the seabed, placed by its azimuth and pretension at the station");
     v.section("dp", dp, "dp: the dynamic-positioning controller");
+    v.section("compliant", compliant, "compliant: the structure's first mode, a horizontal spring and damper");
     v.field("applied_force_n", applied_force_n, "N",
             "moored, dp: a steady external pull [x, y] on the body's reference point, earth frame (a tug, or a "
             "pull test of the mooring)",
@@ -247,6 +267,7 @@ struct StationKeepingOptions {
       v.problem("applied_force_n", "acts only on a moored or dp body");
   }
   bool fixed() const { return mode == "fixed"; }
+  bool compliant_held() const { return mode == "compliant"; }
   bool moored() const { return mode == "moored"; }
   bool dp_held() const { return mode == "dp"; }
   bool held() const { return mode != "propulsion"; }  // a structure: fixed, moored or dp
@@ -502,6 +523,12 @@ struct ContactOptions {
   double pressure_area_exponent = 0.0;      // e_x of p_c(A) = sigma_c (A / 1 m^2)^e_x; 0: constant pressure sigma_c
   double area_gradient_step_m = 0.005;      // smallest step of the secant dA/d(delta) = (A(delta + step) - A) / step
   double crushing_damping_ratio = 0.0;      // zeta of c_n = 2 zeta sqrt(m_eff K_t) added to the crushing force
+  // The crushing pressure against a structure with the relative speed (PHYSICS.md 8.3): "none" (p_c(A) at any
+  // speed) or "maattanen" (p_c(A) times Maattanen's strength over its value at rest, sigma(sigma_dot) / 2 MPa, with
+  // sigma_dot = v_n 8 sigma_ref / (pi w_d), w_d = min(w, 2 h): up to 1.5 on the rising branch, down to 0.5 above it,
+  // a negative damping between v_n = 0.104 and 0.474 m/s for w_d = 2 m and sigma_ref = 2.2 MPa).
+  std::string crushing_speed_law = "none";
+  double maattanen_reference_pa = 2.2e6;    // sigma_ref of the stress rate
   template <class V>
   void visit(V& v) {
     v.field("ice_structure", ice_structure, "-",
@@ -520,6 +547,14 @@ struct ContactOptions {
     v.field("crushing_damping_ratio", crushing_damping_ratio, "-",
             "damping c_n = 2 zeta sqrt(m_eff K_t) of crushing contacts, fraction of critical (0: pure crushing)",
             in_range(0, 2));
+    v.field("crushing_speed_law", crushing_speed_law, "-",
+            "the ice's crushing pressure against a structure with the speed the ice closes on it: none, or "
+            "maattanen (PHYSICS.md 8.3: p_c(A) x sigma(sigma_dot) / sigma(0), the stress rate sigma_dot = v_n x 8 "
+            "sigma_ref / (pi w_d), w_d = min(contact width, 2 h); a falling branch, the negative damping of "
+            "frequency lock-in)",
+            one_of({"none", "maattanen"}));
+    v.field("maattanen_reference_pa", maattanen_reference_pa, "Pa", "sigma_ref of Maattanen's stress rate",
+            positive());
   }
 };
 

@@ -34,6 +34,21 @@ bool same_key(const CachedContact& c, const Contact& k) {
   return c.body_a == k.body_a && c.part_a == k.part_a && c.body_b == k.body_b && c.part_b == k.part_b;
 }
 
+}  // namespace
+
+double maattanen_strength_ratio(double closing_mps, double width_m, double thickness_m, double reference_pa) {
+  // Maattanen (1998) as IceFloe codes it (PHYSICS.md 8.3): sigma_dot = v 8 sigma_ref / (pi w_d) in MPa/s, w_d =
+  // min(w, 2 h), sigma(sigma_dot) a quartic in MPa on 0 .. 1.3287 MPa/s and the brittle plateau above; over its value
+  // at rest, 2.00 MPa.
+  const double wd = std::max(std::min(width_m, 2 * thickness_m), 1e-6);
+  constexpr double kBrittle = 1.3287;
+  const double rate = std::min(std::max(closing_mps, 0.0) * 8 * (reference_pa / 1e6) / (kPi * wd), kBrittle);
+  const double sigma = 2.00 + rate * (7.80 + rate * (-18.57 + rate * (13.00 - 2.91 * rate)));
+  return sigma / 2.00;
+}
+
+namespace {
+
 // The pressure-area law p_c(A) = sigma_c (A / 1 m^2)^e_x (PHYSICS.md §1.8(a)); A = 0 carries no pressure.
 double crushing_pressure(const EngineSettings& o, double area) {
   const double e = o.contact.pressure_area_exponent;
@@ -48,7 +63,11 @@ double crushing_pressure(const EngineSettings& o, double area) {
 // deepened by the step the collision stage measured, and the gradient K_t = dF/d(delta) as the secant between
 // them (for e_x = 0 and a wedge: exactly 2 sigma_c h tan(phi)). Returns each body pair's total K_t (the sum over
 // its rows), in contact order (deterministic sums).
-std::map<std::pair<int, int>, double> crushing_law(const EngineSettings& o, std::vector<Contact>& contacts) {
+std::map<std::pair<int, int>, double> crushing_law(const Model& model, const State& state,
+                                                   std::vector<Contact>& contacts) {
+  const EngineSettings& o = model.settings;
+  const bool speed_law = o.contact.crushing_speed_law == "maattanen";
+  const int hulls = model.hull_count();
   struct PairArea {
     double area = 0, area_end = 0;
   };
@@ -63,8 +82,20 @@ std::map<std::pair<int, int>, double> crushing_law(const EngineSettings& o, std:
   for (Contact& c : contacts) {
     if (c.type != ContactType::crushing) continue;
     const PairArea& pa = areas.at({c.body_a, c.body_b});
-    c.crush_force_n = crushing_pressure(o, pa.area) * c.area_m2;
-    c.crush_force_end_n = std::max(c.crush_force_n, crushing_pressure(o, pa.area_end) * c.area_end_m2);
+    // Against a structure with Maattanen's law: the pressure scaled by the strength at the speed the ice closes on
+    // it (the bodies' velocities as the solve starts, at the contact point), over the contact's width.
+    double scale = 1;
+    if (speed_law && c.body_a < hulls) {
+      const Vec3 pa_ = c.point - state.position[c.body_a], pb_ = c.point - state.position[c.body_b];
+      const Vec3 va = state.velocity[c.body_a] + state.angular_velocity[c.body_a].cross(pa_);
+      const Vec3 vb = state.velocity[c.body_b] + state.angular_velocity[c.body_b].cross(pb_);
+      const double closing = std::max(0.0, -(vb - va).dot(c.normal));
+      const double width = (c.span_hi - c.span_lo).norm();
+      scale = maattanen_strength_ratio(closing, width, model.bodies[c.body_b].thickness_m,
+                                       o.contact.maattanen_reference_pa);
+    }
+    c.crush_force_n = scale * crushing_pressure(o, pa.area) * c.area_m2;
+    c.crush_force_end_n = std::max(c.crush_force_n, scale * crushing_pressure(o, pa.area_end) * c.area_end_m2);
     c.crush_stiffness_npm = c.area_step_m > 0 ? (c.crush_force_end_n - c.crush_force_n) / c.area_step_m : 0.0;
     stiffness[{c.body_a, c.body_b}] += c.crush_stiffness_npm;
   }
@@ -165,7 +196,7 @@ ContactIslands prepare_contacts(const Model& model, const SolverBodies& sb, Stat
                                 std::vector<Contact>& contacts, double dt) {
   const SolverOptions& o = model.settings.solver;
   const double match_tol2 = 0.1 * 0.1;  // m^2: a cached point further than 10 cm is another point
-  const std::map<std::pair<int, int>, double> pair_stiffness = crushing_law(model.settings, contacts);
+  const std::map<std::pair<int, int>, double> pair_stiffness = crushing_law(model, state, contacts);
   for (Contact& c : contacts) {
     // 1. Auxiliary data: lever arms, tangents, I^-1 (r x d) per row and body, effective masses 1/W.
     c.ra = c.point - state.position[c.body_a];

@@ -53,6 +53,12 @@ struct ContactIslands {
 // 1. Auxiliary data (lever arms, tangents, effective masses, bias, which bodies are fixed), 2. the warm start:
 // impulses taken from the previous step's cache (matched by body/part pair and nearest local point) and applied to
 // the velocities, and the contacts' islands (the same for every pass over these contacts).
+// Maattanen's ice strength at the stress rate a closing speed v (m/s) gives against a structure w wide in ice h thick
+// (PHYSICS.md 8.3; w_d = min(w, 2 h), sigma_dot = v 8 sigma_ref / (pi w_d)), over its value at rest: 1 at rest, 1.5 at
+// the top of the rising branch, falling to 0.5 at the brittle plateau. contact.crushing_speed_law "maattanen" scales
+// the crushing pressure against a structure by it.
+double maattanen_strength_ratio(double closing_mps, double width_m, double thickness_m, double reference_pa);
+
 ContactIslands prepare_contacts(const Model& model, const SolverBodies& bodies, State& state,
                                 std::vector<Contact>& contacts, double dt);
 

@@ -256,7 +256,9 @@ void World::stage_forces() {
     const Body& body = model_.bodies[vessel];
     const BodyKinematics k = kinematics(vessel);
     Wrench total = gravity_force(model_, body);
-    report_.hydro_load = hull_water(body, vessel_ref(model_), k);
+    // A compliant (bottom-founded) structure's foundation holds it: no buoyancy or drag apart from its mode.
+    if (!model_.settings.vessel.station_keeping.compliant_held())
+      report_.hydro_load = hull_water(body, vessel_ref(model_), k);
     report_.wind_load = vessel_wind(model_, k);
     if (model_.settings.vessel.station_keeping.held()) {
       // A moored or DP structure: its mooring lines or thrusters take the place of propulsion and steering (its
@@ -286,7 +288,7 @@ void World::stage_forces() {
     const Body& body = model_.bodies[b];
     const BodyKinematics k = kinematics(b);
     const HullRef h = structure_ref(model_, static_cast<int>(s));
-    sr.hydro_load = hull_water(body, h, k);
+    if (!h.options.station_keeping.compliant_held()) sr.hydro_load = hull_water(body, h, k);
     sr.station_keeping_load = station_keeping_force(model_, h, k, state_.time_s, dt,
                                                     &state_.structure_dp_memory[s], &sr.station_keeping);
     Wrench total = gravity_force(model_, body);

@@ -225,6 +225,35 @@ nlohmann::json parts_json(const std::vector<double>& parts, int count, double he
   return list;
 }
 
+// A compliant structure's sway over the steady part (PHYSICS.md 8.3): its velocity over the earth along `along`, its
+// amplitude sqrt(2) x the standard deviation (a sine's) and its frequency by the up-crossings of its mean, the
+// offset along it, and the natural frequency it is compared with (a structure locked in sways at it with a velocity
+// amplitude about the ice's speed).
+nlohmann::json sway_json(const std::vector<double>& velocity, const std::vector<double>& offset, const Vec2& along,
+                         size_t first, size_t steps, double dt, const CompliantOptions& c) {
+  std::vector<double> u, x;
+  for (size_t i = first; i < steps; ++i) {
+    u.push_back(along.dot(Vec2(velocity[3 * i], velocity[3 * i + 1])));
+    x.push_back(along.dot(Vec2(offset[3 * i], offset[3 * i + 1])));
+  }
+  const Stats su = stats_of(u), sx = stats_of(x);
+  size_t up = 0;
+  for (size_t i = 1; i < u.size(); ++i) up += u[i - 1] < su.mean && u[i] >= su.mean;
+  const double span = dt * static_cast<double>(u.size());
+  return {{"velocity_amplitude_mps", std::sqrt(2.0) * su.std},
+          {"frequency_hz", span > 0 ? static_cast<double>(up) / span : 0.0},
+          {"natural_frequency_hz", c.natural_frequency_hz},
+          {"offset_along_drift_m", stats_json(sx)},
+          {"what", "the structure's velocity over the earth along the drift: its amplitude (sqrt 2 x its standard "
+                   "deviation) and frequency (up-crossings of its mean), and its offset from the station"}};
+}
+
+// The unit vector along the ice's drift (earth frame), or along the station's heading without one.
+Vec2 drift_along(const SimulateOptions& o, double heading_rad) {
+  const Vec2 d = o.drift.velocity();
+  return d.norm() > 0 ? Vec2(d.normalized()) : Vec2(std::cos(heading_rad), std::sin(heading_rad));
+}
+
 // The steady part's first step: the first at or after steady_start_s.
 size_t steady_first(const SimulateOptions& o, const SeriesSource& series) {
   const std::vector<double> t = series.get("time_s");
@@ -294,8 +323,13 @@ nlohmann::json listed_structure_summary(const SimulateOptions& o, const Model& m
     return Vec3(x + q * sb.station.reference_point_body);
   }));
   j["rubble_height_m"] = {{"mean", hr.mean}, {"max", hr.max}, {"within_m_of_axis", radius}};
-  // 4. How it is held: offsets, the force balance along the drift, the lines' tensions or the thrusters' use.
+  // 4. How it is held: offsets, the force balance along the drift, the lines' tensions or the thrusters' use; a
+  // compliant one's sway.
   const StationKeepingOptions& sk = so.body.station_keeping;
+  if (sk.compliant_held()) {
+    const Vec2 d = drift_along(o, a);
+    j["sway"] = sway_json(field("velocity_mps"), field("offset"), d, first, steps, o.time_step_s, sk.compliant);
+  }
   if (sk.moored() || sk.dp_held()) {
     nlohmann::json h;
     const std::vector<double>& off = field("offset");
@@ -443,6 +477,12 @@ nlohmann::json structure_summary(const SimulateOptions& o, const Model& model, c
                             nw);
   if (o.vessel.station_keeping.moored() || o.vessel.station_keeping.dp_held())
     j["station_keeping"] = station_keeping_summary(o, model, series, first);
+  if (o.vessel.station_keeping.compliant_held()) {
+    const auto v = r.structure_series.find("vessel/velocity_mps"), x = r.structure_series.find("vessel/offset");
+    if (v != r.structure_series.end() && x != r.structure_series.end())
+      j["sway"] = sway_json(v->second, x->second, drift_along(o, model.station.heading_rad), first, steps,
+                            o.time_step_s, o.vessel.station_keeping.compliant);
+  }
   return j;
 }
 

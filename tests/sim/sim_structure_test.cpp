@@ -13,6 +13,7 @@
 #include "pipeline/error.h"
 #include "pipeline/options.h"
 #include "pipeline/results_io.h"
+#include "sim/engine/solver.h"
 #include "sim/simulate/simulate.h"
 #include "sim_fixtures.h"
 
@@ -393,6 +394,94 @@ TEST(Structure, IceDriftingUnderStillAirRestsUntilTheStructureComes) {
     for (int k = 0; k < 300; ++k) world.step();
     EXPECT_EQ(world.state().awake[1], wind == 0 ? 0 : 1) << "wind " << wind;
   }
+}
+
+TEST(Structure, MaattanensStrengthGivesTheWorkedLoads) {
+  // PHYSICS.md 8.3's example (w = 5 m, h = 1 m, sigma_ref = 2.2 MPa): F = sigma (w_d h)^-1/2 w h is 7.07 MN at rest,
+  // 10.60 MN at 0.104 m/s (the top of the rising branch), 8.98 at 0.2, 6.03 at 0.3 and 3.55 MN at 0.474 m/s.
+  const double at_rest = 2.00e6 / std::sqrt(2.0) * 5;
+  const std::vector<std::pair<double, double>> worked = {
+      {0.0, 7.07e6}, {0.104, 10.60e6}, {0.2, 8.98e6}, {0.3, 6.03e6}, {0.474, 3.55e6}};
+  for (const auto& [v, f] : worked) EXPECT_NEAR(at_rest * maattanen_strength_ratio(v, 5, 1, 2.2e6), f, 0.005e6) << v;
+  // Above the falling branch the brittle plateau: the strength at its end, 0.5 of the one at rest.
+  EXPECT_NEAR(maattanen_strength_ratio(2.0, 5, 1, 2.2e6), maattanen_strength_ratio(1.3287 / 2.8011, 5, 1, 2.2e6),
+              1e-3);
+  EXPECT_NEAR(maattanen_strength_ratio(2.0, 5, 1, 2.2e6), 0.502, 0.002);
+}
+
+// A compliant structure (a 5 m cylinder on its first mode) in a level ice sheet drifting onto it at `drift`.
+SimulateOptions compliant_in_sheet(double drift) {
+  SimulateOptions o = drifting_sheet(1.0, drift);
+  o.vessel.station_keeping.mode = "compliant";
+  o.vessel.station_keeping.compliant.modal_mass_kg = 1e6;
+  o.vessel.station_keeping.compliant.natural_frequency_hz = 0.33;
+  o.vessel.station_keeping.compliant.damping_ratio = 0.02;
+  o.contact.crushing_speed_law = "maattanen";
+  return o;
+}
+
+TEST(Structure, ACompliantStructureSwaysAtItsNaturalFrequencyWithItsDamping) {
+  // Free vibration in open water, released 0.1 m off its station: zero crossings 1 / f_n apart (the damped period,
+  // 0.02 % longer), each cycle's amplitude exp(-2 pi zeta / sqrt(1 - zeta^2)) of the one before.
+  SimulateOptions o = compliant_in_sheet(0.0);
+  o.level_ice.extent_m.clear();
+  o.drift.speed_mps = o.water.current_speed_mps = 0;
+  const HullModel cylinder = structure("cylinder", 5);
+  World world(build_model(FloeField{}, &cylinder, o));
+  world.mutable_state().position[0].x() += 0.1;
+  std::vector<double> up, peaks;
+  double last = 0.1, top = 0;
+  for (int k = 1; k <= 3000; ++k) {
+    world.step();
+    const double x = world.report().station_keeping.offset.x();
+    if (last < 0 && x >= 0) up.push_back(k * o.time_step_s - x / (x - last) * o.time_step_s);
+    if (last < 0 && x >= 0 && top > 0) peaks.push_back(top), top = 0;
+    if (x > 0) top = std::max(top, x);
+    last = x;
+  }
+  ASSERT_GE(up.size(), 8u);
+  const double zeta = 0.02, period = 1 / 0.33 / std::sqrt(1 - zeta * zeta);
+  EXPECT_NEAR((up.back() - up.front()) / static_cast<double>(up.size() - 1), period, 0.005 * period);
+  const double decay = std::exp(-2 * kPi * zeta / std::sqrt(1 - zeta * zeta));
+  for (size_t i = 1; i < peaks.size(); ++i) EXPECT_NEAR(peaks[i] / peaks[i - 1], decay, 0.01) << i;
+}
+
+// The sway of a compliant 5 m cylinder (f_n 2 Hz, 2 % damping) in 1 m ice drifting at v: its velocity amplitude over
+// the earth (sqrt 2 x its standard deviation) and its frequency (up-crossings of the velocity) after the start.
+struct Sway {
+  double amplitude_mps = 0, frequency_hz = 0;
+};
+Sway sway_in_sheet(double v, const char* law) {
+  SimulateOptions o = compliant_in_sheet(v);
+  o.vessel.station_keeping.compliant.natural_frequency_hz = 2.0;
+  o.contact.crushing_speed_law = law;
+  const HullModel cylinder = structure("cylinder", 5);
+  World world(build_model(FloeField{}, &cylinder, o));
+  const double t0 = 2.0 / v + 10, window = 20;  // in the ice after the front half's 2.5 m
+  double s = 0, s2 = 0, last = 0;
+  int n = 0, up = 0;
+  for (long k = 1; k * o.time_step_s <= t0 + window; ++k) {
+    world.step();
+    const double u = world.state().velocity[0].x() + world.model().frame_velocity.x();
+    if (k * o.time_step_s > t0) {
+      s += u, s2 += u * u, ++n;
+      up += last < 0 && u >= 0;
+    }
+    last = u;
+  }
+  const double mean = s / n;
+  return {std::sqrt(2 * (s2 / n - mean * mean)), up / window};
+}
+
+TEST(Structure, MaattanensFallingStrengthDrivesACompliantStructureAtItsNaturalFrequency) {
+  // PHYSICS.md 8.3: on the falling branch (0.2 m/s, for w_d = 2 m) the strength falls as the ice closes faster, a
+  // negative damping far beyond the structure's 2 %: the sway grows until it is limited by the ice separating, at the
+  // structure's natural frequency. With a strength that does not depend on the speed it stays small.
+  const Sway flat = sway_in_sheet(0.2, "none"), falling = sway_in_sheet(0.2, "maattanen");
+  EXPECT_LT(flat.amplitude_mps, 0.1 * 0.2);
+  EXPECT_GT(falling.amplitude_mps, 10 * flat.amplitude_mps);
+  EXPECT_GT(falling.amplitude_mps, 0.2) << "a locked structure sways at about the ice's speed";
+  EXPECT_NEAR(falling.frequency_hz, 2.0, 0.5);
 }
 
 TEST(Structure, BadInputIsNamed) {
