@@ -58,7 +58,8 @@ Polygon part_band_footprint(const ConvexPart& part, const Vec3& position, const 
 
 namespace {
 
-// The clearings by fixed hull body s, into cuts (tiles in cut_tiles are left alone; the ones cut join them).
+// The clearings by hull body s (a fixed or compliant structure: Body::clears_ice), into cuts (tiles in cut_tiles
+// are left alone; the ones cut join them).
 void clear_for(const Model& model, const State& state, const std::vector<Contact>& contacts, int s,
                std::set<int>& cut_tiles, std::vector<FractureCut>& cuts) {
   // 1. The tiles the structure crushes, and how it presses on each.

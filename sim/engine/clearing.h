@@ -27,8 +27,8 @@ namespace floesim::sim {
 
 // The clearings of this step: one cut per tile (body: the tile; pieces: its outline less the cleared ice, in its
 // body frame; wedge_pieces 0: every piece stays held by the sheet unless it is brash; event.mode kFractureCrushing,
-// event.brash_mass_kg the crushed mass). Empty unless a hull body (the vessel, a structure) is fixed. Deterministic:
-// hull bodies, tiles and parts in index order.
+// event.brash_mass_kg the crushed mass). Empty unless a hull body (the vessel, a structure) is fixed or compliant
+// (Body::clears_ice). Deterministic: hull bodies, tiles and parts in index order.
 std::vector<FractureCut> find_clearings(const Model& model, const State& state, const std::vector<Contact>& contacts);
 
 // A convex part's footprint over the band zlo <= z <= zhi (world), in the world x-y plane: the convex hull of its

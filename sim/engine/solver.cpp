@@ -86,9 +86,9 @@ std::map<std::pair<int, int>, double> crushing_law(const Model& model, const Sta
     // it (the bodies' velocities as the solve starts, at the contact point), over the contact's width.
     double scale = 1;
     if (speed_law && c.body_a < hulls) {
-      const Vec3 pa_ = c.point - state.position[c.body_a], pb_ = c.point - state.position[c.body_b];
-      const Vec3 va = state.velocity[c.body_a] + state.angular_velocity[c.body_a].cross(pa_);
-      const Vec3 vb = state.velocity[c.body_b] + state.angular_velocity[c.body_b].cross(pb_);
+      const Vec3 arm_a = c.point - state.position[c.body_a], arm_b = c.point - state.position[c.body_b];
+      const Vec3 va = state.velocity[c.body_a] + state.angular_velocity[c.body_a].cross(arm_a);
+      const Vec3 vb = state.velocity[c.body_b] + state.angular_velocity[c.body_b].cross(arm_b);
       const double closing = std::max(0.0, -(vb - va).dot(c.normal));
       const double width = (c.span_hi - c.span_lo).norm();
       scale = maattanen_strength_ratio(closing, width, model.bodies[c.body_b].thickness_m,

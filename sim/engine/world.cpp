@@ -886,7 +886,7 @@ std::unique_ptr<World> World::restore(const Model& base, ByteReader& r) {
   s.dp_memory = r.vec<double>();
   FLOESIM_REQUIRE(s.dp_memory.empty() || s.dp_memory.size() == static_cast<size_t>(DpController::kMemory), r.what(),
                   ": damaged (a DP controller's memory of ", s.dp_memory.size(), " values)");
-  s.structure_dp_memory.resize(r.size());
+  s.structure_dp_memory.resize(r.size(8));
   FLOESIM_REQUIRE(s.structure_dp_memory.size() == w->model_.structures.size(), r.what(), ": damaged (",
                   s.structure_dp_memory.size(), " structures' DP memories for ", w->model_.structures.size(),
                   " structures)");
