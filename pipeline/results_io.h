@@ -50,8 +50,9 @@
 //                                                   (structure_fields below). Earth axes; NAME/hull_vertices_m
 //                                                   [V x 3] and NAME/hull_triangles [T x 3] its mesh in its body
 //                                                   frame (origin = centre of mass).
-//   Layout "floesim-results/9" (this one) added /structures. "/8" added the fracture mode 4, crushing, and the series station_offset,
-//   station_keeping_demanded and station_keeping_delivered (NaN when reading an earlier file). "/7" stores only the
+//   Layout "floesim-results/9" (this one) added /structures (none when reading an earlier file). "/8" added the
+//   fracture mode 4, crushing, and the series station_offset, station_keeping_demanded and
+//   station_keeping_delivered (NaN when reading an earlier file). "/7" stores only the
 //   changed bodies in a frame and added the series ice_kinetic_energy (NaN when reading an earlier file); earlier
 //   layouts stored every alive body in every frame, which FrameReplay reads the same way. "/6" added the series
 //   ice_load_level_ice (NaN when reading an earlier file); "/5" added /geometry/floe_level_ice (all 0 when reading an

@@ -130,13 +130,14 @@ Wrench vessel_propulsion(const Model& m, const BodyKinematics& k, double time_s,
 // Heading hold: PD yaw moment towards heading_ref, limited.
 Wrench vessel_autopilot(const Model& m, const Body& b, const BodyKinematics& k, double heading_ref);
 
-// A moored or DP hull body's station keeping (its station_keeping options, issue #34), from its pose at time t (the run's
-// frame; the earth frame's pose is x + frame_velocity t): the mooring legs' pull (spread_at_pose, quasi-static
-// catenaries, at the reference point's earth-frame offset from the station and the heading's change), or the DP
-// controller's delivered force (its observer and integral carry over in `dp_memory`, State::dp_memory), plus the
-// steady applied pull.
-// World frame, about the centre of mass. `delivered` gets the generalised force in the station's axes (mooring) or
-// body axes (dp): x, y, yaw moment; `demanded` the DP controller's before its limits (the delivered otherwise).
+// A moored, DP or compliant hull body's station keeping (its station_keeping options, issue #34), from its pose at
+// time t (the run's frame; the earth frame's pose is x + frame_velocity t): the mooring legs' pull (spread_at_pose,
+// quasi-static catenaries, at the reference point's earth-frame offset from the station and the heading's change),
+// the DP controller's delivered force (its observer and integral carry over in `dp_memory`, State::dp_memory) or a
+// compliant body's spring and damper on its offset and velocity over the earth, plus the steady applied pull.
+// World frame, about the centre of mass. `delivered` gets the generalised force in the station's axes (mooring,
+// compliant) or body axes (dp): x, y, yaw moment; `demanded` the DP controller's before its limits (the delivered
+// otherwise).
 struct StationKeeping {
   double demanded[3] = {0, 0, 0};
   double delivered[3] = {0, 0, 0};

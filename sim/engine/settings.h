@@ -270,7 +270,7 @@ struct StationKeepingOptions {
   bool compliant_held() const { return mode == "compliant"; }
   bool moored() const { return mode == "moored"; }
   bool dp_held() const { return mode == "dp"; }
-  bool held() const { return mode != "propulsion"; }  // a structure: fixed, moored or dp
+  bool held() const { return mode != "propulsion"; }  // a structure: fixed, moored, dp or compliant
 };
 
 struct VesselOptions {
@@ -390,11 +390,11 @@ struct StructureOptions {
             "its mesh (OBJ, or any mesh assimp reads) in its hull frame: bow +x, z up, waterline z = 0, taken as the "
             "file has it (floesim-hull's output); relative to the config file");
     body.visit_body(v);
-    v.section("station_keeping", body.station_keeping, "how it is held: fixed, moored or dp");
+    v.section("station_keeping", body.station_keeping, "how it is held: fixed, moored, dp or compliant");
     if (hull_file.empty()) v.problem("hull_file", "must name the structure's mesh");
     if (!body.station_keeping.held())
-      v.problem("station_keeping", "a structure is fixed, moored or dp (mode \"" + body.station_keeping.mode +
-                "\" drives a ship: that is the case's vessel)");
+      v.problem("station_keeping", "a structure is fixed, moored, dp or compliant (mode \"" +
+                                       body.station_keeping.mode + "\" drives a ship: that is the case's vessel)");
   }
 };
 

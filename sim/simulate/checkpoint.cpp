@@ -25,7 +25,8 @@ constexpr const char* kRecordsMagic = "floesim-checkpoint-records/1\n";
 constexpr size_t kHashChars = 64;  // SHA-256, hex
 
 // The arrays the recorder appends to at every step or frame, in a fixed order: every series of the layout, then the
-// frames and their body states, then the structures' series (by name). A checkpoint stores their tails since the previous one.
+// frames and their body states, then the structures' series (by name). A checkpoint stores their tails since the
+// previous one.
 template <class R, class F>
 void for_each_recorded(R& r, F&& f) {
   for (const FieldSpec& s : series_fields()) f(s.name, r.series.at(s.name));

@@ -50,9 +50,9 @@ struct SimulateOptions : EngineSettings {
     v.section("level_ice", level_ice, "a level ice sheet, broken by the fracture module (issue #10)");
     v.section("drift", drift, "the ice's drift toward a structure: the run is computed in the ice's frame");
     v.list("structures", structures,
-           "structures beside the vessel (fixed, moored or dp), each a hull body of its own with its loads, pose and "
-           "station keeping recorded under its name: [{\"name\", \"hull_file\", placement and mass as the "
-           "vessel's, \"station_keeping\"}]");
+           "structures beside the vessel (fixed, moored, dp or compliant), each a hull body of its own with its "
+           "loads, pose and station keeping recorded under its name: [{\"name\", \"hull_file\", placement and "
+           "mass as the vessel's, \"station_keeping\"}]");
     for (size_t i = 0; i < structures.size(); ++i)
       for (size_t j = 0; j < i; ++j)
         if (structures[i].name == structures[j].name)

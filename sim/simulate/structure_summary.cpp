@@ -72,14 +72,9 @@ std::vector<double> rubble_heights(const Results& r, double from_s, double radiu
   return heights;
 }
 
-// A moored or DP structure: its offset and heading change, the force balance along the drift (PHYSICS.md §8.4.3:
-// the mean station-keeping force against the mean ice, water and wind loads, earth frame), and each mooring line's
-// tension (quasi-static: from the recorded offset, PHYSICS.md §8.4.1) or the DP thrusters' use of their limits.
-nlohmann::json station_keeping_summary(const SimulateOptions& o, const Model& model, const SeriesSource& series,
-                                       size_t first) {
-  nlohmann::json j;
-  const size_t steps = series.steps();
-  const std::vector<double> off = series.get("station_offset");
+// The offset from the station (x, y: series `off` [steps x 3], x, y and the heading's change) over the steady part:
+// each component's, the distance's and the heading change's statistics.
+nlohmann::json offsets_json(const std::vector<double>& off, size_t first, size_t steps) {
   std::vector<double> dx, dy, dist, dpsi;
   for (size_t i = first; i < steps; ++i) {
     dx.push_back(off[3 * i]);
@@ -87,10 +82,20 @@ nlohmann::json station_keeping_summary(const SimulateOptions& o, const Model& mo
     dist.push_back(std::hypot(off[3 * i], off[3 * i + 1]));
     dpsi.push_back(off[3 * i + 2] * 180 / kPi);
   }
-  j["offset_x_m"] = stats_json(stats_of(dx));
-  j["offset_y_m"] = stats_json(stats_of(dy));
-  j["offset_m"] = stats_json(stats_of(dist));
-  j["heading_change_deg"] = stats_json(stats_of(dpsi));
+  return {{"offset_x_m", stats_json(stats_of(dx))},
+          {"offset_y_m", stats_json(stats_of(dy))},
+          {"offset_m", stats_json(stats_of(dist))},
+          {"heading_change_deg", stats_json(stats_of(dpsi))}};
+}
+
+// A moored or DP structure: its offset and heading change, the force balance along the drift (PHYSICS.md §8.4.3:
+// the mean station-keeping force against the mean ice, water and wind loads, earth frame), and each mooring line's
+// tension (quasi-static: from the recorded offset, PHYSICS.md §8.4.1) or the DP thrusters' use of their limits.
+nlohmann::json station_keeping_summary(const SimulateOptions& o, const Model& model, const SeriesSource& series,
+                                       size_t first) {
+  const size_t steps = series.steps();
+  const std::vector<double> off = series.get("station_offset");
+  nlohmann::json j = offsets_json(off, first, steps);
   // 1. The balance along the drift (or the station's x axis without one): each load turned into the earth frame.
   const Vec2 drift = o.drift.velocity();
   const double a = model.station.heading_rad;
@@ -134,7 +139,8 @@ nlohmann::json station_keeping_summary(const SimulateOptions& o, const Model& mo
     std::vector<std::vector<double>> hs(model.station.mooring.size()), ts(model.station.mooring.size());
     for (size_t i = first; i < steps; ++i) {
       const double ex = off[3 * i], ey = off[3 * i + 1];
-      const SpreadState sp = spread_at_pose(model.station.mooring, c0 * ex + s0 * ey, -s0 * ex + c0 * ey, off[3 * i + 2]);
+      const SpreadState sp =
+          spread_at_pose(model.station.mooring, c0 * ex + s0 * ey, -s0 * ex + c0 * ey, off[3 * i + 2]);
       for (size_t l = 0; l < sp.lines.size(); ++l) {
         hs[l].push_back(sp.lines[l].horizontal_tension_n);
         ts[l].push_back(sp.lines[l].fairlead_tension_n);
@@ -331,19 +337,7 @@ nlohmann::json listed_structure_summary(const SimulateOptions& o, const Model& m
     j["sway"] = sway_json(field("velocity_mps"), field("offset"), d, first, steps, o.time_step_s, sk.compliant);
   }
   if (sk.moored() || sk.dp_held()) {
-    nlohmann::json h;
-    const std::vector<double>& off = field("offset");
-    std::vector<double> dx, dy, dist, dpsi;
-    for (size_t i = first; i < steps; ++i) {
-      dx.push_back(off[3 * i]);
-      dy.push_back(off[3 * i + 1]);
-      dist.push_back(std::hypot(off[3 * i], off[3 * i + 1]));
-      dpsi.push_back(off[3 * i + 2] * 180 / kPi);
-    }
-    h["offset_x_m"] = stats_json(stats_of(dx));
-    h["offset_y_m"] = stats_json(stats_of(dy));
-    h["offset_m"] = stats_json(stats_of(dist));
-    h["heading_change_deg"] = stats_json(stats_of(dpsi));
+    nlohmann::json h = offsets_json(field("offset"), first, steps);
     const Vec2 drift = o.drift.velocity();
     const Vec3 along = drift.norm() > 0 ? Vec3(drift.x(), drift.y(), 0).normalized() : Vec3(c, s, 0);
     const double n = static_cast<double>(steps - first);
