@@ -260,6 +260,32 @@ Vec2 drift_along(const SimulateOptions& o, double heading_rad) {
   return d.norm() > 0 ? Vec2(d.normalized()) : Vec2(std::cos(heading_rad), std::sin(heading_rad));
 }
 
+// The loads' part of a structure's summary into j, over the steady part: the horizontal load along the drift fh,
+// raw and through the filter (the filter and the steady part stated), the transverse fy, vertical fv and overturning
+// my; the horizontal load's cycles; and with level ice (`sheet`, its part from the sheet's tiles) the breaking.
+void add_loads_json(const std::vector<double>& fh, const std::vector<double>& fy, const std::vector<double>& fv,
+                    const std::vector<double>& my, const std::vector<double>& sheet, const SimulateOptions& o,
+                    size_t nw, nlohmann::json& j) {
+  const std::vector<double> fh_f = moving_average_full_windows(fh, nw);
+  j["filter"] = {{"kind", "centred moving average of the compliant contacts' load (PHYSICS.md 5)"},
+                 {"window_s", kFilterS}};
+  j["steady_part"] = {{"from_s", o.steady_start_s}, {"to_s", o.duration_s}, {"samples", fh.size()}};
+  j["horizontal_load_N"] = stats_json(stats_of(fh));
+  j["horizontal_load_filtered_N"] = stats_json(stats_of(fh_f));
+  j["transverse_load_N"] = stats_json(stats_of(fy));
+  j["vertical_load_N"] = stats_json(stats_of(fv));
+  j["overturning_moment_y_Nm"] = stats_json(stats_of(my));
+  j["cycles"] = cycles_json(fh_f, o, nw);
+  if (!o.level_ice.extent_m.empty()) {
+    const std::vector<double> sheet_f = moving_average_full_windows(sheet, nw);
+    j["breaking"] = {{"what", "the part of the horizontal load from the level ice sheet's tiles (ice_load_level_ice): "
+                              "the structure breaking the sheet's edge, without the rubble and the broken pieces"},
+                     {"load_N", stats_json(stats_of(sheet))},
+                     {"load_filtered_N", stats_json(stats_of(sheet_f))},
+                     {"cycles", cycles_json(sheet_f, o, nw)}};
+  }
+}
+
 // The steady part's first step: the first at or after steady_start_s.
 size_t steady_first(const SimulateOptions& o, const SeriesSource& series) {
   const std::vector<double> t = series.get("time_s");
@@ -294,28 +320,12 @@ nlohmann::json listed_structure_summary(const SimulateOptions& o, const Model& m
     sheet.push_back(-(c * sheet_series[3 * i] + s * sheet_series[3 * i + 1]));
   }
   const size_t nw = window_samples(kFilterS, o.time_step_s);
-  const std::vector<double> fh_f = moving_average_full_windows(fh, nw);
   nlohmann::json j;
   j["name"] = so.name;
   j["kind"] = so.body.station_keeping.mode;
   j["reference_point"] = "the structure's axis at the water line (the hull frame's origin)";
   j["axes"] = "the structure's at its station: x along its heading (into the ice that comes), z up";
-  j["filter"] = {{"kind", "centred moving average of the compliant contacts' load (PHYSICS.md 5)"},
-                 {"window_s", kFilterS}};
-  j["steady_part"] = {{"from_s", o.steady_start_s}, {"to_s", o.duration_s}, {"samples", fh.size()}};
-  j["horizontal_load_N"] = stats_json(stats_of(fh));
-  j["horizontal_load_filtered_N"] = stats_json(stats_of(fh_f));
-  j["transverse_load_N"] = stats_json(stats_of(fy));
-  j["vertical_load_N"] = stats_json(stats_of(fv));
-  j["overturning_moment_y_Nm"] = stats_json(stats_of(my));
-  j["cycles"] = cycles_json(fh_f, o, nw);
-  if (!o.level_ice.extent_m.empty()) {
-    const std::vector<double> sheet_f = moving_average_full_windows(sheet, nw);
-    j["breaking"] = {{"what", "the part of the horizontal load from the level ice sheet's tiles"},
-                     {"load_N", stats_json(stats_of(sheet))},
-                     {"load_filtered_N", stats_json(stats_of(sheet_f))},
-                     {"cycles", cycles_json(sheet_f, o, nw)}};
-  }
+  add_loads_json(fh, fy, fv, my, sheet, o, nw, j);
   // 2. Each part's share.
   j["parts"] = parts_json(field("part_force_n"), sb.part_count, a, first, steps, nw);
   // 3. The rubble: the highest ice within the waterline width of its axis, per stored frame.
@@ -411,32 +421,17 @@ nlohmann::json structure_summary(const SimulateOptions& o, const Model& model, c
     }
   }
   const size_t nw = window_samples(kFilterS, o.time_step_s);
-  const std::vector<double> fh_f = moving_average_full_windows(fh, nw);
   j["kind"] = o.vessel.station_keeping.mode;
   j["reference_point"] = "the structure's axis at the water line (the hull frame's origin)";
-  j["filter"] = {{"kind", "centred moving average of the compliant contacts' load (PHYSICS.md 5)"},
-                 {"window_s", kFilterS}};
-  j["steady_part"] = {{"from_s", o.steady_start_s}, {"to_s", o.duration_s}, {"samples", fh.size()}};
   j["drift_speed_mps"] = o.drift.speed_mps;
-  j["horizontal_load_N"] = stats_json(stats_of(fh));
-  j["horizontal_load_filtered_N"] = stats_json(stats_of(fh_f));
-  j["transverse_load_N"] = stats_json(stats_of(fy));
-  j["vertical_load_N"] = stats_json(stats_of(fv));
-  j["overturning_moment_y_Nm"] = stats_json(stats_of(my));
   // 2. Load cycles of the filtered horizontal load, and of its part from the level ice sheet (breaking its edge:
   // the cycles of §8.2.4), each against (4-12) h/v.
-  j["cycles"] = cycles_json(fh_f, o, nw);
+  std::vector<double> sheet;
   if (!o.level_ice.extent_m.empty()) {
-    std::vector<double> sheet;
     const std::vector<double> li = series.get("ice_load_level_ice");
     for (size_t i = first; i < steps; ++i) sheet.push_back(-li[6 * i]);
-    const std::vector<double> sheet_f = moving_average_full_windows(sheet, nw);
-    j["breaking"] = {{"what", "the part of the horizontal load from the level ice sheet's tiles (ice_load_level_ice): "
-                              "the structure breaking the sheet's edge, without the rubble and the broken pieces"},
-                     {"load_N", stats_json(stats_of(sheet))},
-                     {"load_filtered_N", stats_json(stats_of(sheet_f))},
-                     {"cycles", cycles_json(sheet_f, o, nw)}};
   }
+  add_loads_json(fh, fy, fv, my, sheet, o, nw, j);
   // 3. How far across the drift the ice broke, against the sheet's sides: the sides are held (fixed tiles), so they
   // leave no artefact in the loads while no crack comes near them.
   const std::vector<double>& e = o.level_ice.extent_m;
