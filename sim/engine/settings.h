@@ -695,7 +695,7 @@ struct SleepOptions {
   double linear_mps = 0.02;      // a floe slower than this ...
   double angular_radps = 0.02;   // ... and turning slower than this ...
   double time_s = 1.0;           // ... without contacts for this long falls asleep (not integrated)
-  double freeze_astern_m = 0;         // > 0: floes this far astern of the vessel's centre sleep at any speed
+  double freeze_astern_m = 0;    // > 0: floes this far astern of every hull body sleep at any speed
   template <class V>
   void visit(V& v) {
     v.field("enabled", enabled, "-", "let resting floes sleep (no integration until touched)");
@@ -703,12 +703,13 @@ struct SleepOptions {
     v.field("angular_radps", angular_radps, "rad/s", "angular speed below which a floe may sleep", non_negative());
     v.field("time_s", time_s, "s", "time below the thresholds, without contacts, before sleeping", non_negative());
     v.field("freeze_astern_m", freeze_astern_m, "m",
-            "0: off; else a floe whose centre lies astern of the vessel (behind its centre of mass along its heading) "
-            "and farther than this from it falls asleep at once, whatever its speed, and is held there (a moving "
-            "body that touches it wakes it for that step). Broken ice drifting in the channel far behind the "
-            "vessel no longer loads it, and would otherwise stay awake for minutes (quadratic drag stops a piece "
-            "slowly): the cost then follows the ice near the vessel, not the length of channel broken. Only in still "
-            "water and air, like all sleeping",
+            "0: off; else a floe far astern of every hull body falls asleep at once, whatever its speed, and is "
+            "held there (a moving body that touches it wakes it for that step). Far astern of a ship: behind its "
+            "centre of mass along its heading and farther than this from it; of a structure in drifting ice: more "
+            "than this behind it along its motion through the ice (the ice it breaks spreads beside it and still "
+            "flows past it there). Broken ice far behind no longer loads the hull, and would otherwise stay awake for "
+            "minutes (quadratic drag stops a piece slowly): the cost then follows the ice near the hull, not the "
+            "length of ice broken. Only in still water and air (or in the drifting ice's frame), like all sleeping",
             non_negative());
   }
 };

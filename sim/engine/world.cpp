@@ -595,22 +595,25 @@ void World::stage_sleep() {
   for (int b : awake_list_)
     if (b < model_.hull_count() || state_.still_time_s[b] < s.time_s) island_ok_[find(b)] = 0;
   // Far astern (sleep.freeze_astern_m): asleep at any speed; the island rule above no longer applies to it.
-  // Astern is behind a ship's bow, or behind a structure's motion through the ice (downstream of it in the earth
-  // frame: against the drift); a structure at rest in the ice has no astern. A body is frozen when it is far astern
-  // of every hull body.
+  // Astern is behind a ship's bow, farther than the distance from its centre; or behind a structure's motion through
+  // the ice (downstream of it in the earth frame: against the drift), farther than the distance along that motion,
+  // since the ice a structure breaks spreads beside it and still flows past it there. A structure at rest in the ice
+  // has no astern. A body is frozen when it is far astern of every hull body.
   const int hulls = model_.hull_count();
-  std::vector<Vec3> astern_dir(hulls, Vec3::Zero());  // zero: this hull has no astern (nothing is astern of all)
+  std::vector<Vec3> ahead(hulls, Vec3::Zero());  // zero: this hull has no astern (nothing is astern of all)
+  std::vector<char> ship(hulls, 0);
   const Vec3 through_ice = -Vec3(model_.frame_velocity.x(), model_.frame_velocity.y(), 0);
   for (int hb = 0; hb < hulls; ++hb) {
-    const bool ship = hb == model_.vessel && !model_.settings.vessel.station_keeping.held();
-    if (ship) astern_dir[hb] = state_.orientation[hb] * Vec3::UnitX();
-    else if (through_ice.norm() > 0) astern_dir[hb] = through_ice.normalized();
+    ship[hb] = hb == model_.vessel && !model_.settings.vessel.station_keeping.held();
+    if (ship[hb]) ahead[hb] = state_.orientation[hb] * Vec3::UnitX();
+    else if (through_ice.norm() > 0) ahead[hb] = through_ice.normalized();
   }
   auto far_astern = [&](int b) {
     for (int hb = 0; hb < hulls; ++hb) {
       const Vec3 d = state_.position[b] - state_.position[hb];
-      if (astern_dir[hb].squaredNorm() == 0 || d.dot(astern_dir[hb]) >= 0 || d.head<2>().norm() <= s.freeze_astern_m)
-        return false;
+      const double behind = -d.dot(ahead[hb]);
+      if (ahead[hb].squaredNorm() == 0 || behind <= 0) return false;
+      if ((ship[hb] ? d.head<2>().norm() : behind) <= s.freeze_astern_m) return false;
     }
     return true;
   };

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include "pipeline/error.h"
 #include "pipeline/signal.h"
@@ -70,6 +71,85 @@ std::vector<double> rubble_heights(const Results& r, double from_s, double radiu
     heights.push_back(top);
   }
   return heights;
+}
+
+// Where every hull body was at a recorded step, in the run's frame: the vessel slot first (vessel_position_m is in
+// the run's frame), then the structures beside it (their position_m series are in the earth's).
+class HullTracks {
+ public:
+  HullTracks(const SimulateOptions& o, const Model& model, const Results& r, const SeriesSource& series)
+      : o_(o), frame_velocity_(model.frame_velocity), vessel_(series.get("vessel_position_m")) {
+    for (const StructureOptions& so : o.structures) {
+      const auto it = r.structure_series.find(so.name + "/position_m");
+      FLOESIM_REQUIRE(it != r.structure_series.end(), "internal: no series ", so.name, "/position_m");
+      listed_.push_back(&it->second);
+    }
+  }
+  // The hull body nearest p at time t: 0 the vessel slot, 1 + k the k-th structure beside it.
+  size_t nearest(const Vec2& p, double t) const {
+    const size_t rows = vessel_.size() / 3;
+    if (rows == 0) return 0;
+    const long row = std::lround(t / o_.time_step_s) - 1;
+    const size_t i = static_cast<size_t>(std::clamp<long>(row, 0, static_cast<long>(rows) - 1));
+    size_t best = 0;
+    double best_d = (Vec2(vessel_[3 * i], vessel_[3 * i + 1]) - p).norm();
+    for (size_t k = 0; k < listed_.size(); ++k) {
+      const std::vector<double>& x = *listed_[k];
+      const Vec2 at = Vec2(x[3 * i], x[3 * i + 1]) - t * frame_velocity_.head<2>();
+      if ((at - p).norm() < best_d) best_d = (at - p).norm(), best = k + 1;
+    }
+    return best;
+  }
+
+ private:
+  const SimulateOptions& o_;
+  Vec3 frame_velocity_;
+  std::vector<double> vessel_;
+  std::vector<const std::vector<double>*> listed_;
+};
+
+// The break length (PHYSICS.md §8.2.4: the load period of flexural failure is the break length over the drift
+// speed): the extent along the drift of each piece a level ice sheet lost in the steady part, in a break nearer
+// hull body `self` than any other (HullTracks). A piece keeps its tile's axes, which are the run's, and the sheet
+// rests in the run's frame, so its outline's extent along the drift is how far the break reached into the sheet.
+// The median (a crack beside an earlier one leaves a sliver) and the mean; over h, the period in h/v.
+nlohmann::json break_length_json(const SimulateOptions& o, const Results& r, const HullTracks& tracks, size_t self) {
+  const Vec2 d = o.drift.velocity();
+  if (d.norm() <= 0 || r.floe_level_ice.size() != r.floe_id.size()) return nullptr;
+  const Vec2 along = d.normalized();
+  std::map<int32_t, size_t> row_of;
+  for (size_t g = 0; g < r.floe_id.size(); ++g) row_of[r.floe_id[g]] = g;
+  std::vector<double> lengths;
+  for (size_t e = 0; e < r.fracture_time_s.size(); ++e) {
+    const double t = r.fracture_time_s[e];
+    const auto parent = row_of.find(r.fracture_parent_id[e]);
+    if (t < o.steady_start_s || parent == row_of.end() || !r.floe_level_ice[parent->second]) continue;
+    if (tracks.nearest(Vec2(r.fracture_point_m[3 * e], r.fracture_point_m[3 * e + 1]), t) != self) continue;
+    for (int64_t c = r.fracture_child_offset[e]; c < r.fracture_child_offset[e + 1]; ++c) {
+      const auto child = row_of.find(r.fracture_child_id[c]);
+      if (child == row_of.end() || r.floe_level_ice[child->second]) continue;  // the sheet that is left
+      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+      for (int64_t i = r.floe_vertex_offset[child->second]; i < r.floe_vertex_offset[child->second + 1]; ++i) {
+        const double u = along.dot(Vec2(r.floe_vertices_m[2 * i], r.floe_vertices_m[2 * i + 1]));
+        lo = std::min(lo, u);
+        hi = std::max(hi, u);
+      }
+      lengths.push_back(hi - lo);
+    }
+  }
+  const double h = o.level_ice.thickness_m;
+  nlohmann::json j = {{"pieces", lengths.size()},
+                      {"what", "the extent along the drift of the pieces the sheet lost near this structure in the "
+                               "steady part; the load period of flexural failure is the break length over the drift "
+                               "speed, so in h/v it is the break length over h"}};
+  if (lengths.empty()) return j;
+  std::sort(lengths.begin(), lengths.end());
+  const size_t n = lengths.size();
+  const double median = n % 2 ? lengths[n / 2] : 0.5 * (lengths[n / 2 - 1] + lengths[n / 2]);
+  j["median_m"] = median;
+  j["mean_m"] = stats_of(lengths).mean;
+  j["period_over_h_per_v"] = median / h;
+  return j;
 }
 
 // The offset from the station (x, y: series `off` [steps x 3], x, y and the heading's change) over the steady part:
@@ -326,6 +406,8 @@ nlohmann::json listed_structure_summary(const SimulateOptions& o, const Model& m
   j["reference_point"] = "the structure's axis at the water line (the hull frame's origin)";
   j["axes"] = "the structure's at its station: x along its heading (into the ice that comes), z up";
   add_loads_json(fh, fy, fv, my, sheet, o, nw, j);
+  if (j.contains("breaking"))
+    j["breaking"]["break_length"] = break_length_json(o, r, HullTracks(o, model, r, series), k + 1);
   // 2. Each part's share.
   j["parts"] = parts_json(field("part_force_n"), sb.part_count, a, first, steps, nw);
   // 3. The rubble: the highest ice within the waterline width of its axis, per stored frame.
@@ -432,6 +514,8 @@ nlohmann::json structure_summary(const SimulateOptions& o, const Model& model, c
     for (size_t i = first; i < steps; ++i) sheet.push_back(-li[6 * i]);
   }
   add_loads_json(fh, fy, fv, my, sheet, o, nw, j);
+  if (j.contains("breaking"))
+    j["breaking"]["break_length"] = break_length_json(o, r, HullTracks(o, model, r, series), 0);
   // 3. How far across the drift the ice broke, against the sheet's sides: the sides are held (fixed tiles), so they
   // leave no artefact in the loads while no crack comes near them.
   const std::vector<double>& e = o.level_ice.extent_m;

@@ -139,6 +139,30 @@ TEST(Structure, AnUpwardBreakingConeBendsTheSheetUpAndIsPushedDown) {
   EXPECT_LT(fz, 0) << "the ice riding up presses the cone down (PHYSICS.md 8.2.5)";
 }
 
+TEST(Structure, TheConesBreakLengthIsTheWedgesOfTheSheetsCharacteristicLength) {
+  // PHYSICS.md 8.2.4: a cone breaks the sheet into pieces of R_b = 0.3-0.8 l_c along the drift, so the load period
+  // (break length over drift speed) is 4-12 h/v. The summary's break length is the pieces' extent along the drift;
+  // l_c by hand from the plate's stiffness and the water's.
+  SimulateOptions o = drifting_sheet(0.5, 0.3);
+  o.duration_s = 40;
+  o.steady_start_s = 10;
+  o.output_interval_s = 1;
+  const HullModel cone = structure("cone", 10);
+  const Model m = build_model(FloeField{}, &cone, o);
+  RunStats stats;
+  const Results r = simulate(o, m, stats);
+  const nlohmann::json b = summarize(o, m, r)["structure"]["breaking"]["break_length"];
+  const double E = o.fracture.youngs_modulus_pa, nu = o.fracture.poisson_ratio, h = 0.5;
+  const double lc = std::pow(E * h * h * h / (12 * (1 - nu * nu) * o.water.density_kg_m3 * o.water.gravity_mps2), 0.25);
+  ASSERT_GE(b["pieces"].get<int>(), 3) << b.dump();
+  const double median = b["median_m"].get<double>();
+  std::printf("[measured] %d pieces, break length median %.2f m = %.2f l_c = %.1f h\n", b["pieces"].get<int>(), median,
+              median / lc, median / h);
+  EXPECT_GT(median, 0.3 * lc);
+  EXPECT_LT(median, 0.8 * lc);
+  EXPECT_NEAR(b["period_over_h_per_v"].get<double>(), median / h, 1e-12);
+}
+
 TEST(Structure, TheSameBitsOnOneThreadAndTwo) {
   auto loads = [](int threads) {
     SimulateOptions o = drifting_sheet(0.5, 0.3);
