@@ -1,10 +1,10 @@
 // Structures in drifting ice (issue #34): a vertical cylinder crushing a level ice sheet at the crushing pressure over
 // its width and clearing exactly the ice it sweeps (geometry by hand), the momentum a fixed structure carries against
 // the ice's (a momentum budget in a vacuum), an upward-breaking cone bending the sheet up and being pushed down
-// (PHYSICS.md §8.2.5's sign), a moored body's offset under a steady pull against §8.4.1's worked catenary figures, a
-// DP body back at its station within its thrust limits (§8.4.2), structures beside the vessel (each carrying its
-// floe's momentum, its parts' forces adding up; a moored one at the catenary's offset), the same bits on one thread
-// and two, and bad input named.
+// (PHYSICS.md §8.2.5's sign) into pieces of §8.2.4's 0.3-0.8 l_c (its break length), a moored body's offset under a
+// steady pull against §8.4.1's worked catenary figures, a DP body back at its station within its thrust limits
+// (§8.4.2), structures beside the vessel (each carrying its floe's momentum, its parts' forces adding up; a moored one
+// at the catenary's offset), the same bits on one thread and two, and bad input named.
 #include <gtest/gtest.h>
 
 #include <cmath>
