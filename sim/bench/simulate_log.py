@@ -1,0 +1,17 @@
+"""What floesim-simulate prints as it runs, read back by the bench scripts: its progress lines (one per tenth of
+the run) and its closing line of steps, wall time and speed. Standard library only."""
+import re
+
+PROGRESS = re.compile(r't = ([0-9.]+) s\s+\(\s*([0-9]+) %, ([0-9.]+) s wall, awake floes ([0-9]+), contacts ([0-9]+)\)')
+TOTAL = re.compile(r'steps ([0-9]+), wall ([0-9.]+) s, ([0-9.]+) ms/step, ([0-9.]+) simulated s per wall s')
+
+
+def progress(text):
+    """The progress lines as (simulated s, wall s since the start, awake floes, contacts), in order."""
+    return [(float(m.group(1)), float(m.group(3)), int(m.group(4)), int(m.group(5))) for m in PROGRESS.finditer(text)]
+
+
+def total(text):
+    """(steps, wall s, ms per step, simulated s per wall s) of the closing line, or None if it is absent."""
+    m = TOTAL.search(text)
+    return (int(m.group(1)), float(m.group(2)), float(m.group(3)), float(m.group(4))) if m else None
