@@ -601,11 +601,10 @@ void World::stage_sleep() {
   // has no astern. A body is frozen when it is far astern of every hull body.
   const int hulls = model_.hull_count();
   std::vector<Vec3> ahead(hulls, Vec3::Zero());  // zero: this hull has no astern (nothing is astern of all)
-  std::vector<char> ship(hulls, 0);
+  const int ship = model_.settings.vessel.station_keeping.held() ? -1 : model_.vessel;  // the hull body that sails
   const Vec3 through_ice = -Vec3(model_.frame_velocity.x(), model_.frame_velocity.y(), 0);
   for (int hb = 0; hb < hulls; ++hb) {
-    ship[hb] = hb == model_.vessel && !model_.settings.vessel.station_keeping.held();
-    if (ship[hb]) ahead[hb] = state_.orientation[hb] * Vec3::UnitX();
+    if (hb == ship) ahead[hb] = state_.orientation[hb] * Vec3::UnitX();
     else if (through_ice.norm() > 0) ahead[hb] = through_ice.normalized();
   }
   auto far_astern = [&](int b) {
@@ -613,7 +612,7 @@ void World::stage_sleep() {
       const Vec3 d = state_.position[b] - state_.position[hb];
       const double behind = -d.dot(ahead[hb]);
       if (ahead[hb].squaredNorm() == 0 || behind <= 0) return false;
-      if ((ship[hb] ? d.head<2>().norm() : behind) <= s.freeze_astern_m) return false;
+      if ((hb == ship ? d.head<2>().norm() : behind) <= s.freeze_astern_m) return false;
     }
     return true;
   };
