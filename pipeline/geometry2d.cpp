@@ -235,9 +235,20 @@ std::vector<std::array<int, 3>> ear_clip(const Polygon& p) {
   return tris;
 }
 
-// Ear clipping, then Hertel-Mehlhorn merging of the diagonals, longest first (at most 4x the fewest pieces): the
-// pieces of CCW ring p, which is not convex, as index rings.
-std::vector<std::vector<int>> hertel_mehlhorn(const Polygon& p) {
+}  // namespace
+
+std::vector<Polygon> convex_decompose(const Polygon& in) {
+  Polygon p;
+  for (const Vec2& v : in)
+    if (p.empty() || v != p.back()) p.push_back(v);
+  while (p.size() > 1 && p.front() == p.back()) p.pop_back();
+  FLOESIM_REQUIRE(p.size() >= 3, "convex_decompose: a polygon needs at least 3 distinct vertices, got ", p.size());
+  for (const Vec2& v : p) FLOESIM_REQUIRE(v.allFinite(), "convex_decompose: polygon has a non-finite vertex");
+  const double area = signed_area(p);
+  FLOESIM_REQUIRE(area != 0, "convex_decompose: polygon has zero area");
+  if (area < 0) std::reverse(p.begin(), p.end());  // tolerate clockwise input; pieces come back CCW
+  if (is_convex(p)) return {p};
+
   constexpr double kTol = 1e-12;  // is_convex's default, so every piece passes is_convex(piece)
   const auto tris = ear_clip(p);
 
@@ -292,292 +303,15 @@ std::vector<std::vector<int>> hertel_mehlhorn(const Polygon& p) {
     alive[Q] = false;
   }
 
-  std::vector<std::vector<int>> pieces;
-  for (size_t i = 0; i < ring.size(); ++i)
-    if (alive[i]) pieces.push_back(std::move(ring[i]));
-  return pieces;
-}
-
-// The fewest convex pieces by diagonals (no new vertices), a branch and bound. Pieces cut by a set of non-crossing
-// diagonals are convex exactly when at every reflex vertex the diagonals there cut its interior angle into wedges
-// that turn left (as is_convex tests a piece's corner); a convex vertex needs no diagonal, and a diagonal between two
-// convex vertices can always be removed (the two wedges it parts make one convex wedge), so the search takes only
-// diagonals at reflex vertices. It resolves the first unresolved reflex vertex by each diagonal into its first
-// wedge that turns right, in turn (some diagonal must go there), those that also resolve their other end first; one
-// diagonal resolves at most its two ends, so d chosen and u reflex vertices unresolved need d + ceil(u / 2)
-// diagonals at least, and a branch that cannot beat the best found is left. The search stops after `budget` nodes
-// with the best found (Hertel-Mehlhorn's count to beat first), so a polygon with many reflex vertices costs bounded
-// time; below that, the count is the fewest (Keil's minimum convex partition without Steiner points).
-class FewestDiagonals {
- public:
-  FewestDiagonals(const Polygon& p, double turn_tol) : p_(p), n_(static_cast<int>(p.size())), tol_(turn_tol) {
-    interior_.resize(n_);
-    reflex_.assign(n_, 0);
-    at_.resize(n_);
-    for (int v = 0; v < n_; ++v) {
-      const Vec2& a = p_[(v + n_ - 1) % n_];
-      const Vec2& c = p_[(v + 1) % n_];
-      interior_[v] = angle_at(v, a);
-      reflex_[v] = turn(a, p_[v], c) < -tol_;
-    }
-    // Every vertex within 1e-9 of the polygon's size of a diagonal blocks it (a pixel outline's collinear runs).
-    Vec2 lo = p_[0], hi = p_[0];
-    for (const Vec2& q : p_) lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
-    near_ = 1e-9 * (hi - lo).norm();
-    candidates_.resize(n_);
-    for (int v = 0; v < n_; ++v) {
-      if (!reflex_[v]) continue;
-      for (int w = 0; w < n_; ++w)
-        if (is_diagonal(v, w)) candidates_[v].push_back({w, angle_at(v, p_[w])});
-    }
-  }
-
-  // Searches for fewer than `limit` diagonals within `budget` nodes; true and the diagonals if it found them.
-  bool search(int limit, long budget, std::vector<std::pair<int, int>>& out) {
-    best_count_ = limit;
-    budget_ = budget;
-    nodes_ = 0;
-    found_ = false;
-    chosen_.clear();
-    descend();
-    if (found_) out = best_;
-    return found_;
-  }
-
-  const Vec2& vertex(int i) const { return p_[i]; }
-
-  // The angle of the direction from vertex v to point q, counter-clockwise from v's outgoing edge, in [0, 2 pi).
-  double angle_at(int v, const Vec2& q) const {
-    const Vec2 e = p_[(v + 1) % n_] - p_[v], d = q - p_[v];
-    const double t = std::atan2(cross(e, d), e.dot(d));
-    return t < 0 ? t + 2 * kPi : t;
-  }
-
- private:
-  struct Candidate {
-    int w;
-    double angle;  // at v
-  };
-
-  // v-w lies inside the polygon: it leaves both ends into their interior angles, crosses no edge and passes no
-  // other vertex (within near_).
-  bool is_diagonal(int v, int w) const {
-    if (w == v || w == (v + 1) % n_ || v == (w + 1) % n_) return false;
-    constexpr double kAngleTol = 1e-9;
-    const double av = angle_at(v, p_[w]), aw = angle_at(w, p_[v]);
-    if (!(av > kAngleTol && av < interior_[v] - kAngleTol && aw > kAngleTol && aw < interior_[w] - kAngleTol))
-      return false;
-    const Vec2 &s0 = p_[v], &s1 = p_[w];
-    for (int u = 0; u < n_; ++u) {
-      const int u1 = (u + 1) % n_;
-      if (u != v && u != w && point_segment_distance(p_[u], s0, s1) <= near_) return false;
-      if (u == v || u == w || u1 == v || u1 == w) continue;
-      if (segments_cross(s0, s1, p_[u], p_[u1])) return false;
-    }
-    return true;
-  }
-  // The open segments cross (end points on the other segment are blocked separately).
-  static bool segments_cross(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
-    const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a), d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);
-    return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
-  }
-  bool crosses_chosen(int v, int w) const {
-    for (const auto& [a, b] : chosen_)
-      if (a != v && a != w && b != v && b != w && segments_cross(p_[v], p_[w], p_[a], p_[b])) return true;
-    return false;
-  }
-
-  // The first wedge at reflex vertex v (between consecutive diagonals, counter-clockwise from the outgoing edge)
-  // that turns right, as its bounding angles; false if v is resolved. `extra` is a diagonal end to count as chosen
-  // (-1: none).
-  bool open_wedge(int v, int extra, double& from, double& to) const {
-    // The wedge's sides: the outgoing edge (angle 0), the chosen diagonals' other ends, the incoming edge.
-    int ends[64];
-    double angles[64];
-    int k = 0;
-    ends[k] = (v + 1) % n_, angles[k++] = 0;
-    auto add = [&](int w) {
-      if (k >= 63) return;
-      const double a = angle_at(v, p_[w]);
-      int i = k++;
-      for (; i > 1 && angles[i - 1] > a; --i) ends[i] = ends[i - 1], angles[i] = angles[i - 1];
-      ends[i] = w, angles[i] = a;
-    };
-    for (int w : at_[v]) add(w);
-    if (extra >= 0) add(extra);
-    ends[k] = (v + n_ - 1) % n_, angles[k++] = interior_[v];
-    for (int i = 0; i + 1 < k; ++i) {
-      // The piece's corner at v runs from the side at angles[i + 1] in, to the side at angles[i] out: is_convex's
-      // turn, bit for bit (cross(dA, dB) = cross(v - b, a - v)).
-      const Vec2 da = p_[ends[i]] - p_[v], db = p_[ends[i + 1]] - p_[v];
-      if (cross(da, db) < -tol_ || angles[i + 1] - angles[i] > 1.5 * kPi) {
-        from = angles[i], to = angles[i + 1];
-        return true;
-      }
-    }
-    return false;
-  }
-
-  struct Option {
-    int rank, w;
-    double length2;
-  };
-  // The diagonals from reflex vertex v into its open wedge (from, to) that cross no chosen one, those resolving both
-  // ends first, then those resolving one, shortest first (a local pair leaves the rest of the polygon free).
-  void options_at(int v, double from, double to, std::vector<Option>& options) const {
-    options.clear();
-    for (const Candidate& c : candidates_[v]) {
-      if (!(c.angle > from && c.angle < to)) continue;
-      if (std::find(at_[v].begin(), at_[v].end(), c.w) != at_[v].end()) continue;
-      if (crosses_chosen(v, c.w)) continue;
-      double f, t;
-      int rank = 2;
-      if (!open_wedge(v, c.w, f, t)) --rank;
-      if (reflex_[c.w] && open_wedge(c.w, -1, f, t) && !open_wedge(c.w, v, f, t)) --rank;
-      options.push_back({rank, c.w, (p_[c.w] - p_[v]).squaredNorm()});
-    }
-    std::stable_sort(options.begin(), options.end(), [](const Option& x, const Option& y) {
-      return x.rank != y.rank ? x.rank < y.rank : x.length2 < y.length2;
-    });
-  }
-
-  // One node: branches on the unresolved reflex vertex with the fewest options (the most constrained first; ties
-  // by index), over its options.
-  void descend() {
-    if (++nodes_ > budget_) return;
-    int unresolved = 0;
-    for (int v = 0; v < n_; ++v) {
-      double f, t;
-      if (reflex_[v] && open_wedge(v, -1, f, t)) ++unresolved;
-    }
-    const int d = static_cast<int>(chosen_.size());
-    if (unresolved == 0) {
-      if (d < best_count_) best_count_ = d, best_ = chosen_, found_ = true;
-      return;
-    }
-    if (d + (unresolved + 1) / 2 >= best_count_) return;
-    int branch = -1;
-    std::vector<Option> options, trial;
-    for (int v = 0; v < n_; ++v) {
-      double f, t;
-      if (!reflex_[v] || !open_wedge(v, -1, f, t)) continue;
-      options_at(v, f, t, trial);
-      if (branch < 0 || trial.size() < options.size()) branch = v, options.swap(trial);
-      if (options.empty()) return;  // a vertex no diagonal can resolve any more: a dead end
-    }
-    for (const Option& o : options) {
-      chosen_.push_back({branch, o.w});
-      at_[branch].push_back(o.w);
-      at_[o.w].push_back(branch);
-      descend();
-      at_[o.w].pop_back();
-      at_[branch].pop_back();
-      chosen_.pop_back();
-      if (nodes_ > budget_) return;
-    }
-  }
-
-  const Polygon& p_;
-  const int n_;
-  const double tol_;
-  double near_ = 0;
-  std::vector<double> interior_;
-  std::vector<uint8_t> reflex_;
-  std::vector<std::vector<Candidate>> candidates_;  // per reflex vertex: its diagonals
-  std::vector<std::vector<int>> at_;                // per vertex: the other ends of the chosen diagonals there
-  std::vector<std::pair<int, int>> chosen_, best_;
-  int best_count_ = 0;
-  long nodes_ = 0, budget_ = 0;
-  bool found_ = false;
-};
-
-// Ring `whole` (0..n-1) cut along the diagonals into index rings: each diagonal splits the ring that holds it
-// (the one whose corner at v the diagonal enters).
-std::vector<std::vector<int>> cut_along(const FewestDiagonals& f, int n, const std::vector<std::pair<int, int>>& cuts) {
-  std::vector<std::vector<int>> rings(1);
-  for (int i = 0; i < n; ++i) rings[0].push_back(i);
-  for (const auto& [v, w] : cuts) {
-    for (size_t r = 0; r < rings.size(); ++r) {
-      std::vector<int>& ring = rings[r];
-      const auto iv = std::find(ring.begin(), ring.end(), v);
-      const auto iw = std::find(ring.begin(), ring.end(), w);
-      if (iv == ring.end() || iw == ring.end()) continue;
-      const size_t m = ring.size(), jv = iv - ring.begin(), jw = iw - ring.begin();
-      const int next = ring[(jv + 1) % m], prev = ring[(jv + m - 1) % m];
-      const double aw = f.angle_at(v, f.vertex(w));
-      if (!(aw > f.angle_at(v, f.vertex(next)) && aw < f.angle_at(v, f.vertex(prev)))) continue;
-      std::vector<int> one, two;
-      for (size_t k = jv;; k = (k + 1) % m) {
-        one.push_back(ring[k]);
-        if (k == jw) break;
-      }
-      for (size_t k = jw;; k = (k + 1) % m) {
-        two.push_back(ring[k]);
-        if (k == jv) break;
-      }
-      ring = std::move(one);
-      rings.push_back(std::move(two));
-      break;
-    }
-  }
-  return rings;
-}
-
-// The index rings as polygons of p's vertices.
-std::vector<Polygon> as_polygons(const Polygon& p, const std::vector<std::vector<int>>& rings) {
   std::vector<Polygon> pieces;
-  for (const std::vector<int>& ring : rings) {
+  for (size_t i = 0; i < ring.size(); ++i) {
+    if (!alive[i]) continue;
     Polygon piece;
-    for (int k : ring) piece.push_back(p[k]);
+    for (int k : ring[i]) piece.push_back(p[k]);
     pieces.push_back(std::move(piece));
   }
   return pieces;
 }
-
-}  // namespace
-
-std::vector<Polygon> convex_decompose(const Polygon& in) {
-  Polygon p;
-  for (const Vec2& v : in)
-    if (p.empty() || v != p.back()) p.push_back(v);
-  while (p.size() > 1 && p.front() == p.back()) p.pop_back();
-  FLOESIM_REQUIRE(p.size() >= 3, "convex_decompose: a polygon needs at least 3 distinct vertices, got ", p.size());
-  for (const Vec2& v : p) FLOESIM_REQUIRE(v.allFinite(), "convex_decompose: polygon has a non-finite vertex");
-  const double area = signed_area(p);
-  FLOESIM_REQUIRE(area != 0, "convex_decompose: polygon has zero area");
-  if (area < 0) std::reverse(p.begin(), p.end());  // tolerate clockwise input; pieces come back CCW
-  if (is_convex(p)) return {p};
-  constexpr double kTol = 1e-12;  // is_convex's default, so every piece passes is_convex(piece)
-  std::vector<std::vector<int>> rings = hertel_mehlhorn(p);
-  // One diagonal resolves at most two reflex vertices, so r of them need ceil(r / 2) + 1 pieces at least: there
-  // Hertel-Mehlhorn's pieces are the fewest. Else the search for fewer; its pieces must keep the contract as
-  // Hertel-Mehlhorn's do (convex to is_convex, no sliver, tiling the polygon), and a set that does not, to round-off,
-  // is not taken.
-  int reflex = 0;
-  for (size_t i = 0; i < p.size(); ++i)
-    reflex += turn(p[(i + p.size() - 1) % p.size()], p[i], p[(i + 1) % p.size()]) < -kTol;
-  if (static_cast<int>(rings.size()) <= (reflex + 1) / 2 + 1) return as_polygons(p, rings);
-  FewestDiagonals fewest(p, kTol);
-  std::vector<std::pair<int, int>> cuts;
-  constexpr long kSearchNodes = 2000;
-  if (fewest.search(static_cast<int>(rings.size()) - 1, kSearchNodes, cuts)) {
-    std::vector<std::vector<int>> cut = cut_along(fewest, static_cast<int>(p.size()), cuts);
-    bool ok = cut.size() == cuts.size() + 1;
-    double sum = 0;
-    for (size_t i = 0; i < cut.size() && ok; ++i) {
-      Polygon piece;
-      for (int k : cut[i]) piece.push_back(p[k]);
-      double perimeter = 0;
-      for (size_t k = 0; k < piece.size(); ++k) perimeter += (piece[(k + 1) % piece.size()] - piece[k]).norm();
-      const double a = signed_area(piece);
-      ok = piece.size() >= 3 && is_convex(piece, kTol) && a > 1e-9 * perimeter * perimeter;
-      sum += a;
-    }
-    if (ok && std::abs(sum - std::abs(area)) <= 1e-9 * std::abs(area)) rings = std::move(cut);
-  }
-  return as_polygons(p, rings);
-}
-
 
 }  // namespace floesim
 

@@ -27,10 +27,8 @@ std::pair<int, int> find_self_intersection(const Polygon& p);
 bool is_convex(const Polygon& p, double tol = 1e-12);
 // Removes repeated vertices and vertices on a straight line (within tol metres of the chord).
 Polygon clean_polygon(const Polygon& p, double tol = 1e-9);
-// Splits a simple CCW polygon into convex CCW pieces that tile it exactly, cut along diagonals (no new vertices): the
-// fewest such pieces, found by a bounded branch and bound over the diagonals at reflex vertices, or where that search
-// ends without a better set (thousands of nodes: many reflex vertices) Hertel-Mehlhorn's (ear clipping, then merging
-// of diagonals: at most 4x the fewest). A convex input comes back whole.
+// Splits a simple CCW polygon into convex CCW pieces that tile it exactly (ear-clipping triangulation, then
+// Hertel-Mehlhorn merging of diagonals: at most 4x the optimal number of pieces). A convex input comes back whole.
 std::vector<Polygon> convex_decompose(const Polygon& ccw_simple_polygon);
 
 // ---- Cutting floes (Boost.Geometry inside; no Boost type appears here) ----
