@@ -9,6 +9,7 @@
 #include <fcl/narrowphase/collision.h>
 #include <fcl/narrowphase/collision_object.h>
 
+#include "pipeline/error.h"
 #include "sim/geometry/polygon3d.h"
 #include "sim/engine/parallel.h"
 
@@ -33,33 +34,46 @@ struct PartWorld {
   std::vector<Vec3> v;        // vertices
   std::vector<Vec3> n;        // face normals
   std::vector<double> d;      // face plane offsets n.x
-  std::vector<Vec3> face_lo, face_hi;  // box of each face
   Vec3 lo, hi;                // exact box
 };
 
-// Places part cp at (x, R): world vertices, face normals and plane offsets, exact box.
-void transform_part(const ConvexPart& cp, const Vec3& x, const Mat3& R, PartWorld& w) {
-  w.v.resize(cp.vertices.size());
-  w.n.resize(cp.faces.size());
-  w.d.resize(cp.faces.size());
-  w.face_lo.resize(cp.faces.size());
-  w.face_hi.resize(cp.faces.size());
+// The parts' local geometry as placing them reads it: vertices, face normals and each face's first vertex, in
+// arrays shared by all parts, part after part, so that placing the awake parts (every one, every step) reads memory
+// in order instead of chasing each part's own vectors (and a face's vertex list for its first vertex).
+struct LocalParts {
+  std::vector<int> v_first{0}, f_first{0};  // part p's vertices are v[v_first[p], v_first[p + 1]); faces likewise
+  std::vector<Vec3> v, n;
+  std::vector<int> anchor;  // per face: its first vertex (the part's index)
+  void append(const ConvexPart& cp) {
+    v.insert(v.end(), cp.vertices.begin(), cp.vertices.end());
+    n.insert(n.end(), cp.face_normal.begin(), cp.face_normal.end());
+    for (const auto& f : cp.faces) anchor.push_back(f[0]);
+    v_first.push_back(static_cast<int>(v.size()));
+    f_first.push_back(static_cast<int>(n.size()));
+  }
+};
+
+// Places part p of `local` at (x, R): world vertices, face normals and plane offsets, exact box. Every awake part is
+// placed every step, most of them to be boxed by the broad phase only: what the narrow phase alone needs (each
+// face's box) is computed where it is used.
+void transform_part(const LocalParts& local, int p, const Vec3& x, const Mat3& R, PartWorld& w) {
+  const Vec3* lv = local.v.data() + local.v_first[p];
+  const Vec3* ln = local.n.data() + local.f_first[p];
+  const int* anchor = local.anchor.data() + local.f_first[p];
+  const size_t nv = static_cast<size_t>(local.v_first[p + 1] - local.v_first[p]);
+  const size_t nf = static_cast<size_t>(local.f_first[p + 1] - local.f_first[p]);
+  w.v.resize(nv);
+  w.n.resize(nf);
+  w.d.resize(nf);
   Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-  for (size_t i = 0; i < cp.vertices.size(); ++i) {
-    w.v[i] = x + R * cp.vertices[i];
+  for (size_t i = 0; i < nv; ++i) {
+    w.v[i] = x + R * lv[i];
     lo = lo.cwiseMin(w.v[i]);
     hi = hi.cwiseMax(w.v[i]);
   }
-  for (size_t f = 0; f < cp.faces.size(); ++f) {
-    w.n[f] = R * cp.face_normal[f];
-    w.d[f] = w.n[f].dot(w.v[cp.faces[f][0]]);
-    Vec3 flo = Vec3::Constant(1e300), fhi = Vec3::Constant(-1e300);
-    for (int i : cp.faces[f]) {
-      flo = flo.cwiseMin(w.v[i]);
-      fhi = fhi.cwiseMax(w.v[i]);
-    }
-    w.face_lo[f] = flo;
-    w.face_hi[f] = fhi;
+  for (size_t f = 0; f < nf; ++f) {
+    w.n[f] = R * ln[f];
+    w.d[f] = w.n[f].dot(w.v[anchor[f]]);
   }
   w.lo = lo;
   w.hi = hi;
@@ -132,7 +146,12 @@ void clip_faces(const ConvexPart& P, const PartWorld& pw, const Vec3& tp, const 
   // Q's box in P's placement (P's faces' boxes are where P is, shifted by tp).
   const Vec3 qlo = qw.lo + tq - tp - Vec3::Constant(kBoxMargin), qhi = qw.hi + tq - tp + Vec3::Constant(kBoxMargin);
   for (size_t f = 0; f < P.faces.size(); ++f) {
-    if ((pw.face_lo[f].array() > qhi.array()).any() || (pw.face_hi[f].array() < qlo.array()).any()) continue;
+    Vec3 flo = Vec3::Constant(1e300), fhi = Vec3::Constant(-1e300);
+    for (int i : P.faces[f]) {
+      flo = flo.cwiseMin(pw.v[i]);
+      fhi = fhi.cwiseMax(pw.v[i]);
+    }
+    if ((flo.array() > qhi.array()).any() || (fhi.array() < qlo.array()).any()) continue;
     if (second_side) {
       const double df = pw.d[f] + pw.n[f].dot(shift_p);
       bool coplanar = false;
@@ -448,6 +467,7 @@ struct CollisionWorld::Impl {
   const Model& model;
   std::vector<std::shared_ptr<fcl::Convexd>> shapes;
   std::vector<std::unique_ptr<PartObject>> objects;
+  LocalParts local;
   std::vector<PartWorld> world;
   // Two trees (Box2D's static/dynamic split): parts of sleeping bodies do not move and are never paired with each
   // other, so the per-step cost scales with the awake bodies. The trees give the awake x sleeping pairs; the awake
@@ -683,8 +703,11 @@ struct CollisionWorld::Impl {
     objects.resize(np);
     world.resize(np);
     box_changed.resize(np, 0);
+    FLOESIM_REQUIRE(static_cast<size_t>(first) + 1 == local.v_first.size(), "internal: parts ", first, " on added to a ",
+                    "collision world of ", local.v_first.size() - 1, " parts (parts are only appended)");
     for (size_t p = first; p < np; ++p) {
       const ConvexPart& cp = model.parts[p];
+      local.append(cp);
       auto verts = std::make_shared<std::vector<Vec3>>(cp.vertices);
       auto faces = std::make_shared<std::vector<int>>();
       for (const auto& f : cp.faces) {
@@ -694,18 +717,17 @@ struct CollisionWorld::Impl {
       shapes[p] = std::make_shared<fcl::Convexd>(verts, static_cast<int>(cp.faces.size()), faces);
       shapes[p]->computeLocalAABB();
       objects[p] = std::make_unique<PartObject>(shapes[p], static_cast<int>(p));
-      place_part(static_cast<int>(p), state.position[cp.body], state.orientation[cp.body]);
+      place_part(static_cast<int>(p), state.position[cp.body], state.orientation[cp.body].toRotationMatrix());
       // The object's first box is FCL's, of the part at the origin: always replace it with the placed fat box.
       objects[p]->set_aabb(world[p].lo - Vec3::Constant(kTreeMargin), world[p].hi + Vec3::Constant(kTreeMargin));
     }
   }
 
-  // Moves part p to the pose (x, q). Returns true when its box in the tree must change: the tree holds a box
+  // Moves part p to the pose (x, R). Returns true when its box in the tree must change: the tree holds a box
   // enlarged by kTreeMargin (Box2D's fat boxes), so that small motions do not re-insert the leaf every step.
-  bool place_part(int p, const Vec3& x, const Quat& q) {
+  bool place_part(int p, const Vec3& x, const Mat3& R) {
     PartWorld& w = world[p];
-    const Mat3 R = q.toRotationMatrix();
-    transform_part(model.parts[p], x, R, w);
+    transform_part(local, p, x, R, w);
     const Vec3 lo = w.lo, hi = w.hi;
     objects[p]->setTransform(R, x);
     const fcl::AABBd& fat = objects[p]->getAABB();
@@ -1076,8 +1098,9 @@ void CollisionWorld::update_bodies(const State& state, const std::vector<int>& m
       const int b = moved[i];
       if (m.tree_of[b] == Impl::kRemoved) continue;
       const Body& body = m.model.bodies[b];
+      const Mat3 R = state.orientation[b].toRotationMatrix();
       for (int p = body.first_part; p < body.first_part + body.part_count; ++p)
-        m.box_changed[p] = m.place_part(p, state.position[b], state.orientation[b]);
+        m.box_changed[p] = m.place_part(p, state.position[b], R);
     }
   });
   for (int b : moved) {
@@ -1174,9 +1197,12 @@ void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out
 
 ContactPatch convex_overlap(const ConvexPart& pa, const Vec3& xa, const Quat& qa, const ConvexPart& pb,
                             const Vec3& xb, const Quat& qb, PatchSide side, double eps) {
+  LocalParts local;
+  local.append(pa);
+  local.append(pb);
   PartWorld wa, wb;
-  transform_part(pa, xa, qa.toRotationMatrix(), wa);
-  transform_part(pb, xb, qb.toRotationMatrix(), wb);
+  transform_part(local, 0, xa, qa.toRotationMatrix(), wa);
+  transform_part(local, 1, xb, qb.toRotationMatrix(), wb);
   PatchScratch ps;
   PatchMember m;
   m.A = &pa, m.wa = &wa, m.B = &pb, m.wb = &wb;
