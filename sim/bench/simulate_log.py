@@ -4,6 +4,7 @@ import re
 
 PROGRESS = re.compile(r't = ([0-9.]+) s\s+\(\s*([0-9]+) %, ([0-9.]+) s wall, awake floes ([0-9]+), contacts ([0-9]+)\)')
 TOTAL = re.compile(r'steps ([0-9]+), wall ([0-9.]+) s, ([0-9.]+) ms/step, ([0-9.]+) simulated s per wall s')
+PEAK = re.compile(r'^peak memory ([0-9.]+) MB$', re.MULTILINE)
 
 
 def progress(text):
@@ -15,3 +16,9 @@ def total(text):
     """(steps, wall s, ms per step, simulated s per wall s) of the closing line, or None if it is absent."""
     m = TOTAL.search(text)
     return (int(m.group(1)), float(m.group(2)), float(m.group(3)), float(m.group(4))) if m else None
+
+
+def peak_memory_mb(text):
+    """The process's peak resident memory (MB) it reports at its end, or None if it is absent."""
+    m = PEAK.search(text)
+    return float(m.group(1)) if m else None
