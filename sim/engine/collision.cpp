@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 
 #include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
 #include <fcl/geometry/shape/convex.h>
@@ -29,51 +30,81 @@ class PartObject : public fcl::CollisionObjectd {
   int part;
 };
 
-// A part in world coordinates (refreshed when its body moves).
+// A part in world coordinates (refreshed when its body moves): its arrays in PartArrays.
 struct PartWorld {
-  std::vector<Vec3> v;        // vertices
-  std::vector<Vec3> n;        // face normals
-  std::vector<double> d;      // face plane offsets n.x
+  Vec3* v = nullptr;          // vertices (nv)
+  Vec3* n = nullptr;          // face normals (nf)
+  double* d = nullptr;        // face plane offsets n.x (nf)
+  int nv = 0, nf = 0;
   Vec3 lo, hi;                // exact box
 };
 
-// The parts' local geometry as placing them reads it: vertices, face normals and each face's first vertex, in
-// arrays shared by all parts, part after part, so that placing the awake parts (every one, every step) reads memory
-// in order instead of chasing each part's own vectors (and a face's vertex list for its first vertex).
-struct LocalParts {
-  std::vector<int> v_first{0}, f_first{0};  // part p's vertices are v[v_first[p], v_first[p + 1]); faces likewise
-  std::vector<Vec3> v, n;
-  std::vector<int> anchor;  // per face: its first vertex (the part's index)
-  void append(const ConvexPart& cp) {
-    v.insert(v.end(), cp.vertices.begin(), cp.vertices.end());
-    n.insert(n.end(), cp.face_normal.begin(), cp.face_normal.end());
-    for (const auto& f : cp.faces) anchor.push_back(f[0]);
-    v_first.push_back(static_cast<int>(v.size()));
-    f_first.push_back(static_cast<int>(n.size()));
+// The parts' geometry as placing them reads and writes it: local vertices, face normals and each face's first
+// vertex, and the world vertices, normals and plane offsets, in arrays shared by the parts added together (all of the
+// model's at the start, then each fracture's pieces), part after part. Placing the awake parts (every one, every
+// step) then reads and writes memory in order instead of chasing each part's own vectors (and a face's vertex list
+// for its first vertex). A batch's arrays are never moved or regrown once made (growing them at every fracture left
+// the old copies in the process's memory), so the parts' pointers into them stay valid.
+struct PartGeometry {
+  const Vec3* v;       // local vertices (nv)
+  const Vec3* n;       // local face normals (nf)
+  const int* anchor;   // per face: its first vertex
+};
+class PartArrays {
+ public:
+  // Adds parts[first...] as one batch; `views` (one per part) get their world arrays.
+  void add(const std::vector<ConvexPart>& parts, size_t first, std::vector<PartWorld>& views) {
+    size_t nv = 0, nf = 0;
+    for (size_t p = first; p < parts.size(); ++p) nv += parts[p].vertices.size(), nf += parts[p].faces.size();
+    Batch& b = *batches_.emplace_back(std::make_unique<Batch>());
+    b.local_v.reserve(nv), b.local_n.reserve(nf), b.anchor.reserve(nf);
+    b.v.resize(nv), b.n.resize(nf), b.d.resize(nf);
+    views.resize(parts.size());
+    size_t iv = 0, jf = 0;
+    for (size_t p = first; p < parts.size(); ++p) {
+      const ConvexPart& cp = parts[p];
+      PartWorld& w = views[p];
+      w.v = b.v.data() + iv, w.n = b.n.data() + jf, w.d = b.d.data() + jf;
+      w.nv = static_cast<int>(cp.vertices.size()), w.nf = static_cast<int>(cp.faces.size());
+      b.local_v.insert(b.local_v.end(), cp.vertices.begin(), cp.vertices.end());
+      b.local_n.insert(b.local_n.end(), cp.face_normal.begin(), cp.face_normal.end());
+      for (const auto& f : cp.faces) b.anchor.push_back(f[0]);
+      iv += cp.vertices.size(), jf += cp.faces.size();
+    }
+    // The local pointers once the batch is complete (its arrays were reserved exactly, so never moved).
+    iv = jf = 0;
+    for (size_t p = first; p < parts.size(); ++p) {
+      local_.push_back({b.local_v.data() + iv, b.local_n.data() + jf, b.anchor.data() + jf});
+      iv += parts[p].vertices.size(), jf += parts[p].faces.size();
+    }
   }
+  const PartGeometry& local(int p) const { return local_[p]; }
+  size_t size() const { return local_.size(); }
+
+ private:
+  struct Batch {
+    std::vector<Vec3> local_v, local_n, v, n;
+    std::vector<int> anchor;
+    std::vector<double> d;
+  };
+  std::vector<std::unique_ptr<Batch>> batches_;
+  std::vector<PartGeometry> local_;
 };
 
-// Places part p of `local` at (x, R): world vertices, face normals and plane offsets, exact box. Every awake part is
-// placed every step, most of them to be boxed by the broad phase only: what the narrow phase alone needs (each
-// face's box) is computed where it is used.
-void transform_part(const LocalParts& local, int p, const Vec3& x, const Mat3& R, PartWorld& w) {
-  const Vec3* lv = local.v.data() + local.v_first[p];
-  const Vec3* ln = local.n.data() + local.f_first[p];
-  const int* anchor = local.anchor.data() + local.f_first[p];
-  const size_t nv = static_cast<size_t>(local.v_first[p + 1] - local.v_first[p]);
-  const size_t nf = static_cast<size_t>(local.f_first[p + 1] - local.f_first[p]);
-  w.v.resize(nv);
-  w.n.resize(nf);
-  w.d.resize(nf);
+// Places a part (its local geometry g) at (x, R) into its view w: world vertices, face normals and plane offsets,
+// exact box. Every awake part is placed every step, most of them to be boxed by the broad phase only: what the
+// narrow phase alone needs (each face's box) is computed where it is used.
+void transform_part(const PartGeometry& g, const Vec3& x, const Mat3& R, PartWorld& w) {
+  const int nv = w.nv, nf = w.nf;
   Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-  for (size_t i = 0; i < nv; ++i) {
-    w.v[i] = x + R * lv[i];
+  for (int i = 0; i < nv; ++i) {
+    w.v[i] = x + R * g.v[i];
     lo = lo.cwiseMin(w.v[i]);
     hi = hi.cwiseMax(w.v[i]);
   }
-  for (size_t f = 0; f < nf; ++f) {
-    w.n[f] = R * ln[f];
-    w.d[f] = w.n[f].dot(w.v[anchor[f]]);
+  for (int f = 0; f < nf; ++f) {
+    w.n[f] = R * g.n[f];
+    w.d[f] = w.n[f].dot(w.v[g.anchor[f]]);
   }
   w.lo = lo;
   w.hi = hi;
@@ -467,8 +498,8 @@ struct CollisionWorld::Impl {
   const Model& model;
   std::vector<std::shared_ptr<fcl::Convexd>> shapes;
   std::vector<std::unique_ptr<PartObject>> objects;
-  LocalParts local;
-  std::vector<PartWorld> world;
+  PartArrays part_arrays;
+  std::vector<PartWorld> world;  // per part: its world geometry (in part_arrays)
   // Two trees (Box2D's static/dynamic split): parts of sleeping bodies do not move and are never paired with each
   // other, so the per-step cost scales with the awake bodies. The trees give the awake x sleeping pairs; the awake
   // x awake pairs come from a grid rebuilt every step (awake_pairs_in_grid).
@@ -701,13 +732,12 @@ struct CollisionWorld::Impl {
     const size_t np = model.parts.size();
     shapes.resize(np);
     objects.resize(np);
-    world.resize(np);
     box_changed.resize(np, 0);
-    FLOESIM_REQUIRE(static_cast<size_t>(first) + 1 == local.v_first.size(), "internal: parts ", first, " on added to a ",
-                    "collision world of ", local.v_first.size() - 1, " parts (parts are only appended)");
+    FLOESIM_REQUIRE(static_cast<size_t>(first) == part_arrays.size(), "internal: parts ", first, " on added to a ",
+                    "collision world of ", part_arrays.size(), " parts (parts are only appended)");
+    part_arrays.add(model.parts, first, world);
     for (size_t p = first; p < np; ++p) {
       const ConvexPart& cp = model.parts[p];
-      local.append(cp);
       auto verts = std::make_shared<std::vector<Vec3>>(cp.vertices);
       auto faces = std::make_shared<std::vector<int>>();
       for (const auto& f : cp.faces) {
@@ -727,7 +757,7 @@ struct CollisionWorld::Impl {
   // enlarged by kTreeMargin (Box2D's fat boxes), so that small motions do not re-insert the leaf every step.
   bool place_part(int p, const Vec3& x, const Mat3& R) {
     PartWorld& w = world[p];
-    transform_part(local, p, x, R, w);
+    transform_part(part_arrays.local(p), x, R, w);
     const Vec3 lo = w.lo, hi = w.hi;
     objects[p]->setTransform(R, x);
     const fcl::AABBd& fat = objects[p]->getAABB();
@@ -845,7 +875,7 @@ struct CollisionWorld::Impl {
     for (size_t f = 0; f < ref.faces.size(); ++f) {
       if (ref.face_internal[f]) continue;  // not a surface of the body
       double s = 1e300;
-      for (size_t i = 0; i < other.v.size() && s > sep; ++i) s = std::min(s, rw.n[f].dot(other.v[i]) - rw.d[f]);
+      for (int i = 0; i < other.nv && s > sep; ++i) s = std::min(s, rw.n[f].dot(other.v[i]) - rw.d[f]);
       if (s > sep) {
         sep = s;
         best = static_cast<int>(f);
@@ -866,7 +896,7 @@ struct CollisionWorld::Impl {
     for (size_t f = 0; f < ref.faces.size(); ++f) {
       if (ref.face_internal[f]) continue;
       bool all_in_front = true;
-      for (size_t i = 0; i < other.v.size() && all_in_front; ++i) all_in_front = rw.n[f].dot(other.v[i]) - rw.d[f] > 0;
+      for (int i = 0; i < other.nv && all_in_front; ++i) all_in_front = rw.n[f].dot(other.v[i]) - rw.d[f] > 0;
       if (all_in_front) return true;
     }
     return false;
@@ -933,13 +963,13 @@ struct CollisionWorld::Impl {
     if (!(nh.squaredNorm() > 0.5)) nh = Vec3::UnitZ();
     {
       double amax = -1e300, amin = 1e300, bmax = -1e300, bmin = 1e300;
-      for (const Vec3& v : wa.v) {
-        const double t = nh.dot(v);
+      for (int i = 0; i < wa.nv; ++i) {
+        const double t = nh.dot(wa.v[i]);
         amax = std::max(amax, t);
         amin = std::min(amin, t);
       }
-      for (const Vec3& v : wb.v) {
-        const double t = nh.dot(v);
+      for (int i = 0; i < wb.nv; ++i) {
+        const double t = nh.dot(wb.v[i]);
         bmax = std::max(bmax, t);
         bmin = std::min(bmin, t);
       }
@@ -1197,12 +1227,13 @@ void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out
 
 ContactPatch convex_overlap(const ConvexPart& pa, const Vec3& xa, const Quat& qa, const ConvexPart& pb,
                             const Vec3& xb, const Quat& qb, PatchSide side, double eps) {
-  LocalParts local;
-  local.append(pa);
-  local.append(pb);
-  PartWorld wa, wb;
-  transform_part(local, 0, xa, qa.toRotationMatrix(), wa);
-  transform_part(local, 1, xb, qb.toRotationMatrix(), wb);
+  const std::vector<ConvexPart> two{pa, pb};
+  PartArrays arrays;
+  std::vector<PartWorld> views;
+  arrays.add(two, 0, views);
+  PartWorld &wa = views[0], &wb = views[1];
+  transform_part(arrays.local(0), xa, qa.toRotationMatrix(), wa);
+  transform_part(arrays.local(1), xb, qb.toRotationMatrix(), wb);
   PatchScratch ps;
   PatchMember m;
   m.A = &pa, m.wa = &wa, m.B = &pb, m.wb = &wb;
