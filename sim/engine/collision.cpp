@@ -733,8 +733,8 @@ struct CollisionWorld::Impl {
     shapes.resize(np);
     objects.resize(np);
     box_changed.resize(np, 0);
-    FLOESIM_REQUIRE(static_cast<size_t>(first) == part_arrays.size(), "internal: parts ", first, " on added to a ",
-                    "collision world of ", part_arrays.size(), " parts (parts are only appended)");
+    FLOESIM_REQUIRE(static_cast<size_t>(first) == part_arrays.size(), "internal: parts from index ", first,
+                    " added to a collision world of ", part_arrays.size(), " parts (parts are only appended)");
     part_arrays.add(model.parts, first, world);
     for (size_t p = first; p < np; ++p) {
       const ConvexPart& cp = model.parts[p];
