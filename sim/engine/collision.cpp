@@ -52,34 +52,25 @@ struct PartGeometry {
 };
 class PartArrays {
  public:
-  // Adds parts[first...] as one batch; `views` (one per part) get their world arrays.
-  void add(const std::vector<ConvexPart>& parts, size_t first, std::vector<PartWorld>& views) {
+  // Appends `parts` as one batch, and their world geometry's views to `views` (one per part, in the same order).
+  void add(const std::vector<const ConvexPart*>& parts, std::vector<PartWorld>& views) {
     size_t nv = 0, nf = 0;
-    for (size_t p = first; p < parts.size(); ++p) nv += parts[p].vertices.size(), nf += parts[p].faces.size();
+    for (const ConvexPart* cp : parts) nv += cp->vertices.size(), nf += cp->faces.size();
     Batch& b = *batches_.emplace_back(std::make_unique<Batch>());
+    // Reserved exactly, so that the pointers taken while they are filled stay valid.
     b.local_v.reserve(nv), b.local_n.reserve(nf), b.anchor.reserve(nf);
     b.v.resize(nv), b.n.resize(nf), b.d.resize(nf);
-    views.resize(parts.size());
-    size_t iv = 0, jf = 0;
-    for (size_t p = first; p < parts.size(); ++p) {
-      const ConvexPart& cp = parts[p];
-      PartWorld& w = views[p];
-      w.v = b.v.data() + iv, w.n = b.n.data() + jf, w.d = b.d.data() + jf;
-      w.nv = static_cast<int>(cp.vertices.size()), w.nf = static_cast<int>(cp.faces.size());
-      b.local_v.insert(b.local_v.end(), cp.vertices.begin(), cp.vertices.end());
-      b.local_n.insert(b.local_n.end(), cp.face_normal.begin(), cp.face_normal.end());
-      for (const auto& f : cp.faces) b.anchor.push_back(f[0]);
-      iv += cp.vertices.size(), jf += cp.faces.size();
-    }
-    // The local pointers once the batch is complete (its arrays were reserved exactly, so never moved).
-    iv = jf = 0;
-    for (size_t p = first; p < parts.size(); ++p) {
+    for (const ConvexPart* cp : parts) {
+      const size_t iv = b.local_v.size(), jf = b.local_n.size();
       local_.push_back({b.local_v.data() + iv, b.local_n.data() + jf, b.anchor.data() + jf});
-      iv += parts[p].vertices.size(), jf += parts[p].faces.size();
+      views.push_back({b.v.data() + iv, b.n.data() + jf, b.d.data() + jf, static_cast<int>(cp->vertices.size()),
+                       static_cast<int>(cp->faces.size()), Vec3::Zero(), Vec3::Zero()});
+      b.local_v.insert(b.local_v.end(), cp->vertices.begin(), cp->vertices.end());
+      b.local_n.insert(b.local_n.end(), cp->face_normal.begin(), cp->face_normal.end());
+      for (const auto& f : cp->faces) b.anchor.push_back(f[0]);
     }
   }
   const PartGeometry& local(int p) const { return local_[p]; }
-  size_t size() const { return local_.size(); }
 
  private:
   struct Batch {
@@ -733,9 +724,11 @@ struct CollisionWorld::Impl {
     shapes.resize(np);
     objects.resize(np);
     box_changed.resize(np, 0);
-    FLOESIM_REQUIRE(static_cast<size_t>(first) == part_arrays.size(), "internal: parts from index ", first,
-                    " added to a collision world of ", part_arrays.size(), " parts (parts are only appended)");
-    part_arrays.add(model.parts, first, world);
+    FLOESIM_REQUIRE(static_cast<size_t>(first) == world.size(), "internal: parts from index ", first,
+                    " added to a collision world of ", world.size(), " parts (parts are only appended)");
+    std::vector<const ConvexPart*> added;
+    for (size_t p = first; p < np; ++p) added.push_back(&model.parts[p]);
+    part_arrays.add(added, world);
     for (size_t p = first; p < np; ++p) {
       const ConvexPart& cp = model.parts[p];
       auto verts = std::make_shared<std::vector<Vec3>>(cp.vertices);
@@ -1227,10 +1220,9 @@ void CollisionWorld::find_contacts(const State& state, std::vector<Contact>& out
 
 ContactPatch convex_overlap(const ConvexPart& pa, const Vec3& xa, const Quat& qa, const ConvexPart& pb,
                             const Vec3& xb, const Quat& qb, PatchSide side, double eps) {
-  const std::vector<ConvexPart> two{pa, pb};
   PartArrays arrays;
   std::vector<PartWorld> views;
-  arrays.add(two, 0, views);
+  arrays.add({&pa, &pb}, views);
   PartWorld &wa = views[0], &wb = views[1];
   transform_part(arrays.local(0), xa, qa.toRotationMatrix(), wa);
   transform_part(arrays.local(1), xb, qb.toRotationMatrix(), wb);
