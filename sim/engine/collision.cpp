@@ -57,6 +57,8 @@ class PartArrays {
     size_t nv = 0, nf = 0;
     for (const ConvexPart* cp : parts) nv += cp->vertices.size(), nf += cp->faces.size();
     Batch& b = *batches_.emplace_back(std::make_unique<Batch>());
+    b.live = static_cast<int>(parts.size());
+    batch_of_.insert(batch_of_.end(), parts.size(), static_cast<int>(batches_.size()) - 1);
     // Reserved exactly, so that the pointers taken while they are filled stay valid.
     b.local_v.reserve(nv), b.local_n.reserve(nf), b.anchor.reserve(nf);
     b.v.resize(nv), b.n.resize(nf), b.d.resize(nf);
@@ -71,14 +73,22 @@ class PartArrays {
     }
   }
   const PartGeometry& local(int p) const { return local_[p]; }
+  // Part p is gone for good (its body broke): once every part of its batch is, the batch's arrays are freed (the
+  // views into them are never read again).
+  void release(int p) {
+    std::unique_ptr<Batch>& b = batches_[batch_of_[p]];
+    if (b && --b->live == 0) b.reset();
+  }
 
  private:
   struct Batch {
     std::vector<Vec3> local_v, local_n, v, n;
     std::vector<int> anchor;
     std::vector<double> d;
+    int live = 0;  // its parts not yet released
   };
   std::vector<std::unique_ptr<Batch>> batches_;
+  std::vector<int> batch_of_;  // per part: its batch
   std::vector<PartGeometry> local_;
 };
 
@@ -1106,7 +1116,15 @@ void CollisionWorld::remove_body(int b) {
   if (m.tree_of[b] == Impl::kRemoved) return;
   auto& tree = m.tree_of[b] == Impl::kAwakeTree ? m.awake_tree : m.sleeping_tree;
   const Body& body = m.model.bodies[b];
-  for (int p = body.first_part; p < body.first_part + body.part_count; ++p) tree.unregisterObject(m.objects[p].get());
+  // A removed body never comes back (fracture gives its pieces new bodies): its parts' FCL objects and shapes (a copy
+  // of each part's geometry, with FCL's edges and neighbours) and, once no part of their batch is left, their arrays
+  // are freed, so that a run's memory follows the ice that exists, not every piece it ever had.
+  for (int p = body.first_part; p < body.first_part + body.part_count; ++p) {
+    tree.unregisterObject(m.objects[p].get());
+    m.objects[p].reset();
+    m.shapes[p].reset();
+    m.part_arrays.release(p);
+  }
   m.tree_of[b] = Impl::kRemoved;
 }
 
