@@ -5,6 +5,7 @@ import re
 PROGRESS = re.compile(r't = ([0-9.]+) s\s+\(\s*([0-9]+) %, ([0-9.]+) s wall, awake floes ([0-9]+), contacts ([0-9]+)\)')
 TOTAL = re.compile(r'steps ([0-9]+), wall ([0-9.]+) s, ([0-9.]+) ms/step, ([0-9.]+) simulated s per wall s')
 PEAK = re.compile(r'^peak memory ([0-9.]+) MB$', re.MULTILINE)
+AWAKE = re.compile(r'^mean awake floes ([0-9.]+),', re.MULTILINE)
 
 
 def progress(text):
@@ -21,4 +22,11 @@ def total(text):
 def peak_memory_mb(text):
     """The process's peak resident memory (MB) it reports at its end, or None if it is absent."""
     m = PEAK.search(text)
+    return float(m.group(1)) if m else None
+
+
+def mean_awake_floes(text):
+    """The mean awake floes per step over the whole run, from its closing lines, or None if they are absent (the
+    summary's mean_awake_floes is over the steady part only)."""
+    m = AWAKE.search(text)
     return float(m.group(1)) if m else None
