@@ -165,4 +165,73 @@ RalstonLoad ralston(const SlopingStructure& s, const StructureIce& ice, const Ru
   return o;
 }
 
+std::vector<std::string> keel_problems(const RidgeKeel& k, const StructureIce& ice) {
+  std::vector<std::string> p;
+  if (!(std::isfinite(k.depth_m) && k.depth_m > 0)) p.push_back(range_text("ridge.keel_depth_m", k.depth_m, "must be > 0"));
+  if (!(k.porosity > 0 && k.porosity < 1)) p.push_back(range_text("ridge.porosity", k.porosity, "must be in (0, 1)"));
+  if (!(std::isfinite(k.cohesion_pa) && k.cohesion_pa >= 0))
+    p.push_back(range_text("ridge.cohesion_pa", k.cohesion_pa, "must be >= 0"));
+  if (!(k.friction_angle_deg > 0 && k.friction_angle_deg < 90))
+    p.push_back(range_text("ridge.friction_angle_deg", k.friction_angle_deg, "must be in (0, 90) deg"));
+  if (!(ice.ice_density_kg_m3 > 0 && ice.water_density_kg_m3 > ice.ice_density_kg_m3))
+    p.push_back(range_text("ice.density_kg_m3", ice.ice_density_kg_m3,
+                           "must be > 0 and below water.density_kg_m3 (a keel floats)"));
+  if (!(std::isfinite(ice.gravity_mps2) && ice.gravity_mps2 > 0))
+    p.push_back(range_text("water.gravity_mps2", ice.gravity_mps2, "must be > 0"));
+  return p;
+}
+
+double keel_unit_weight_npm3(const RidgeKeel& k, const StructureIce& ice) {
+  return (1 - k.porosity) * (ice.water_density_kg_m3 - ice.ice_density_kg_m3) * ice.gravity_mps2;
+}
+
+namespace {
+// F_K's two parts at keel depth h on width w.
+void dolgopolov_parts(double h, double w, double mu, double gamma, double c, double& friction, double& cohesion) {
+  const double three_d = 1 + h / (6 * w);
+  friction = mu * h * w * (h * mu * gamma / 2) * three_d;
+  cohesion = mu * h * w * (2 * c) * three_d;
+}
+}  // namespace
+
+KeelLoad dolgopolov_keel_load(const RidgeKeel& k, double w, const StructureIce& ice) {
+  std::vector<std::string> p = keel_problems(k, ice);
+  if (!(std::isfinite(w) && w > 0)) p.push_back(range_text("structure.waterline_width_m", w, "must be > 0"));
+  throw_if(p, "Dolgopolov's keel load");
+  KeelLoad r;
+  r.unit_weight_npm3 = keel_unit_weight_npm3(k, ice);
+  r.mu_phi = std::tan(rad(45 + k.friction_angle_deg / 2));
+  dolgopolov_parts(k.depth_m, w, r.mu_phi, r.unit_weight_npm3, k.cohesion_pa, r.friction_n, r.cohesion_n);
+  r.force_n = r.friction_n + r.cohesion_n;
+  double f, c;
+  dolgopolov_parts(k.depth_m + w / 2, w, r.mu_phi, r.unit_weight_npm3, k.cohesion_pa, f, c);
+  r.surcharge_bound_n = f + c;
+  return r;
+}
+
+double keel_ship_bound_n(const RidgeKeel& k, double beam, double draught, double consolidated,
+                         const StructureIce& ice) {
+  std::vector<std::string> p = keel_problems(k, ice);
+  if (!(std::isfinite(beam) && beam > 0)) p.push_back(range_text("beam_m", beam, "must be > 0"));
+  if (!(std::isfinite(draught) && draught > 0)) p.push_back(range_text("draught_m", draught, "must be > 0"));
+  if (!(std::isfinite(consolidated) && consolidated >= 0))
+    p.push_back(range_text("ridge.consolidated_thickness_m", consolidated, "must be >= 0"));
+  throw_if(p, "the keel's bound on a ship");
+  const double gamma = keel_unit_weight_npm3(k, ice);
+  const double kp = std::pow(std::tan(rad(45 + k.friction_angle_deg / 2)), 2);
+  const double bottom = std::min(draught, k.depth_m);
+  if (bottom <= consolidated) return 0.0;
+  const double za = k.depth_m - bottom, zb = k.depth_m - consolidated;
+  return beam * (kp * gamma * (zb * zb - za * za) / 2 + 2 * k.cohesion_pa * std::sqrt(kp) * (zb - za));
+}
+
+double keel_sail_area_ratio(const StructureIce& ice) {
+  std::vector<std::string> p;
+  if (!(ice.ice_density_kg_m3 > 0 && ice.water_density_kg_m3 > ice.ice_density_kg_m3))
+    p.push_back(range_text("ice.density_kg_m3", ice.ice_density_kg_m3,
+                           "must be > 0 and below water.density_kg_m3 (a ridge floats)"));
+  throw_if(p, "the keel-to-sail area ratio");
+  return ice.ice_density_kg_m3 / (ice.water_density_kg_m3 - ice.ice_density_kg_m3);
+}
+
 }  // namespace floesim

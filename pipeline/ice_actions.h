@@ -89,4 +89,47 @@ struct RalstonLoad {
 std::vector<std::string> ralston_problems(const SlopingStructure& s, const StructureIce& ice, const Rubble& r);
 RalstonLoad ralston(const SlopingStructure& s, const StructureIce& ice, const Rubble& r);
 
+// ---- §9: ice ridges. A keel of buoyant rubble under a consolidated layer (the layer itself loads a structure as
+// level ice of its thickness h_c: iso_global_crushing, croasdale, ralston; a ship as Lindqvist's level ice).
+struct RidgeKeel {
+  double depth_m = 8;              // h_k: the depth of unconsolidated rubble the structure or bow meets
+  double porosity = 0.3;           // e: macro-porosity of the rubble
+  double cohesion_pa = 5e3;        // c: apparent cohesion of the rubble (freeze bonds)
+  double friction_angle_deg = 30;  // phi: its internal friction angle
+};
+std::vector<std::string> keel_problems(const RidgeKeel& k, const StructureIce& ice);
+
+// The keel's effective unit weight gamma_e = (1 - e)(rho_w - rho_i) g: the net buoyancy of the rubble, with which the
+// vertical effective stress grows upward from the keel's bottom (N/m^3).
+double keel_unit_weight_npm3(const RidgeKeel& k, const StructureIce& ice);
+
+// The keel load on a vertical structure of width w by Dolgopolov et al. (1975), as ISO 19906 adopts it: Rankine's
+// passive pressure on the keel's depth with the 3-D factor,
+//   F_K = mu_phi h_k w (h_k mu_phi gamma_e / 2 + 2 c) (1 + h_k / (6 w)),   mu_phi = tan(45 deg + phi / 2).
+// With the surcharge of the rubble piled in front of the structure, Dolgopolov bounded the design keel depth by
+// h_k + w / 2: surcharge_bound_n is F_K there (PHYSICS.md §9.3, §9.5 check 3).
+struct KeelLoad {
+  double unit_weight_npm3 = 0;  // gamma_e
+  double mu_phi = 0;            // tan(45 deg + phi / 2) = sqrt(K_p)
+  double friction_n = 0;        // the gamma_e (friction) part of F_K
+  double cohesion_n = 0;        // the cohesion part of F_K
+  double force_n = 0;           // F_K(h_k)
+  double surcharge_bound_n = 0;  // F_K(h_k + w / 2)
+};
+KeelLoad dolgopolov_keel_load(const RidgeKeel& k, double width_m, const StructureIce& ice);
+
+// The keel's load on a ship's bow, bounded by Rankine's passive force on the bow's vertical projection (PHYSICS.md
+// §9.4): the rubble between the consolidated layer's bottom (h_c below the waterline) and the shallower of the
+// draught T and the keel's draft H_k, with the effective stress counted from the keel's bottom,
+//   R_keel <= B int_{zeta_a}^{zeta_b} (K_p gamma_e zeta + 2 c sqrt(K_p)) d zeta,
+//   zeta_a = H_k - min(T, H_k), zeta_b = H_k - h_c.
+// An upper bound: a sloping bow pushes the rubble down and aside at less. Here k.depth_m is the keel's draft H_k
+// (from the waterline); 0 when the keel does not reach below the layer within the draught.
+double keel_ship_bound_n(const RidgeKeel& k, double beam_m, double draught_m, double consolidated_m,
+                         const StructureIce& ice);
+
+// The keel-to-sail cross-section ratio of a ridge in hydrostatic balance, the consolidated layer floating freely and
+// keel and sail of one porosity: A_k / A_s = rho_i / (rho_w - rho_i) (7.20 for rho_i = 900, 8.49 for 917).
+double keel_sail_area_ratio(const StructureIce& ice);
+
 }  // namespace floesim

@@ -105,7 +105,55 @@ std::string run_ice_actions(const IceActionsOptions& o, const fs::path& config_f
     throw Error(cfg + ": " + e.what());
   }
 
-  // 2. The mooring: each line at its pretension, the spread's stiffness, the offsets under the loads.
+  // 2. A ridge: the keel per depth (Dolgopolov, and with the surcharge bound h_k + w/2), the consolidated layer as
+  // level ice of thickness h_c by the structure's own method, and their sum F_R = F_C + F_K.
+  nlohmann::json ridge;
+  std::ostringstream ridge_text;
+  if (!o.ridge.keel_depths_m.empty()) {
+    const double w = o.structure.waterline_width_m, hc = o.ridge.consolidated_thickness_m;
+    double layer_n = 0;
+    try {
+      if (hc > 0)
+        layer_n = vertical ? iso_global_crushing(hc, w, o.crushing.strength_coefficient_pa,
+                                                 o.crushing.form == "2010" ? IsoCrushingForm::iso2010
+                                                                           : IsoCrushingForm::iso2019)
+                                 .force_n
+                           : croasdale(sloping(o), structure_ice(o, hc), o.rubble.r).horizontal_n;
+      nlohmann::json keels = nlohmann::json::array();
+      ridge_text << "ridge: keel e " << shortest(o.ridge.keel.porosity) << ", c "
+                 << shortest(o.ridge.keel.cohesion_pa / 1e3) << " kPa, phi " << shortest(o.ridge.keel.friction_angle_deg)
+                 << " deg; consolidated layer h_c " << shortest(hc) << " m: F_C " << fixed(kn(layer_n), 1)
+                 << " kN (" << (vertical ? "ISO 19906" : "Croasdale") << ")\n"
+                 << "| h_k (m) | F_K (kN) | friction part | cohesion part | F_K(h_k + w/2) | F_C + F_K (kN) |\n"
+                 << "|---|---|---|---|---|---|\n";
+      KeelLoad any;  // its unit weight and mu_phi are every depth's
+      for (double hk : o.ridge.keel_depths_m) {
+        RidgeKeel k = o.ridge.keel;
+        k.depth_m = hk;
+        const KeelLoad r = dolgopolov_keel_load(k, w, structure_ice(o, hc > 0 ? hc : 1.0));
+        any = r;
+        keels.push_back({{"keel_depth_m", hk},
+                         {"force_kN", kn(r.force_n)},
+                         {"friction_kN", kn(r.friction_n)},
+                         {"cohesion_kN", kn(r.cohesion_n)},
+                         {"surcharge_bound_kN", kn(r.surcharge_bound_n)},
+                         {"ridge_total_kN", kn(layer_n + r.force_n)}});
+        ridge_text << "| " << shortest(hk) << " | " << fixed(kn(r.force_n), 1) << " | " << fixed(kn(r.friction_n), 1)
+                   << " | " << fixed(kn(r.cohesion_n), 1) << " | " << fixed(kn(r.surcharge_bound_n), 1) << " | "
+                   << fixed(kn(layer_n + r.force_n), 1) << " |\n";
+      }
+      ridge = {{"keel_unit_weight_N_per_m3", any.unit_weight_npm3},
+               {"mu_phi", any.mu_phi},
+               {"keel_sail_area_ratio", keel_sail_area_ratio(structure_ice(o, 1.0))},
+               {"consolidated_thickness_m", hc},
+               {"consolidated_layer_kN", kn(layer_n)},
+               {"keels", keels}};
+    } catch (const Error& e) {
+      throw Error(cfg + ": " + e.what());
+    }
+  }
+
+  // 3. The mooring: each line at its pretension, the spread's stiffness, the offsets under the loads.
   nlohmann::json mooring;
   std::ostringstream mooring_text;
   if (!o.mooring.lines.empty()) {
@@ -169,7 +217,7 @@ std::string run_ice_actions(const IceActionsOptions& o, const fs::path& config_f
     mooring["offsets"] = offsets;
   }
 
-  // 3. DP gains.
+  // 4. DP gains.
   nlohmann::json dp;
   std::ostringstream dp_text;
   if (o.dp.mass_kg > 0) {
@@ -183,7 +231,7 @@ std::string run_ice_actions(const IceActionsOptions& o, const fs::path& config_f
             << " kN/(m s)\n";
   }
 
-  // 4. The record.
+  // 5. The record.
   nlohmann::json table = nlohmann::json::array();
   for (const ThicknessRow& r : rows) table.push_back(row_json(o, r));
   std::vector<NamedInput> inputs;
@@ -196,6 +244,7 @@ std::string run_ice_actions(const IceActionsOptions& o, const fs::path& config_f
                                "Ralston (IEC 61400-3 closed form) for a cone (PHYSICS.md 8.2)";
   doc["structure"] = options_to_json(o.structure);
   doc["rows"] = table;
+  if (!ridge.is_null()) doc["ridge"] = ridge;
   if (!mooring.is_null()) doc["mooring"] = mooring;
   if (!dp.is_null()) doc["dp"] = dp;
   if (!out.parent_path().empty()) ensure_directory(out.parent_path());
@@ -225,7 +274,7 @@ std::string run_ice_actions(const IceActionsOptions& o, const fs::path& config_f
   }
   write_text_atomic(json_file, doc.dump(2) + "\n");
 
-  // 5. The tables as printed.
+  // 6. The tables as printed.
   std::ostringstream s;
   s << "structure: " << o.structure.kind << ", waterline width " << shortest(o.structure.waterline_width_m) << " m";
   if (!vertical)
@@ -252,7 +301,7 @@ std::string run_ice_actions(const IceActionsOptions& o, const fs::path& config_f
         << fixed(kn(r.ralston.ride_up_n), 1) << " | " << fixed(kn(r.ralston.horizontal_n), 1) << " |\n";
     }
   }
-  s << mooring_text.str() << dp_text.str();
+  s << ridge_text.str() << mooring_text.str() << dp_text.str();
   s << "-> " << (ext == ".csv" ? out.string() + " (+ " + json_file.filename().string() + ")" : out.string()) << "\n";
   return s.str();
 }

@@ -1,7 +1,8 @@
 // The structure formula tool (floesim-ice-actions): the closed-form ice actions on a fixed structure (PHYSICS.md §8.1
 // ISO 19906 crushing on a vertical face; §8.2 Croasdale's and Ralston's methods on a cone or sloping face; formulas
 // in pipeline/ice_actions.h) over ice thicknesses, and the station keeping of a floating one (§8.4: its mooring lines'
-// catenaries, the spread's stiffness and its offsets under steady loads, or the DP gains; pipeline/station_keeping.h).
+// catenaries, the spread's stiffness and its offsets under steady loads, or the DP gains; pipeline/station_keeping.h),
+// and a ridge's load (§9.3: the keel by Dolgopolov with its surcharge bound, the consolidated layer as level ice).
 // The ice takes the simulation's keys and defaults (SAMS Table 1), as floesim-resistance's does.
 #pragma once
 #include <filesystem>
@@ -92,6 +93,29 @@ struct IceActionsDpOptions {
   }
 };
 
+struct IceActionsRidgeOptions {
+  std::vector<double> keel_depths_m;  // none: no ridge figures
+  RidgeKeel keel;
+  double consolidated_thickness_m = 0;
+  template <class V>
+  void visit(V& v) {
+    v.field("keel_depths_m", keel_depths_m, "m",
+            "depths h_k of unconsolidated keel rubble the structure meets (a list; none: no ridge figures)",
+            Check<std::vector<double>>([](const std::vector<double>& a) -> std::string {
+              for (double x : a)
+                if (!std::isfinite(x) || x <= 0) return "must be numbers > 0";
+              return "";
+            }));
+    v.field("porosity", keel.porosity, "-", "keel macro-porosity e (0.25-0.35 measured)", in_range(0.01, 0.95));
+    v.field("cohesion_pa", keel.cohesion_pa, "Pa", "keel rubble apparent cohesion c (2-10 kPa)", non_negative());
+    v.field("friction_angle_deg", keel.friction_angle_deg, "deg", "keel rubble internal friction angle phi",
+            in_range(1, 89));
+    v.field("consolidated_thickness_m", consolidated_thickness_m, "m",
+            "consolidated layer thickness h_c, loading the structure as level ice of that thickness (0: none)",
+            non_negative());
+  }
+};
+
 struct IceActionsOptions {
   std::vector<double> thicknesses_m = {0.5, 1.0, 1.5};
   IceActionsStructureOptions structure;
@@ -102,6 +126,7 @@ struct IceActionsOptions {
   IceActionsRubbleOptions rubble;
   IceActionsMooringOptions mooring;
   IceActionsDpOptions dp;
+  IceActionsRidgeOptions ridge;
   template <class V>
   void visit(V& v) {
     v.field("thicknesses_m", thicknesses_m, "m", "ice thicknesses h (a list)",
@@ -119,6 +144,7 @@ struct IceActionsOptions {
     v.section("rubble", rubble, "the rubble on a cone (Croasdale) and the ice ridden up it (Ralston)");
     v.section("mooring", mooring, "a spread mooring holding a floating structure");
     v.section("dp", dp, "dynamic positioning gains of one degree of freedom");
+    v.section("ridge", ridge, "a ridge: its keel by Dolgopolov (ISO 19906) and its consolidated layer as level ice");
   }
 };
 

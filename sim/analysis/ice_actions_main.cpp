@@ -13,7 +13,8 @@ int main(int argc, char** argv) {
   CLI::App app{"Ice actions on a structure by the design formulas: ISO 19906 global crushing on a vertical\n"
                "structure, Croasdale's five terms and Ralston's method on a cone (PHYSICS.md 8.1-8.2), over ice\n"
                "thicknesses; and for a floating structure its mooring lines' catenaries, the spread's stiffness and\n"
-               "offsets under steady loads, or the DP controller's gains (8.4). The references a simulated structure\n"
+               "offsets under steady loads, or the DP controller's gains (8.4); a ridge's keel by Dolgopolov with its\n"
+               "surcharge bound and its consolidated layer as level ice (9.3). The references a simulated structure\n"
                "is held against.",
                "floesim-ice-actions"};
   std::string config, out, kind;

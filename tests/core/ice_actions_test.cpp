@@ -2,9 +2,12 @@
 // §8.1-8.2, reproduced by ../shared/docs/physics-scripts/structures_ridges.py: ISO 19906's crushing pressure (2019 and
 // 2010 forms, and OpenFAST IceFloe's test log), Croasdale's five terms on IceFloe's test cone (its log to 5 digits)
 // and on the brief's cone, Ralston's method on IceFloe's IEC test input; the 0.68 of Croasdale's breaking term as an
-// elastic beam's break load (a second derivation); bad input refused with the field named.
+// elastic beam's break load (a second derivation); bad input refused with the field named. And §9, ridges: Dolgopolov's
+// keel load (the worked example, its band, the surcharge bound and the trend in keel depth), its 2-D part against
+// a quadrature of Rankine's passive pressure, the keel's bound on a ship's bow, the hydrostatic keel-to-sail ratio.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <string>
@@ -165,6 +168,110 @@ TEST(SlopingStructures, BadInputNamesTheField) {
   SlopingStructure neck;
   neck.neck_width_m = 12;  // wider than the 10 m waterline
   EXPECT_NE(error_of([&] { ralston(neck, ice, Rubble{}); }).find("structure.neck_width_m"), std::string::npos);
+}
+
+// PHYSICS.md §9.3's worked example (structures_ridges.py "9.2 keel load"): h_k = 8 m, w = 10 m, phi = 30 deg,
+// c = 5 kPa, e = 0.3, rho_w = 1025, rho_i = 900.
+TEST(RidgeKeel, DolgopolovsWorkedExampleAndItsSurchargeBound) {
+  const StructureIce ice;  // rho_i 900, rho_w 1025, g 9.81
+  RidgeKeel k;             // 8 m, e 0.3, c 5 kPa, phi 30 deg
+  const KeelLoad r = dolgopolov_keel_load(k, 10.0, ice);
+  EXPECT_NEAR(r.unit_weight_npm3, 858.4, 0.05);
+  EXPECT_NEAR(r.mu_phi, std::sqrt(3.0), 1e-12);  // tan 60 deg
+  EXPECT_NEAR(r.force_n / 1e6, 2.504, 0.0005);
+  EXPECT_NEAR(r.friction_n / 1e6, 0.934, 0.0005);
+  EXPECT_NEAR(r.cohesion_n / 1e6, 1.570, 0.0005);
+  EXPECT_NEAR(r.surcharge_bound_n / 1e6, 5.39, 0.005);  // h_k + w/2 = 13 m
+  // The parameter band of §9.3: phi 25-45 deg, c 2-10 kPa.
+  double lo = 1e300, hi = 0;
+  for (double phi : {25.0, 45.0})
+    for (double c : {2e3, 10e3}) {
+      RidgeKeel b = k;
+      b.friction_angle_deg = phi, b.cohesion_pa = c;
+      const double f = dolgopolov_keel_load(b, 10.0, ice).force_n;
+      lo = std::min(lo, f), hi = std::max(hi, f);
+    }
+  EXPECT_NEAR(lo / 1e6, 1.34, 0.005);
+  EXPECT_NEAR(hi / 1e6, 6.19, 0.005);
+}
+
+TEST(RidgeKeel, TheTrendInKeelDepthWithAndWithoutCohesion) {
+  // §9.3's table (w = 10 m, phi = 30 deg): F_K in MN at h_k = 2, 4, 6, 8, 12 m, with c = 5 kPa and with c = 0.
+  const double depth[] = {2, 4, 6, 8, 12};
+  const double with_c[] = {0.411, 0.959, 1.653, 2.504, 4.719};
+  const double without_c[] = {0.053, 0.220, 0.510, 0.934, 2.225};
+  const StructureIce ice;
+  for (int i = 0; i < 5; ++i) {
+    RidgeKeel k;
+    k.depth_m = depth[i];
+    EXPECT_NEAR(dolgopolov_keel_load(k, 10.0, ice).force_n / 1e6, with_c[i], 0.0005) << "h_k " << depth[i];
+    k.cohesion_pa = 0;
+    EXPECT_NEAR(dolgopolov_keel_load(k, 10.0, ice).force_n / 1e6, without_c[i], 0.0005) << "h_k " << depth[i];
+  }
+}
+
+TEST(RidgeKeel, ThePlaneStrainPartIsRankinesPassivePressureIntegratedOverTheKeel) {
+  // A second algorithm: F_K / (1 + h_k / 6w) against w times the integral, by Simpson's rule, of the passive pressure
+  // sigma_h = K_p gamma_e zeta + 2 c sqrt(K_p) over the keel's depth (zeta from its bottom).
+  const StructureIce ice;
+  for (double phi : {25.0, 35.0, 45.0})
+    for (double c : {0.0, 3e3, 8e3}) {
+      RidgeKeel k;
+      k.depth_m = 6.5, k.friction_angle_deg = phi, k.cohesion_pa = c, k.porosity = 0.28;
+      const double w = 12.0;
+      const KeelLoad r = dolgopolov_keel_load(k, w, ice);
+      const double kp = std::pow(std::tan((45 + phi / 2) * kPi / 180), 2);
+      const double gamma = (1 - k.porosity) * (ice.water_density_kg_m3 - ice.ice_density_kg_m3) * ice.gravity_mps2;
+      auto sigma = [&](double z) { return kp * gamma * z + 2 * c * std::sqrt(kp); };
+      const int n = 64;
+      double sum = sigma(0) + sigma(k.depth_m);
+      for (int i = 1; i < n; ++i) sum += (i % 2 ? 4 : 2) * sigma(k.depth_m * i / n);
+      const double plane = w * sum * k.depth_m / (3 * n);
+      EXPECT_NEAR(r.force_n / (1 + k.depth_m / (6 * w)), plane, 1e-9 * plane) << "phi " << phi << " c " << c;
+    }
+}
+
+TEST(RidgeKeel, TheBoundOnAShipsBowAndTheFullKeel) {
+  // §9.4: B = 20 m, T = 7 m, h_c = 1.5 m, keel draft H_k = 8 m, phi = 30 deg, c = 5 kPa: Rankine over the draught
+  // 2.97 MN; Dolgopolov's full keel with w = B and h_k = H_k - h_c = 6.5 m, 3.52 MN.
+  const StructureIce ice;
+  RidgeKeel k;
+  EXPECT_NEAR(keel_ship_bound_n(k, 20, 7, 1.5, ice) / 1e6, 2.97, 0.005);
+  RidgeKeel full = k;
+  full.depth_m = 6.5;
+  EXPECT_NEAR(dolgopolov_keel_load(full, 20, ice).force_n / 1e6, 3.52, 0.005);
+  // A keel that does not reach below the consolidated layer within the draught: no keel load.
+  RidgeKeel shallow = k;
+  shallow.depth_m = 1.2;
+  EXPECT_EQ(keel_ship_bound_n(shallow, 20, 7, 1.5, ice), 0.0);
+  // It scales with the beam (cohesion and friction alike).
+  EXPECT_NEAR(keel_ship_bound_n(k, 40, 7, 1.5, ice), 2 * keel_ship_bound_n(k, 20, 7, 1.5, ice), 1e-6);
+}
+
+TEST(RidgeKeel, HydrostaticKeelToSailRatio) {
+  StructureIce ice;
+  EXPECT_NEAR(keel_sail_area_ratio(ice), 7.20, 0.005);
+  ice.ice_density_kg_m3 = 917;
+  EXPECT_NEAR(keel_sail_area_ratio(ice), 8.49, 0.005);
+}
+
+TEST(RidgeKeel, BadInputNamesTheField) {
+  const StructureIce ice;
+  RidgeKeel k;
+  k.porosity = 1.2;
+  EXPECT_NE(error_of([&] { dolgopolov_keel_load(k, 10, ice); }).find("ridge.porosity"), std::string::npos);
+  k = RidgeKeel{};
+  k.depth_m = 0;
+  EXPECT_NE(error_of([&] { dolgopolov_keel_load(k, 10, ice); }).find("ridge.keel_depth_m"), std::string::npos);
+  k = RidgeKeel{};
+  k.friction_angle_deg = 95;
+  EXPECT_NE(error_of([&] { keel_ship_bound_n(k, 20, 7, 1.5, ice); }).find("ridge.friction_angle_deg"),
+            std::string::npos);
+  StructureIce sinking;
+  sinking.ice_density_kg_m3 = 1100;
+  EXPECT_NE(error_of([&] { keel_sail_area_ratio(sinking); }).find("ice.density_kg_m3"), std::string::npos);
+  EXPECT_NE(error_of([&] { dolgopolov_keel_load(RidgeKeel{}, -1, ice); }).find("structure.waterline_width_m"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 // floesim-ice-actions (issue #34 item 4): the stage over the core's structure formulas (pipeline/ice_actions.h,
 // pipeline/station_keeping.h, whose worked examples tests/core holds). Here: the stage's tables carry those numbers
 // through its options (the brief's cone, the 12-line spread, the DP gains of PHYSICS.md §8), strict options with
-// the key named and nothing written, the executable end to end.
+// the key named and nothing written, the executable end to end; and a ridge's keel and consolidated layer (§9.3).
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -62,6 +62,26 @@ TEST(IceActions, TheStageCarriesTheBriefsNumbers) {
   fs::remove_all(dir);
 }
 
+// PHYSICS.md §9.3's worked ridge on a 10 m vertical structure: a consolidated layer of 1.5 m (ISO 19906: p_G 2.232
+// MPa, F_C 33.47 MN) over a keel of 8 m (phi 30 deg, c 5 kPa, e 0.3: F_K 2.504 MN, 5.39 MN at h_k + w/2), F_R 35.98 MN.
+TEST(IceActions, ARidgesKeelAndConsolidatedLayer) {
+  const fs::path dir = temp_dir("ice_actions_ridge");
+  const auto o = read_options<IceActionsOptions>(
+      {{"structure", {{"kind", "vertical"}, {"waterline_width_m", 10}}},
+       {"ridge", {{"keel_depths_m", {4, 8}}, {"consolidated_thickness_m", 1.5}}}},
+      "ridge");
+  const std::string text = run_ice_actions(o, "", dir / "ridge.json");
+  const nlohmann::json r = nlohmann::json::parse(read_text(dir / "ridge.json"))["ridge"];
+  EXPECT_NEAR(r["consolidated_layer_kN"].get<double>(), 33470, 5);
+  EXPECT_NEAR(r["keels"][0]["force_kN"].get<double>(), 959, 0.5);
+  EXPECT_NEAR(r["keels"][1]["force_kN"].get<double>(), 2504, 0.5);
+  EXPECT_NEAR(r["keels"][1]["surcharge_bound_kN"].get<double>(), 5390, 5);
+  EXPECT_NEAR(r["keels"][1]["ridge_total_kN"].get<double>(), 35980, 5);
+  EXPECT_NEAR(r["keel_sail_area_ratio"].get<double>(), 7.20, 0.005);
+  EXPECT_NE(text.find("| 8 | 2504.3 | 933.9 | 1570.4 | 5387.0 | 35978.7 |"), std::string::npos) << text;
+  fs::remove_all(dir);
+}
+
 TEST(IceActions, BadInputNamesTheKeyAndWritesNothing) {
   const fs::path dir = temp_dir("ice_actions_bad");
   const std::vector<std::pair<nlohmann::json, std::string>> bad = {
@@ -73,6 +93,9 @@ TEST(IceActions, BadInputNamesTheKeyAndWritesNothing) {
       {{{"structure", {{"neck_width_m", 20}}}}, "structure.neck_width_m"},
       {{{"ice", {{"mu_ice_structure", 1.5}}}}, "ice.mu_ice_structure"},  // above cot 45 deg: refused by the formula
       {{{"mooring", {{"lines", {{{"pretension_n", 1e9}}}}}}}, "mooring.lines[0]"},  // lifts the anchor
+      {{{"ridge", {{"keel_depths_m", {8}}, {"porosity", 1.5}}}}, "ridge.porosity"},
+      {{{"ridge", {{"keel_depths_m", {-2}}}}}, "ridge.keel_depths_m"},
+      {{{"ridge", {{"keel_depths_m", {8}}, {"sail_height_m", 2}}}}, "sail_height_m"},  // not a key of this tool
   };
   for (const auto& [j, key] : bad) {
     expect_error(
