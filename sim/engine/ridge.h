@@ -1,0 +1,119 @@
+// Ice ridges (issue #36, PHYSICS.md §9): a ridge's cross-section (a consolidated layer, the keel of rubble under it
+// and the sail over it), the blocks of rubble released around the layer to be settled by buoyancy and gravity, and
+// the macro-porosity of a set of blocks in the keel's envelope, measured two ways. Geometry only: the world that
+// settles the blocks is built from these.
+//
+// Frame of one straight segment of the ridge line: s across the line (positive to the left of the direction of
+// travel from the segment's first point), t along it from that point, z up from the calm waterline.
+#pragma once
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "pipeline/geometry2d.h"
+#include "pipeline/options.h"
+
+namespace floesim::sim {
+
+struct RidgePoint {
+  double x_m = 0, y_m = 0;
+  template <class V>
+  void visit(V& v) {
+    auto finite = Check<double>([](const double& x) -> std::string { return std::isfinite(x) ? "" : "must be finite"; });
+    v.field("x_m", x_m, "m", "x of a point of the ridge line", finite);
+    v.field("y_m", y_m, "m", "y of a point of the ridge line", finite);
+  }
+};
+
+// One ridge. Its cross-section: a consolidated layer of thickness h_c floating freely (draft h_c rho_i / rho_w)
+// and keel_width_m wide; under it a keel whose sides slope at keel_angle_deg down to keel_depth_m below the
+// waterline (a trapezoid; its bottom at least 0 wide); over it a sail, a triangle of sail_height_m with sides at
+// sail_angle_deg. The rubble: blocks block_thickness_m thick, each plan side drawn log-uniformly from block_size_m.
+struct RidgeOptions {
+  std::vector<RidgePoint> line;
+  double sail_height_m = 1.5;
+  double keel_depth_m = 6.6;
+  double keel_width_m = 25.7;
+  double keel_angle_deg = 30;
+  double sail_angle_deg = 21;
+  double consolidated_thickness_m = 1.0;
+  double porosity = 0.3;
+  double block_thickness_m = 0.5;
+  std::vector<double> block_size_m = {0.5, 2.5};
+  int seed = 1;
+  template <class V>
+  void visit(V& v) {
+    v.list("line", line, "the ridge line: [{\"x_m\", \"y_m\"}, ...], at least two points, straight between them");
+    v.field("sail_height_m", sail_height_m, "m", "sail height above the waterline (0: no sail)", non_negative());
+    v.field("keel_depth_m", keel_depth_m, "m", "keel draft: its deepest point below the waterline", positive());
+    v.field("keel_width_m", keel_width_m, "m", "keel width under the consolidated layer (and the layer's width)",
+            positive());
+    v.field("keel_angle_deg", keel_angle_deg, "deg", "slope of the keel's sides from the horizontal",
+            in_range(5, 85));
+    v.field("sail_angle_deg", sail_angle_deg, "deg", "slope of the sail's sides from the horizontal", in_range(5, 85));
+    v.field("consolidated_thickness_m", consolidated_thickness_m, "m",
+            "thickness h_c of the refrozen layer at the waterline (a level sheet broken by the fracture module)",
+            positive());
+    v.field("porosity", porosity, "-", "macro-porosity e of keel and sail (0.25-0.35 measured)",
+            Check<double>([](const double& e) -> std::string {
+              return e > 0 && e < 1 ? "" : "must be in (0, 1)";
+            }));
+    v.field("block_thickness_m", block_thickness_m, "m", "thickness of the rubble blocks (about the parent ice's)",
+            positive());
+    v.field("block_size_m", block_size_m, "m", "[min, max] of a block's plan sides, drawn log-uniformly",
+            Check<std::vector<double>>([](const std::vector<double>& a) -> std::string {
+              if (a.size() != 2) return "must be [min, max]";
+              if (!(a[0] > 0 && a[1] >= a[0] && std::isfinite(a[1]))) return "must be 0 < min <= max";
+              return "";
+            }));
+    v.field("seed", seed, "-", "seed of the blocks' sizes and placement", int_in_range(0, 2147483647));
+    if (line.size() < 2) v.problem("line", "needs at least two points");
+  }
+};
+
+// The cross-section of a ridge as given (before settling), in the segment frame; water and ice densities from the
+// simulation's settings.
+struct RidgeSection {
+  double layer_top_z = 0, layer_bottom_z = 0;  // the consolidated layer floating freely
+  double keel_top_width_m = 0, keel_bottom_width_m = 0;
+  double keel_bottom_z = 0;                    // -keel_depth_m
+  double keel_area_m2 = 0;                     // below the layer
+  double sail_base_width_m = 0;
+  double sail_area_m2 = 0;                     // above the layer
+};
+// Checks the ridge against its densities (a keel shallower than the layer's bottom, a keel too narrow for its depth
+// and angle, blocks larger than the keel) and throws floesim::Error naming `where` and the key.
+RidgeSection ridge_section(const RidgeOptions& r, double ice_density, double water_density, const std::string& where);
+
+// A block of rubble as released: a box of `size` (plan sides x, y and thickness z in its own axes) turned by `yaw_rad`
+// about the vertical, in world coordinates.
+struct RidgeBlock {
+  Vec2 centre = Vec2::Zero();
+  double z = 0;
+  double size_x = 0, size_y = 0, thickness = 0;
+  double yaw_rad = 0;
+  bool keel = true;  // false: a sail block
+};
+
+// The blocks of rubble of a ridge: (1 - e) times the keel's (and the sail's) envelope volume over the line, in blocks
+// drawn by the seed, released in a loose lattice (cells the size of the largest block plus a tenth, each block
+// turned at random and set at random in its cell) under the consolidated layer across the keel's top width and
+// downwards (the keel's blocks, to float up), and over the layer across the sail's base and upwards (the sail's, to
+// fall onto it). Segment by segment along the line, in order; the same options give the same blocks.
+std::vector<RidgeBlock> release_blocks(const RidgeOptions& r, const RidgeSection& section);
+
+// The keel's envelope along one segment [a, b] of the line: the trapezoid of `section` swept along it.
+// Macro-porosity of `blocks` in it, two ways: 1 - (volume of the blocks' parts inside the envelope) / (envelope
+// volume) by the blocks' volumes (blocks wholly inside count whole, the others by a fine sampling of their own
+// volume), and by voxels: the share of the envelope's voxels (edge `voxel_m`) whose centre lies in no block.
+struct KeelPorosity {
+  double by_volume = 0, by_voxels = 0;
+  double envelope_m3 = 0, blocks_in_envelope_m3 = 0;
+};
+KeelPorosity keel_porosity(const std::vector<RidgeBlock>& blocks, const RidgeSection& section, const Vec2& a,
+                           const Vec2& b, double voxel_m);
+
+// Whether world point (p, z) lies inside block k (its box, turned by its yaw).
+bool block_contains(const RidgeBlock& k, const Vec2& p, double z);
+
+}  // namespace floesim::sim
