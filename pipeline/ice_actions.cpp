@@ -167,7 +167,8 @@ RalstonLoad ralston(const SlopingStructure& s, const StructureIce& ice, const Ru
 
 std::vector<std::string> keel_problems(const RidgeKeel& k, const StructureIce& ice) {
   std::vector<std::string> p;
-  if (!(std::isfinite(k.depth_m) && k.depth_m > 0)) p.push_back(range_text("ridge.keel_depth_m", k.depth_m, "must be > 0"));
+  if (!(std::isfinite(k.depth_m) && k.depth_m > 0))
+    p.push_back(range_text("ridge.keel_depth_m", k.depth_m, "must be > 0"));
   if (!(k.porosity > 0 && k.porosity < 1)) p.push_back(range_text("ridge.porosity", k.porosity, "must be in (0, 1)"));
   if (!(std::isfinite(k.cohesion_pa) && k.cohesion_pa >= 0))
     p.push_back(range_text("ridge.cohesion_pa", k.cohesion_pa, "must be >= 0"));

@@ -121,7 +121,8 @@ std::string run_ice_actions(const IceActionsOptions& o, const fs::path& config_f
                            : croasdale(sloping(o), structure_ice(o, hc), o.rubble.r).horizontal_n;
       nlohmann::json keels = nlohmann::json::array();
       ridge_text << "ridge: keel e " << shortest(o.ridge.keel.porosity) << ", c "
-                 << shortest(o.ridge.keel.cohesion_pa / 1e3) << " kPa, phi " << shortest(o.ridge.keel.friction_angle_deg)
+                 << shortest(o.ridge.keel.cohesion_pa / 1e3) << " kPa, phi "
+                 << shortest(o.ridge.keel.friction_angle_deg)
                  << " deg; consolidated layer h_c " << shortest(hc) << " m: F_C " << fixed(kn(layer_n), 1)
                  << " kN (" << (vertical ? "ISO 19906" : "Croasdale") << ")\n"
                  << "| h_k (m) | F_K (kN) | friction part | cohesion part | F_K(h_k + w/2) | F_C + F_K (kN) |\n"

@@ -41,8 +41,9 @@ RidgeSection ridge_section(const RidgeOptions& r, double ice_density, double wat
   s.keel_top_width_m = r.keel_width_m;
   s.keel_bottom_width_m = r.keel_width_m - 2 * run;
   FLOESIM_REQUIRE(s.keel_bottom_width_m >= 0, where, ": keel_width_m ", number(r.keel_width_m),
-                  " m is too narrow for a keel ", number(depth), " m deep under the layer with sides at keel_angle_deg ",
-                  number(r.keel_angle_deg), ": it needs at least ", number(2 * run),
+                  " m is too narrow for a keel ", number(depth),
+                  " m deep under the layer with sides at keel_angle_deg ", number(r.keel_angle_deg),
+                  ": it needs at least ", number(2 * run),
                   " m (widen it, or steepen keel_angle_deg)");
   s.keel_area_m2 = 0.5 * (s.keel_top_width_m + s.keel_bottom_width_m) * depth;
   const double sail = std::max(0.0, r.sail_height_m - s.layer_top_z);  // above the layer's top
@@ -52,8 +53,9 @@ RidgeSection ridge_section(const RidgeOptions& r, double ice_density, double wat
                   " at sail_angle_deg ", number(r.sail_angle_deg), ") is ", number(s.sail_base_width_m),
                   " m wide at its base, wider than the consolidated layer (keel_width_m ", number(r.keel_width_m), ")");
   const double largest = r.block_size_m.size() == 2 ? r.block_size_m[1] : 0.0;
-  FLOESIM_REQUIRE(r.block_thickness_m < depth && largest <= s.keel_top_width_m, where, ": blocks of block_size_m up to ",
-                  number(largest), " m and block_thickness_m ", number(r.block_thickness_m),
+  FLOESIM_REQUIRE(r.block_thickness_m < depth && largest <= s.keel_top_width_m, where,
+                  ": blocks of block_size_m up to ", number(largest), " m and block_thickness_m ",
+                  number(r.block_thickness_m),
                   " m do not fit a keel ", number(s.keel_top_width_m), " m wide and ", number(depth),
                   " m deep under the layer: make them smaller");
   FLOESIM_REQUIRE(r.line.size() >= 2, where, ": line needs at least two points");
@@ -88,7 +90,8 @@ std::vector<RidgeBlock> release_blocks(const RidgeOptions& r, const RidgeSection
       const double pitch_s = width / across;
       double volume = 0;
       for (int layer = 0; volume < target; ++layer) {
-        const double z = keel ? section.layer_bottom_z - (layer + 0.5) * cell_z : section.layer_top_z + (layer + 0.5) * cell_z;
+        const double z = keel ? section.layer_bottom_z - (layer + 0.5) * cell_z
+                              : section.layer_top_z + (layer + 0.5) * cell_z;
         for (int j = 0; j < along && volume < target; ++j)
           for (int i = 0; i < across && volume < target; ++i) {
             RidgeBlock k;

@@ -19,7 +19,8 @@ struct RidgePoint {
   double x_m = 0, y_m = 0;
   template <class V>
   void visit(V& v) {
-    auto finite = Check<double>([](const double& x) -> std::string { return std::isfinite(x) ? "" : "must be finite"; });
+    auto finite =
+        Check<double>([](const double& x) -> std::string { return std::isfinite(x) ? "" : "must be finite"; });
     v.field("x_m", x_m, "m", "x of a point of the ridge line", finite);
     v.field("y_m", y_m, "m", "y of a point of the ridge line", finite);
   }

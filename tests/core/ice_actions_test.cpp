@@ -2,9 +2,10 @@
 // §8.1-8.2, reproduced by ../shared/docs/physics-scripts/structures_ridges.py: ISO 19906's crushing pressure (2019 and
 // 2010 forms, and OpenFAST IceFloe's test log), Croasdale's five terms on IceFloe's test cone (its log to 5 digits)
 // and on the brief's cone, Ralston's method on IceFloe's IEC test input; the 0.68 of Croasdale's breaking term as an
-// elastic beam's break load (a second derivation); bad input refused with the field named. And §9, ridges: Dolgopolov's
-// keel load (the worked example, its band, the surcharge bound and the trend in keel depth), its 2-D part against
-// a quadrature of Rankine's passive pressure, the keel's bound on a ship's bow, the hydrostatic keel-to-sail ratio.
+// elastic beam's break load (a second derivation); bad input refused with the field named. And §9, ridges:
+// Dolgopolov's keel load (the worked example, its band, the surcharge bound and the trend in keel depth), its 2-D part
+// against a quadrature of Rankine's passive pressure, the keel's bound on a ship's bow, the hydrostatic keel-to-sail
+// ratio.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -127,7 +127,8 @@ TEST(RidgeBlocks, ReleasedBlocksCarryTheRidgesIceWithoutOverlap) {
       const double c = std::cos(a.yaw_rad), sn = std::sin(a.yaw_rad);
       for (double fx : {-0.5, 0.0, 0.5})
         for (double fy : {-0.5, 0.0, 0.5}) {
-          const Vec2 p = a.centre + Vec2(c * fx * a.size_x - sn * fy * a.size_y, sn * fx * a.size_x + c * fy * a.size_y);
+          const Vec2 p =
+              a.centre + Vec2(c * fx * a.size_x - sn * fy * a.size_y, sn * fx * a.size_x + c * fy * a.size_y);
           ASSERT_FALSE(block_contains(blocks[j], p, a.z)) << "blocks " << i << " and " << j;
         }
     }
