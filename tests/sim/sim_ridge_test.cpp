@@ -2,7 +2,7 @@
 // and by its physics (a freely floating layer, sides at the keel angle); the keel's macro-porosity measured two ways
 // (the blocks' volumes, the envelope's voxels) on arrangements of known solid volume; the blocks released for
 // settling (the ice they carry, none overlapping, keel under and sail over the layer, the same for the same seed);
-// bad input named by its key.
+// bad input named by its key; a block released under the layer rising to rest against it.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -142,6 +142,51 @@ TEST(RidgeBlocks, ReleasedBlocksCarryTheRidgesIceWithoutOverlap) {
   RidgeOptions other = r;
   other.seed = 2;
   EXPECT_NE(release_blocks(other, s).front().size_x, blocks.front().size_x);
+}
+
+// How a keel is built (issue #36 item 2): a block released under the consolidated layer floats up and comes to rest
+// against its underside. A 2 m x 2 m x 0.5 m block 3 m deep under a 1 m sheet (one fixed tile): at rest its top
+// touches the layer's bottom, z = -0.87805 - 0.25 m, and the contact carries its net buoyancy (rho_w - rho_i) g V.
+TEST(RidgeSettling, ABlockReleasedUnderTheLayerRisesAndRestsAgainstIt) {
+  SimulateOptions o = testing::floe_options();
+  o.fracture.enabled = false;
+  o.level_ice.extent_m = {-20, -20, 20, 20};
+  o.level_ice.thickness_m = 1.0;
+  o.level_ice.tile_m = 40;
+  FloeField field;
+  field.floes.push_back(testing::rect_floe(1, 29, -1, 2, 2, 0.5));  // beside the sheet: plan overlaps are refused
+  Model m = build_model(field, nullptr, o);
+  int block = -1;
+  for (size_t b = 0; b < m.bodies.size(); ++b)
+    if (m.bodies[b].kind == BodyKind::floe && !m.bodies[b].fixed) block = static_cast<int>(b);
+  ASSERT_GE(block, 0);
+  m.bodies[block].initial_position = Vec3(0, 0, -3.0);  // released under the sheet's middle
+  World w(m);
+  const double rest_z = -1.0 * kIce / kWater - 0.25;
+  double max_up = 0;
+  for (int k = 0; k < 4000; ++k) {
+    w.step();
+    max_up = std::max(max_up, w.state().velocity[block].z());
+  }
+  const Vec3& x = w.state().position[block];
+  // The contacts' vertical push on the block over the last step (impulses / dt) against its net buoyancy.
+  double push = 0;
+  for (const Contact& c : w.contacts()) {
+    const double p = c.pn * c.normal.z() + c.pt1 * c.t1.z() + c.pt2 * c.t2.z();  // on b, from a
+    if (c.body_b == block) push += p;
+    if (c.body_a == block) push -= p;
+  }
+  push /= o.time_step_s;
+  const double net = (kWater - kIce) * o.water.gravity_mps2 * 2.0;  // V = 2 x 2 x 0.5 m^3
+  std::printf("[measured] block at rest: z %.4f m (by hand %.4f), largest rising speed %.3f m/s, |v| %.2e m/s; "
+              "the layer pushes it down with %.1f N against its net buoyancy %.1f N\n",
+              x.z(), rest_z, max_up, w.state().velocity[block].norm(), -push, net);
+  EXPECT_GT(max_up, 0.05);  // it rose
+  // Against the layer: its impact at the rising speed crushed a few millimetres of the layer's underside.
+  EXPECT_NEAR(x.z(), rest_z, 0.01);
+  EXPECT_LT(w.state().velocity[block].norm(), 1e-3);  // at rest
+  EXPECT_NEAR(x.x(), 0.0, 0.05);                      // straight up
+  EXPECT_NEAR(-push, net, 0.01 * net);                // the layer carries its net buoyancy
 }
 
 TEST(RidgeSection, BadInputNamesTheKey) {
