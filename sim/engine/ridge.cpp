@@ -4,19 +4,12 @@
 #include <cmath>
 #include <cstdint>
 #include <random>
-#include <sstream>
 
 #include "pipeline/error.h"
 
 namespace floesim::sim {
 
 namespace {
-
-std::string number(double x) {
-  std::ostringstream s;
-  s << x;
-  return s.str();
-}
 
 // A draw in [0, 1) from the generator's 53 high bits (the same on every platform, unlike the standard
 // distributions).
@@ -32,37 +25,33 @@ RidgeSection ridge_section(const RidgeOptions& r, double ice_density, double wat
   s.layer_bottom_z = -hc * ice_density / water_density;
   s.layer_top_z = s.layer_bottom_z + hc;
   s.keel_bottom_z = -r.keel_depth_m;
-  FLOESIM_REQUIRE(r.keel_depth_m > -s.layer_bottom_z, where, ": keel_depth_m ", number(r.keel_depth_m),
-                  " m does not reach below the consolidated layer (its bottom is ", number(-s.layer_bottom_z),
-                  " m below the waterline for consolidated_thickness_m ", number(hc),
-                  "): deepen the keel or thin the layer");
+  FLOESIM_REQUIRE(r.keel_depth_m > -s.layer_bottom_z, where, ": keel_depth_m ", r.keel_depth_m,
+                  " m does not reach below the consolidated layer (its bottom is ", -s.layer_bottom_z,
+                  " m below the waterline for consolidated_thickness_m ", hc, "): deepen the keel or thin the layer");
   const double depth = s.layer_bottom_z - s.keel_bottom_z;  // of the keel below the layer
   const double run = depth / std::tan(r.keel_angle_deg * kPi / 180);
   s.keel_top_width_m = r.keel_width_m;
   s.keel_bottom_width_m = r.keel_width_m - 2 * run;
-  FLOESIM_REQUIRE(s.keel_bottom_width_m >= 0, where, ": keel_width_m ", number(r.keel_width_m),
-                  " m is too narrow for a keel ", number(depth),
-                  " m deep under the layer with sides at keel_angle_deg ", number(r.keel_angle_deg),
-                  ": it needs at least ", number(2 * run),
-                  " m (widen it, or steepen keel_angle_deg)");
+  FLOESIM_REQUIRE(s.keel_bottom_width_m >= 0, where, ": keel_width_m ", r.keel_width_m, " m is too narrow for a keel ",
+                  depth, " m deep under the layer with sides at keel_angle_deg ", r.keel_angle_deg,
+                  ": it needs at least ", 2 * run, " m (widen it, or steepen keel_angle_deg)");
   s.keel_area_m2 = 0.5 * (s.keel_top_width_m + s.keel_bottom_width_m) * depth;
   const double sail = std::max(0.0, r.sail_height_m - s.layer_top_z);  // above the layer's top
   s.sail_base_width_m = sail > 0 ? 2 * sail / std::tan(r.sail_angle_deg * kPi / 180) : 0.0;
   s.sail_area_m2 = 0.5 * s.sail_base_width_m * sail;
-  FLOESIM_REQUIRE(s.sail_base_width_m <= r.keel_width_m, where, ": the sail (sail_height_m ", number(r.sail_height_m),
-                  " at sail_angle_deg ", number(r.sail_angle_deg), ") is ", number(s.sail_base_width_m),
-                  " m wide at its base, wider than the consolidated layer (keel_width_m ", number(r.keel_width_m), ")");
+  FLOESIM_REQUIRE(s.sail_base_width_m <= r.keel_width_m, where, ": the sail (sail_height_m ", r.sail_height_m,
+                  " at sail_angle_deg ", r.sail_angle_deg, ") is ", s.sail_base_width_m,
+                  " m wide at its base, wider than the consolidated layer (keel_width_m ", r.keel_width_m, ")");
   const double largest = r.block_size_m.size() == 2 ? r.block_size_m[1] : 0.0;
   FLOESIM_REQUIRE(r.block_thickness_m < depth && largest <= s.keel_top_width_m, where,
-                  ": blocks of block_size_m up to ", number(largest), " m and block_thickness_m ",
-                  number(r.block_thickness_m),
-                  " m do not fit a keel ", number(s.keel_top_width_m), " m wide and ", number(depth),
+                  ": blocks of block_size_m up to ", largest, " m and block_thickness_m ", r.block_thickness_m,
+                  " m do not fit a keel ", s.keel_top_width_m, " m wide and ", depth,
                   " m deep under the layer: make them smaller");
   FLOESIM_REQUIRE(r.line.size() >= 2, where, ": line needs at least two points");
   for (size_t i = 1; i < r.line.size(); ++i) {
     const double len = std::hypot(r.line[i].x_m - r.line[i - 1].x_m, r.line[i].y_m - r.line[i - 1].y_m);
-    FLOESIM_REQUIRE(len >= largest, where, ": line segment ", i - 1, "-", i, " is ", number(len),
-                    " m long, shorter than the largest block (block_size_m ", number(largest), ")");
+    FLOESIM_REQUIRE(len >= largest, where, ": line segment ", i - 1, "-", i, " is ", len,
+                    " m long, shorter than the largest block (block_size_m ", largest, ")");
   }
   return s;
 }
