@@ -80,6 +80,12 @@ bool prism_submerged(const Body& b, const BodyKinematics& k, double& volume, Vec
   // l(x, y) = l0 - a x - b y from the bottom (a = m_x/m_z, b = m_y/m_z). While the plane cuts only the side walls
   // (0 <= l <= h everywhere), volume and centre of buoyancy follow from the section's area and second moments.
   if (b.kind != BodyKind::floe || b.section_area <= 0) return false;
+  if (k.x.z() + std::hypot(b.section_radius, 0.5 * b.thickness_m) <= 0) {
+    // Wholly under water at any tilt (a keel's block): the whole prism, centred on its origin.
+    volume = b.section_area * b.thickness_m;
+    centroid = k.x;
+    return true;
+  }
   const Vec3 mv = k.R.row(2).transpose();
   if (mv.z() < 0.5) return false;  // tilted beyond 60 degrees: clip the mesh
   const double h = b.thickness_m, A = b.section_area;

@@ -68,7 +68,7 @@ void propeller_jets(const Model& m, const BodyKinematics& k, double thrust_n, st
 
 Wrench gravity_force(const Model& m, const Body& b);
 // Submerged volume and centre of buoyancy (world) of a floe slab in closed form, when the water plane cuts only
-// its side walls; false otherwise (then the mesh is clipped).
+// its side walls or when it is wholly under water; false otherwise (then the mesh is clipped).
 bool prism_submerged(const Body& b, const BodyKinematics& k, double& volume, Vec3& centroid);
 // rho_w g V_sub at the centre of buoyancy: closed form for floe slabs cut through their sides, else from clipping
 // the body's closed surface at z = 0.

@@ -563,12 +563,133 @@ Ittc57 ittc57_of(const VesselParticulars& v, const VesselOptions& vo, const Engi
 
 namespace {
 
-// 1. The floes of the model: the free floes of the field, then the level ice sheets as tiles (fixed floes).
-std::vector<Floe> model_floes(const FloeField& field, const LevelIceOptions& li) {
+// 1. A ridge's strips: each segment of its line swept keel_width_m across (the width of its consolidated layer).
+std::vector<Polygon> ridge_strips(const RidgeOptions& r) {
+  std::vector<Polygon> strips;
+  for (size_t k = 1; k < r.line.size(); ++k) {
+    const Vec2 a(r.line[k - 1].x_m, r.line[k - 1].y_m), b(r.line[k].x_m, r.line[k].y_m);
+    const Vec2 t = (b - a).normalized(), n = 0.5 * r.keel_width_m * Vec2(-t.y(), t.x());
+    strips.push_back({a - n, b - n, b + n, a + n});
+  }
+  return strips;
+}
+
+// 1. The ridges' consolidated layers (settings.ridges, issue #36) cut out of the level ice tiles: each tile is cut
+// by every ridge's strips in order (ridge by ridge, segment by segment), what lies inside a strip a tile of that
+// ridge's layer, consolidated_thickness_m thick, what is left cut by the next strip. The tiles are numbered again in
+// that order from the first tile's id; `ridge_of` gets each tile's ridge (-1: the sheet). A ridge that no sheet
+// reaches floats freely: its layer is a free floe per segment (the strip less the earlier strips), appended to
+// `free_layers` (ids after the tiles') with its ridge in `free_ridge`. A strip the tiles cover only in part (beside
+// the sheet's edge, over an opening) is an error naming the ridge and the segment. At a bend of a line the strips
+// of its two segments overlap on the inside (the first takes the overlap) and leave a wedge uncut on the outside.
+void cut_ridge_layers(const std::vector<RidgeOptions>& ridges, int next_id, std::vector<Floe>& tiles,
+                      std::vector<int>& ridge_of, std::vector<Floe>& free_layers, std::vector<int>& free_ridge) {
+  ridge_of.assign(tiles.size(), -1);
+  if (ridges.empty()) return;
+  struct Strip {
+    Polygon outline;
+    int ridge = 0, segment = 0;
+    double expected_m2 = 0, cut_m2 = 0;  // its area less the earlier strips' overlap; what the tiles gave it
+  };
+  std::vector<Strip> strips;
+  for (size_t i = 0; i < ridges.size(); ++i) {
+    const std::vector<Polygon> own = ridge_strips(ridges[i]);
+    for (size_t k = 0; k < own.size(); ++k) {
+      Strip s{own[k], static_cast<int>(i), static_cast<int>(k)};
+      s.expected_m2 = signed_area(s.outline);
+      for (const Strip& e : strips) s.expected_m2 -= convex_intersection_area(s.outline, e.outline);
+      strips.push_back(std::move(s));
+    }
+  }
+  const int first_id = tiles.empty() ? 0 : tiles.front().id;
+  std::vector<Floe> out;
+  std::vector<int> out_ridge;
+  for (const Floe& tile : tiles) {
+    std::vector<Polygon> rest = {tile.outline};
+    const Aabb2 box = bounds(tile.outline);
+    for (Strip& s : strips) {
+      if (!box.overlaps(bounds(s.outline))) continue;
+      std::vector<Polygon> left;
+      for (const Polygon& p : rest) {
+        PolygonCut cut;
+        try {
+          cut = cut_polygon(p, s.outline);
+        } catch (const Error& e) {
+          throw Error("ridges[" + std::to_string(s.ridge) + "]: cannot cut segment " + std::to_string(s.segment) +
+                      "'s consolidated layer out of the level ice tile at [" + std::to_string(box.lo.x()) + ", " +
+                      std::to_string(box.lo.y()) + "] (" + e.what() +
+                      "); a layer lying inside one tile would leave a hole: run the line across the sheet's tiles "
+                      "or change level_ice.tile_m");
+        }
+        for (Polygon& q : cut.inside) {
+          Floe f = tile;
+          f.outline = std::move(q);
+          f.area_m2 = signed_area(f.outline);
+          f.thickness_m = ridges[s.ridge].consolidated_thickness_m;
+          s.cut_m2 += f.area_m2;
+          out.push_back(std::move(f));
+          out_ridge.push_back(s.ridge);
+        }
+        for (Polygon& q : cut.outside) left.push_back(std::move(q));
+      }
+      rest = std::move(left);
+    }
+    for (Polygon& q : rest) {
+      Floe f = tile;
+      f.outline = std::move(q);
+      f.area_m2 = signed_area(f.outline);
+      out.push_back(std::move(f));
+      out_ridge.push_back(-1);
+    }
+  }
+  for (const Strip& s : strips)
+    FLOESIM_REQUIRE(s.cut_m2 == 0 || s.cut_m2 >= s.expected_m2 * (1 - 1e-6), "ridges[", s.ridge,
+                    "]: the consolidated layer along segment ", s.segment, " of its line (", s.expected_m2,
+                    " m^2) lies on the level ice sheet over only ", s.cut_m2, " m^2: a ridge lies wholly in a sheet "
+                    "(level_ice.extent_m or floes of kind \"level_ice\"), clear of its openings, or wholly off it; "
+                    "move the line or enlarge the sheet");
+  for (size_t k = 0; k < out.size(); ++k) out[k].id = first_id + static_cast<int>(k);
+  if (!out.empty()) next_id = std::max(next_id, out.back().id + 1);
+  for (size_t k = 0; k < strips.size(); ++k) {
+    if (strips[k].cut_m2 > 0) continue;
+    std::vector<Polygon> pieces = {strips[k].outline};
+    for (size_t j = 0; j < k; ++j) {
+      std::vector<Polygon> left;
+      for (const Polygon& p : pieces)
+        for (Polygon& q : polygon_difference(p, strips[j].outline)) left.push_back(std::move(q));
+      pieces = std::move(left);
+    }
+    for (Polygon& q : pieces) {
+      Floe f;
+      f.id = next_id++;
+      f.outline = std::move(q);
+      f.area_m2 = signed_area(f.outline);
+      f.thickness_m = ridges[strips[k].ridge].consolidated_thickness_m;
+      free_layers.push_back(std::move(f));
+      free_ridge.push_back(strips[k].ridge);
+    }
+  }
+  tiles = std::move(out);
+  ridge_of = std::move(out_ridge);
+}
+
+// 1. The floes of the model: the free floes of the field, the layers of the ridges no sheet reaches, then the level
+// ice sheets as tiles (fixed floes), the ridges' consolidated layers cut out of them; `ridge_of` the ridge of each
+// (-1: none).
+std::vector<Floe> model_floes(const FloeField& field, const EngineSettings& o, std::vector<int>& ridge_of) {
   std::vector<Floe> floes;
   for (const Floe& f : field.floes)
     if (!f.level_ice) floes.push_back(f);
-  for (Floe& f : level_ice_tiles(field, li)) floes.push_back(std::move(f));
+  std::vector<Floe> tiles = level_ice_tiles(field, o.level_ice), free_layers;
+  std::vector<int> tile_ridge, free_ridge;
+  int next_id = 1;
+  for (const Floe& f : field.floes) next_id = std::max(next_id, f.id + 1);
+  cut_ridge_layers(o.ridges, next_id, tiles, tile_ridge, free_layers, free_ridge);
+  ridge_of.assign(floes.size(), -1);
+  for (Floe& f : free_layers) floes.push_back(std::move(f));
+  ridge_of.insert(ridge_of.end(), free_ridge.begin(), free_ridge.end());
+  for (Floe& f : tiles) floes.push_back(std::move(f));
+  ridge_of.insert(ridge_of.end(), tile_ridge.begin(), tile_ridge.end());
   return floes;
 }
 
@@ -913,11 +1034,12 @@ bool overlaps_footprint(const FloeGeometry& fg, const std::vector<Polygon>& foot
 // 4. Floe bodies: slab of the floe's thickness, body frame at the centre of mass, at hydrostatic equilibrium; level
 // ice tiles held fixed. The vessel starts in open water or in broken ice: a floe in its way is removed, level ice
 // is an error.
-void add_floe_bodies(const std::vector<FloeGeometry>& geo, const std::vector<Polygon>& footprint,
-                     const EngineSettings& o, Model& model) {
+void add_floe_bodies(const std::vector<FloeGeometry>& geo, const std::vector<int>& ridge_of,
+                     const std::vector<Polygon>& footprint, const EngineSettings& o, Model& model) {
   std::vector<Aabb2> fp_box;
   for (const Polygon& p : footprint) fp_box.push_back(bounds(p));
-  for (const FloeGeometry& fg : geo) {
+  for (size_t k = 0; k < geo.size(); ++k) {
+    const FloeGeometry& fg = geo[k];
     const Floe& f = *fg.floe;
     const bool hit = overlaps_footprint(fg, footprint, fp_box);
     // The vessel starts in open water or in broken ice: a floe in its way is removed, level ice is an error.
@@ -934,6 +1056,44 @@ void add_floe_bodies(const std::vector<FloeGeometry>& geo, const std::vector<Pol
     model.bodies.push_back(make_floe_body(local, f.thickness_m, f.id, static_cast<int>(model.bodies.size()), c, o,
                                           model.parts));
     if (f.level_ice) hold_fixed(model.bodies.back());
+    if (ridge_of[k] >= 0) {
+      model.bodies.back().ridge = ridge_of[k];
+      model.bodies.back().ridge_part = RidgePart::layer;
+    }
+  }
+}
+
+// 4. The ridges' rubble (settings.ridges): the blocks release_blocks gives each ridge, as floes where they were
+// released (under the layer, to float up; over it, to fall), after the other floes with ids after theirs. A block is
+// brash (rigid contacts, its crushing force as their ceiling, never broken), so a keel costs contact points rather
+// than crushing rows; it starts awake (World). A block over the vessel's start is an error.
+void add_ridge_blocks(const std::vector<Polygon>& footprint, const EngineSettings& o, Model& model) {
+  int next_id = 1;
+  for (const Body& b : model.bodies) next_id = std::max(next_id, b.id + 1);
+  for (size_t i = 0; i < o.ridges.size(); ++i) {
+    const RidgeOptions& r = o.ridges[i];
+    const std::string where = "ridges[" + std::to_string(i) + "]";
+    const RidgeSection section = ridge_section(r, o.ice.density_kg_m3, o.water.density_kg_m3, where);
+    for (const RidgeBlock& k : release_blocks(r, section)) {
+      const double c = std::cos(k.yaw_rad), s = std::sin(k.yaw_rad), hx = 0.5 * k.size_x, hy = 0.5 * k.size_y;
+      Polygon local;
+      for (const Vec2& corner : {Vec2(-hx, -hy), Vec2(hx, -hy), Vec2(hx, hy), Vec2(-hx, hy)})
+        local.emplace_back(c * corner.x() - s * corner.y(), s * corner.x() + c * corner.y());
+      Polygon world;
+      for (const Vec2& v : local) world.push_back(v + k.centre);
+      for (const Polygon& fp : footprint)
+        FLOESIM_REQUIRE(convex_intersection_area(fp, world) <= 1e-9, where, ": a block of its rubble at (",
+                        k.centre.x(), ", ", k.centre.y(), ") m lies under the vessel's start (vessel.x_m, "
+                        "vessel.y_m): start the vessel clear of the ridge");
+      Body b = make_floe_body(local, k.thickness, next_id++, static_cast<int>(model.bodies.size()), k.centre, o,
+                              model.parts);
+      b.initial_position.z() = k.z;
+      b.brash = true;  // p_c h x the plan width 4 A / perimeter, as make_floe_body's brash
+      b.brash_crush_force_n = o.ice.crushing_strength_pa * k.thickness * 4 * signed_area(local) / perimeter_m(local);
+      b.ridge = static_cast<int>(i);
+      b.ridge_part = k.keel ? RidgePart::keel : RidgePart::sail;
+      model.bodies.push_back(std::move(b));
+    }
   }
 }
 
@@ -1031,7 +1191,8 @@ Model build_model(const FloeField& field, const HullModel* hull, const EngineSet
 
   // 1. Floe geometry in the world: cleaned outline and convex pieces. The level ice sheets come as tiles (fixed
   // floes) after the free floes.
-  const std::vector<Floe> floes = model_floes(field, o.level_ice);
+  std::vector<int> ridge_of;
+  const std::vector<Floe> floes = model_floes(field, o, ridge_of);
   const std::vector<FloeGeometry> geo = floe_geometry(floes);
   FLOESIM_REQUIRE(o.drift.speed_mps == 0 || !floes.empty(), "drift.speed_mps is ", o.drift.speed_mps,
                   " m/s but there is no ice to drift (no floes, no level_ice.extent_m): give the ice, or set "
@@ -1047,7 +1208,8 @@ Model build_model(const FloeField& field, const HullModel* hull, const EngineSet
   if (hull) footprint = add_hulls(*hull, structures, floes, o, model);
 
   // 4. Floe bodies: slab of the floe's thickness, body frame at the centre of mass, at hydrostatic equilibrium.
-  add_floe_bodies(geo, footprint, o, model);
+  add_floe_bodies(geo, ridge_of, footprint, o, model);
+  add_ridge_blocks(footprint, o, model);
 
   // 5. Domain walls outside the sides of the domain rectangle.
   if (!o.domain.walls.empty()) add_walls(field, hull != nullptr, footprint, o, model);

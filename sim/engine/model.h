@@ -36,6 +36,10 @@ struct ConvexPart {
 // wall: a fixed body (infinite mass, never awake, no forces) bounding the domain (options.domain).
 enum class BodyKind : uint8_t { vessel, floe, wall };
 
+// What a floe is of a ridge (settings.ridges, issue #36): a tile of its consolidated layer (or a piece broken from
+// one), a block of its keel's rubble or of its sail's.
+enum class RidgePart : uint8_t { none, layer, keel, sail };
+
 // One planar face of a floe slab for the drag model: indices into Body::drag_vertices.
 struct DragFace {
   int first = 0, count = 0;  // into Body::drag_face_index
@@ -113,6 +117,11 @@ struct Body {
   // A structure whose crushed ice is cleared from the level ice it presses into (sim/engine/clearing.h): a fixed or a
   // compliant (bottom-founded) one.
   bool clears_ice = false;
+  // Of a ridge (issue #36): its index in settings.ridges (-1: none) and what it is of it. A keel or sail block is
+  // brash (rigid contacts, never broken) that starts awake where it was released, to be settled by buoyancy and
+  // gravity; a layer tile is level ice h_c thick, and the pieces broken from it keep its tags.
+  int ridge = -1;
+  RidgePart ridge_part = RidgePart::none;
 };
 
 // What the vessel model needs of the hull, computed from the mesh at the design waterline (z = 0).

@@ -15,6 +15,7 @@
 #include "pipeline/geometry2d.h"
 #include "pipeline/options.h"
 #include "pipeline/station_keeping.h"
+#include "sim/engine/ridge.h"
 
 namespace floesim::sim {
 
@@ -842,6 +843,7 @@ struct EngineSettings {
   LevelIceOptions level_ice;
   DriftOptions drift;
   std::vector<StructureOptions> structures;  // hull bodies beside the vessel's (see StructureOptions)
+  std::vector<RidgeOptions> ridges;          // ridges in the level ice (sim/engine/ridge.h, issue #36)
 
   long reference_horizon_steps() const { return std::lround(solver.reference_horizon_s / time_step_s); }  // 0: none
 };

@@ -86,6 +86,9 @@ World::World(Model built) : model_(std::move(built)), pool_(model_.settings.thre
     state_.position[b] = model.bodies[b].initial_position;
     state_.orientation[b] = model.bodies[b].initial_orientation;
     if (is_fixed_body(model.bodies[b])) state_.awake[b] = 0;  // a wall or level ice: never integrated
+    // A ridge's rubble is released out of equilibrium, to be settled: awake.
+    const RidgePart rp = model.bodies[b].ridge_part;
+    if (rp == RidgePart::keel || rp == RidgePart::sail) state_.awake[b] = 1;
     // An established drift: floes start with the current's velocity (horizontal).
     if (model.bodies[b].kind == BodyKind::floe && !model.bodies[b].fixed && o.water.enabled &&
         o.water.floes_start_with_current)
@@ -514,6 +517,8 @@ void World::apply_fracture(FractureCut& cut) {
     spec.position = x + r;
     spec.orientation = q;
     spec.fixed = fixed;
+    spec.ridge = parent_body.ridge;
+    spec.ridge_part = parent_body.ridge_part;
     model_.bodies.push_back(make_piece_body(spec, index, model_.settings, model_.parts));
     grow_body_arrays();
     state_.position[index] = x + r;
@@ -550,6 +555,8 @@ Body make_piece_body(const PieceSpec& p, int body_index, const EngineSettings& o
   b.initial_position = p.position;
   b.initial_orientation = p.orientation;
   if (p.fixed) hold_fixed(b);
+  b.ridge = p.ridge;
+  b.ridge_part = p.ridge_part;
   return b;
 }
 
@@ -703,6 +710,8 @@ void World::save(ByteWriter& w) const {
     w.mat(b.initial_position);
     w.quat(b.initial_orientation);
     w.pod<uint8_t>(b.fixed ? 1 : 0);
+    w.pod<int32_t>(b.ridge);
+    w.pod<uint8_t>(static_cast<uint8_t>(b.ridge_part));
   }
   // 2. The state.
   const State& s = state_;
@@ -798,6 +807,12 @@ std::unique_ptr<World> World::restore(const Model& base, ByteReader& r) {
     r.mat(p.position);
     p.orientation = r.quat();
     p.fixed = r.pod<uint8_t>() != 0;
+    p.ridge = r.pod<int32_t>();
+    const uint8_t part = r.pod<uint8_t>();
+    FLOESIM_REQUIRE(p.ridge >= -1 && p.ridge < static_cast<int>(m.settings.ridges.size()) &&
+                        part <= static_cast<uint8_t>(RidgePart::sail),
+                    r.what(), ": damaged (piece ", p.id, " names ridge ", p.ridge, ", part ", int(part), ")");
+    p.ridge_part = static_cast<RidgePart>(part);
     // Every number finite and every length within kMaxLength_m, the outline's area finite and positive (a NaN,
     // infinite or near-infinite box crashes the broad phase's tree), the orientation a unit quaternion, as a run
     // writes them.

@@ -192,6 +192,8 @@ struct PieceSpec {
   Vec3 position = Vec3::Zero();
   Quat orientation = Quat::Identity();
   bool fixed = false;  // level ice: the rest of a tile, still held by the sheet (hold_fixed)
+  int ridge = -1;      // a piece of a ridge's consolidated layer keeps the layer's tags (Body::ridge)
+  RidgePart ridge_part = RidgePart::none;
 };
 Body make_piece_body(const PieceSpec& p, int body_index, const EngineSettings& o, std::vector<ConvexPart>& parts);
 

@@ -53,6 +53,10 @@ struct SimulateOptions : EngineSettings {
            "structures beside the vessel (fixed, moored, dp or compliant), each a hull body of its own with its "
            "loads, pose and station keeping recorded under its name: [{\"name\", \"hull_file\", placement and "
            "mass as the vessel's, \"station_keeping\"}]");
+    v.list("ridges", ridges,
+           "ridges in the level ice sheet, each a consolidated layer cut out of the sheet along its line and the "
+           "rubble of its keel and sail released around it to settle: [{\"line\", cross-section, porosity, "
+           "blocks}] (PHYSICS.md §9)");
     for (size_t i = 0; i < structures.size(); ++i)
       for (size_t j = 0; j < i; ++j)
         if (structures[i].name == structures[j].name)

@@ -35,7 +35,7 @@ void seal(const fs::path& p, const std::string& magic, const std::string& payloa
 
 
 const char kRecordsMagic[] = "floesim-checkpoint-records/1\n";
-const char kCheckpointMagic[] = "floesim-checkpoint/7\n";
+const char kCheckpointMagic[] = "floesim-checkpoint/8\n";
 
 // Element `index` of the array `name` in a records chunk set to `value` (of the array's element type T), the chunk
 // re-sealed and checkpoint.bin re-sealed naming its new hash: the hashes all agree and the array sizes still add up.
@@ -155,7 +155,7 @@ void reseal_first_piece(const fs::path& dir, int field, double value) {
 
 // Where the heave radiation filter's states (State::heave_lowpass_mps, one double per body) start in checkpoint.bin:
 // after the body table (counts, then each piece: outline, thickness, 4 ints, created_s, position, quaternion,
-// fixed) and the state arrays before it (time, step, positions, orientations, velocities, angular velocities, awake,
+// fixed, its ridge and ridge part) and the state arrays before it (time, step, positions, orientations, velocities, angular velocities, awake,
 // alive, still times). Returns the offset of its count.
 size_t heave_filter_offset(const std::string& c) {
   auto u64 = [&](size_t where) {
@@ -166,7 +166,7 @@ size_t heave_filter_offset(const std::string& c) {
   size_t at = world_offset(c);
   const size_t pieces = u64(at + 16);
   at += 24;
-  for (size_t k = 0; k < pieces; ++k) at += 8 + 16 * u64(at) + 8 + 16 + 8 + 24 + 32 + 1;
+  for (size_t k = 0; k < pieces; ++k) at += 8 + 16 * u64(at) + 8 + 16 + 8 + 24 + 32 + 1 + 4 + 1;
   at += 16;                     // time, step
   at += 8 + 24 * u64(at);       // positions
   at += 8 + 32 * u64(at);       // orientations

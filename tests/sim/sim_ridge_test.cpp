@@ -13,6 +13,7 @@
 #include "pipeline/error.h"
 #include "pipeline/options.h"
 #include "sim/engine/ridge.h"
+#include "sim/engine/ridge_built.h"
 #include "tests/sim/sim_fixtures.h"
 
 namespace floesim::sim {
@@ -189,6 +190,139 @@ TEST(RidgeSettling, ABlockReleasedUnderTheLayerRisesAndRestsAgainstIt) {
   EXPECT_NEAR(-push, net, 0.01 * net);                // the layer carries its net buoyancy
 }
 
+// A small ridge along y at x = 0: keel 3 m deep and 10 m wide at 45 deg under a 0.8 m layer, a 0.8 m sail at 30 deg,
+// blocks 0.3 m thick and 0.5-1.0 m across.
+RidgeOptions small_ridge(double y0, double y1) {
+  RidgeOptions r;
+  r.line = {{0, y0}, {0, y1}};
+  r.sail_height_m = 0.8;
+  r.keel_depth_m = 3.0;
+  r.keel_width_m = 10;
+  r.keel_angle_deg = 45;
+  r.sail_angle_deg = 30;
+  r.consolidated_thickness_m = 0.8;
+  r.block_thickness_m = 0.3;
+  r.block_size_m = {0.5, 1.0};
+  return r;
+}
+
+// A case's ridge (settings.ridges) in a model: its consolidated layer cut out of the level ice sheet along its line
+// (h_c thick, the sheet's ice elsewhere), its rubble as released blocks carrying (1 - e) of the keel's and the sail's
+// envelopes, all of it ice: the model's ice is the sheet's plus the rubble's.
+TEST(RidgeModel, TheLayerIsCutOutOfTheSheetAndTheRubbleCarriesTheRidgesIce) {
+  SimulateOptions o = testing::floe_options();
+  o.level_ice.extent_m = {-40, -10, 40, 10};
+  o.level_ice.thickness_m = 0.5;
+  o.level_ice.tile_m = 20;
+  o.ridges = {small_ridge(-10, 10)};
+  const Model m = build_model(FloeField{}, nullptr, o);
+  // By hand: the layer floats 0.8 x 900/1025 = 0.702439 m deep, so the keel is 2.297561 m deep under it, its bottom
+  // 10 - 2 x 2.297561 = 5.404878 m wide, its section 17.69683 m^2; the sail rises 0.702439 m over the layer's top
+  // (0.097561 m), its base 2 x 0.702439 / tan 30 = 2.433321 m, its section 0.854626 m^2. Over 20 m at e = 0.3 the
+  // rubble is 247.7556 m^3 of keel and 11.96476 m^3 of sail, each overshot by less than one block (0.3 m^3).
+  double layer_m2 = 0, sheet_m2 = 0, keel_m3 = 0, sail_m3 = 0, ice_kg = 0;
+  int keel_blocks = 0, sail_blocks = 0;
+  bool rubble_out_of_place = false;
+  for (const Body& b : m.bodies) {
+    if (b.kind != BodyKind::floe) continue;
+    ice_kg += b.mass_kg;
+    const double volume = b.section_area * b.thickness_m, z = b.initial_position.z();
+    if (b.ridge_part == RidgePart::layer) {
+      EXPECT_TRUE(b.fixed);
+      EXPECT_DOUBLE_EQ(b.thickness_m, 0.8);
+      layer_m2 += b.section_area;
+    } else if (b.ridge_part == RidgePart::keel) {
+      EXPECT_TRUE(b.brash);
+      ++keel_blocks, keel_m3 += volume;
+      rubble_out_of_place = rubble_out_of_place || z + 0.15 > -0.702439 || std::abs(b.initial_position.x()) > 5;
+    } else if (b.ridge_part == RidgePart::sail) {
+      EXPECT_TRUE(b.brash);
+      ++sail_blocks, sail_m3 += volume;
+      rubble_out_of_place = rubble_out_of_place || z - 0.15 < 0.097561;
+    } else {
+      EXPECT_TRUE(b.fixed);
+      EXPECT_DOUBLE_EQ(b.thickness_m, 0.5);
+      sheet_m2 += b.section_area;
+    }
+  }
+  std::printf("[measured] %d keel blocks (%.3f m^3), %d sail blocks (%.3f m^3); layer %.3f m^2, sheet %.3f m^2\n",
+              keel_blocks, keel_m3, sail_blocks, sail_m3, layer_m2, sheet_m2);
+  EXPECT_NEAR(layer_m2, 10 * 20, 1e-9);
+  EXPECT_NEAR(sheet_m2, 80 * 20 - 10 * 20, 1e-9);
+  EXPECT_GE(keel_m3, 247.7556 - 1e-3);
+  EXPECT_LT(keel_m3, 247.7556 + 0.3);
+  EXPECT_GE(sail_m3, 11.96476 - 1e-4);
+  EXPECT_LT(sail_m3, 11.96476 + 0.3);
+  EXPECT_FALSE(rubble_out_of_place);  // the keel's under the layer inside its width, the sail's over it
+  EXPECT_NEAR(ice_kg, kIce * (200 * 0.8 + 1400 * 0.5 + keel_m3 + sail_m3), 1e-9 * ice_kg);
+  // Released out of equilibrium, the rubble starts awake; the sheet never is.
+  const World w(m);
+  for (size_t b = 0; b < m.bodies.size(); ++b) {
+    const RidgePart p = m.bodies[b].ridge_part;
+    EXPECT_EQ(w.state().awake[b] != 0, p == RidgePart::keel || p == RidgePart::sail);
+  }
+}
+
+// A keel built as the ocean builds it (issue #36 item 2): the blocks released under a fixed layer float up and come
+// to rest against it, the sail's fall onto it. At rest the contacts press the sheet up with the keel's net buoyancy
+// less the sail's weight, the closed form of the blocks' volumes.
+TEST(RidgeSettling, AKeelSettlesUnderItsLayerWhichCarriesItsNetBuoyancy) {
+  SimulateOptions o = testing::floe_options();
+  o.fracture.enabled = false;
+  o.level_ice.extent_m = {-15, -3, 15, 3};
+  o.level_ice.thickness_m = 0.5;
+  o.level_ice.tile_m = 10;
+  o.domain.extent_m = {-15, -3, 15, 3};
+  o.domain.walls = {"north", "south"};
+  RidgeOptions r = small_ridge(-3, 3);
+  r.keel_depth_m = 2.2;
+  r.keel_width_m = 7;
+  r.sail_height_m = 0.6;
+  r.consolidated_thickness_m = 0.6;
+  o.ridges = {r};
+  World w(build_model(FloeField{}, nullptr, o));
+  const Model& m = w.model();
+  const double layer_bottom = -0.6 * kIce / kWater, layer_top = 0.6 + layer_bottom;
+  double deepest_released = 0, net_n = 0;
+  const double g = o.water.gravity_mps2;
+  for (const Body& b : m.bodies) {
+    if (b.ridge_part == RidgePart::keel) {
+      deepest_released = std::max(deepest_released, -b.initial_position.z() + 0.15);
+      net_n += (kWater - kIce) * g * b.section_area * b.thickness_m;
+    }
+    if (b.ridge_part == RidgePart::sail) net_n -= kIce * g * b.section_area * b.thickness_m;
+  }
+  for (int k = 0; k < 3000; ++k) w.step();
+  const RidgeBuilt built = measure_ridge(m, w.state(), 0, 0.05);
+  // The rubble's vertical push up on the fixed sheet (its tiles and the layer's) over the last step.
+  double push = 0;
+  for (const Contact& c : w.contacts()) {
+    const double p = (c.pn * c.normal.z() + c.pt1 * c.t1.z() + c.pt2 * c.t2.z()) / o.time_step_s;  // on b, from a
+    if (m.bodies[c.body_b].fixed && m.bodies[c.body_b].kind == BodyKind::floe) push += p;
+    if (m.bodies[c.body_a].fixed && m.bodies[c.body_a].kind == BodyKind::floe) push -= p;
+  }
+  bool above_layer = false, below_layer = false;
+  for (size_t b = 0; b < m.bodies.size(); ++b) {
+    const Body& body = m.bodies[b];
+    const double top = w.state().position[b].z() + 0.5 * std::hypot(body.thickness_m, 2 * body.section_radius);
+    const double bottom = w.state().position[b].z() - 0.5 * std::hypot(body.thickness_m, 2 * body.section_radius);
+    if (body.ridge_part == RidgePart::keel) above_layer = above_layer || bottom > layer_bottom;
+    if (body.ridge_part == RidgePart::sail) below_layer = below_layer || top < layer_top;
+  }
+  std::printf("[measured] %d blocks settled in 30 s: fastest %.2e m/s; keel %.2f m deep (released to %.2f m), "
+              "%.2f m^2 (%.2f m^2 sail); porosity in the keel as built %.3f by volume, %.3f by voxels; the rubble "
+              "presses the sheet up with %.1f N against %.1f N by its volumes\n",
+              built.blocks, built.max_block_speed_mps, built.keel_depth_m, deepest_released, built.keel_area_m2,
+              built.sail_area_m2, built.porosity_by_volume, built.porosity_by_voxels, push, net_n);
+  EXPECT_LT(built.max_block_speed_mps, 0.02);                        // at rest
+  EXPECT_LT(built.keel_depth_m, deepest_released - 0.3);             // it rose
+  EXPECT_GT(built.keel_depth_m, -layer_bottom + 0.3);                // and stays a keel
+  EXPECT_FALSE(above_layer);                                         // no keel block came through the layer
+  EXPECT_FALSE(below_layer);                                         // no sail block fell through it
+  EXPECT_NEAR(built.porosity_by_volume, built.porosity_by_voxels, 0.03);
+  EXPECT_NEAR(push, net_n, 0.01 * net_n);
+}
+
 TEST(RidgeSection, BadInputNamesTheKey) {
   RidgeOptions shallow = first_year();
   shallow.keel_depth_m = 0.5;  // the 1 m layer floats 0.88 m deep
@@ -207,6 +341,12 @@ TEST(RidgeSection, BadInputNamesTheKey) {
                {"line", "two points"});
   expect_error([&] { read_options<RidgeOptions>({{"line", line}, {"keel_draught_m", 6}}, "ridge.json"); },
                {"keel_draught_m"});
+  // A ridge running off the sheet's edge (its layer half on the sheet): named, with the fix.
+  SimulateOptions o = testing::floe_options();
+  o.level_ice.extent_m = {-40, -10, 40, 10};
+  o.level_ice.tile_m = 20;
+  o.ridges = {small_ridge(-30, 10)};
+  expect_error([&] { build_model(FloeField{}, nullptr, o); }, {"ridges[0]", "segment 0", "sheet"});
 }
 
 }  // namespace

@@ -1,0 +1,165 @@
+#include "sim/engine/ridge_built.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "pipeline/error.h"
+
+namespace floesim::sim {
+
+namespace {
+
+// Whether world point p lies in block b at pose (x, q): inside its slab and its (convex) outline.
+bool block_holds(const Body& b, const Vec3& x, const Mat3& R, const Vec3& p) {
+  const Vec3 l = R.transpose() * (p - x);
+  if (std::abs(l.z()) > 0.5 * b.thickness_m) return false;
+  const Polygon& o = b.outline;
+  for (size_t i = 0; i < o.size(); ++i) {
+    const Vec2 e = o[(i + 1) % o.size()] - o[i], d = Vec2(l.x(), l.y()) - o[i];
+    if (e.x() * d.y() - e.y() * d.x() < 0) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+RidgeBuilt measure_ridge(const Model& m, const State& st, int ridge, double voxel) {
+  FLOESIM_REQUIRE(ridge >= 0 && ridge < static_cast<int>(m.settings.ridges.size()), "measure_ridge: no ridge ", ridge);
+  FLOESIM_REQUIRE(voxel > 0, "measure_ridge: the voxel edge must be > 0, got ", voxel);
+  const RidgeOptions& r = m.settings.ridges[ridge];
+  const Vec2 a(r.line[0].x_m, r.line[0].y_m), b(r.line[1].x_m, r.line[1].y_m);
+  const double length = (b - a).norm();
+  const Vec2 t = (b - a) / length, n(-t.y(), t.x());
+  RidgeBuilt out;
+  // 1. The ridge's bodies: the ice under and over the waterline, the layer's level, the blocks' extremes.
+  struct Block {
+    int body;
+    Vec3 x;
+    Mat3 R;
+    double s_lo, s_hi, t_lo, t_hi, z_lo, z_hi;
+    bool keel;
+  };
+  std::vector<Block> blocks;
+  double layer_area = 0, layer_bottom = 0, layer_top = 0;
+  std::vector<Vec3> world;
+  for (size_t k = 0; k < m.bodies.size(); ++k) {
+    const Body& body = m.bodies[k];
+    if (!st.alive[k] || body.ridge != ridge) continue;
+    const Vec3& x = st.position[k];
+    const Mat3 R = st.orientation[k].toRotationMatrix();
+    world.clear();
+    for (const Vec3& v : body.buoyancy_mesh.vertices) world.push_back(x + R * v);
+    const double volume = body.section_area * body.thickness_m;
+    const double below = std::min(volume, submerged_part(world, body.buoyancy_mesh.triangles, 0.0).volume);
+    out.ice_below_m3 += below;
+    out.ice_above_m3 += volume - below;
+    if (body.ridge_part == RidgePart::layer) {
+      layer_area += body.section_area;
+      layer_bottom += body.section_area * (x.z() - 0.5 * body.thickness_m);
+      layer_top += body.section_area * (x.z() + 0.5 * body.thickness_m);
+      continue;
+    }
+    ++out.blocks;
+    out.max_block_speed_mps = std::max(out.max_block_speed_mps, st.velocity[k].norm());
+    Block bl{static_cast<int>(k), x, R, 1e300, -1e300, 1e300, -1e300, 1e300, -1e300,
+             body.ridge_part == RidgePart::keel};
+    for (const Vec3& p : world) {
+      const Vec2 d = p.head<2>() - a;
+      bl.s_lo = std::min(bl.s_lo, d.dot(n)), bl.s_hi = std::max(bl.s_hi, d.dot(n));
+      bl.t_lo = std::min(bl.t_lo, d.dot(t)), bl.t_hi = std::max(bl.t_hi, d.dot(t));
+      bl.z_lo = std::min(bl.z_lo, p.z()), bl.z_hi = std::max(bl.z_hi, p.z());
+    }
+    if (bl.keel) out.keel_depth_m = std::max(out.keel_depth_m, -bl.z_lo);
+    else out.sail_height_m = std::max(out.sail_height_m, bl.z_hi);
+    const double tc = (x.head<2>() - a).dot(t);
+    if (tc >= 0 && tc <= length) blocks.push_back(bl);
+  }
+  FLOESIM_REQUIRE(layer_area > 0, "measure_ridge: ridge ", ridge, " has no consolidated layer left");
+  out.layer_bottom_z = layer_bottom / layer_area;
+  out.layer_top_z = layer_top / layer_area;
+  if (blocks.empty()) return out;
+  // 2. Voxel columns over the blocks' extent across the line, the segment along it; each column's candidates from
+  // buckets of the blocks' plan extents.
+  double s_lo = 1e300, s_hi = -1e300, z_lo = out.layer_bottom_z, z_hi = out.layer_top_z;
+  for (const Block& bl : blocks)
+    s_lo = std::min(s_lo, bl.s_lo), s_hi = std::max(s_hi, bl.s_hi), z_lo = std::min(z_lo, bl.z_lo),
+    z_hi = std::max(z_hi, bl.z_hi);
+  s_lo = voxel * std::floor(s_lo / voxel), s_hi = voxel * std::ceil(s_hi / voxel);
+  const int ns = static_cast<int>(std::lround((s_hi - s_lo) / voxel));
+  const int nt = std::max(1, static_cast<int>(std::ceil(length / voxel)));
+  const double dt = length / nt;
+  // Keel levels down from the highest keel block's top (blocks spread under thinner ice beside the layer rest
+  // higher than its bottom); sail levels up from the layer's top.
+  double keel_top = -1e300;
+  for (const Block& bl : blocks)
+    if (bl.keel) keel_top = std::max(keel_top, bl.z_hi);
+  const int nk = keel_top > z_lo ? static_cast<int>(std::ceil((keel_top - z_lo) / voxel)) : 0;
+  const int nu = static_cast<int>(std::ceil((z_hi - out.layer_top_z) / voxel));     // sail levels, up
+  const double bucket = 2.0;
+  const int bs = static_cast<int>(std::ceil((s_hi - s_lo) / bucket)) + 1, bt = static_cast<int>(length / bucket) + 1;
+  std::vector<std::vector<int>> buckets(static_cast<size_t>(bs) * bt);
+  for (size_t i = 0; i < blocks.size(); ++i) {
+    const Block& bl = blocks[i];
+    const int s0 = std::max(0, static_cast<int>((bl.s_lo - s_lo) / bucket));
+    const int s1 = std::min(bs - 1, static_cast<int>((bl.s_hi - s_lo) / bucket));
+    const int t0 = std::max(0, static_cast<int>(std::floor(bl.t_lo / bucket)));
+    const int t1 = std::min(bt - 1, static_cast<int>(std::floor(bl.t_hi / bucket)));
+    for (int q = t0; q <= t1; ++q)
+      for (int p = s0; p <= s1; ++p) buckets[static_cast<size_t>(q) * bs + p].push_back(static_cast<int>(i));
+  }
+  out.profile_s_m.resize(ns);
+  out.keel_bottom_z.assign(ns, 0.0);
+  out.sail_top_z.assign(ns, 0.0);
+  long envelope = 0, solid = 0;
+  for (int is = 0; is < ns; ++is) {
+    const double s = s_lo + (is + 0.5) * voxel;
+    out.profile_s_m[is] = s;
+    for (int it = 0; it < nt; ++it) {
+      const double u = (it + 0.5) * dt;
+      const std::vector<int>& cand =
+          buckets[static_cast<size_t>(std::min(bt - 1, static_cast<int>(u / bucket))) * bs +
+                  std::min(bs - 1, static_cast<int>((s - s_lo) / bucket))];
+      const Vec2 p = a + u * t + s * n;
+      auto solid_at = [&](double z, bool keel) {
+        for (int i : cand) {
+          const Block& bl = blocks[i];
+          if (bl.keel == keel && z >= bl.z_lo && z <= bl.z_hi &&
+              block_holds(m.bodies[bl.body], bl.x, bl.R, Vec3(p.x(), p.y(), z)))
+            return true;
+        }
+        return false;
+      };
+      // The keel: from the ice's underside (the layer's bottom within its width; beside it, where rubble spread
+      // under thinner ice, the highest keel block) down to the deepest keel block, and the solid levels between.
+      const bool under_layer = std::abs(s) <= 0.5 * r.keel_width_m;
+      const int layer_level = std::max(0, static_cast<int>(std::floor((keel_top - out.layer_bottom_z) / voxel)));
+      int top = under_layer ? layer_level : -1, deepest = -1, count = 0;
+      for (int k = 0; k < nk; ++k)
+        if (solid_at(keel_top - (k + 0.5) * voxel, true)) {
+          if (top < 0) top = k;
+          deepest = k;
+          count += k >= top;
+        }
+      envelope += deepest >= top ? deepest - top + 1 : 0;
+      solid += count;
+      out.keel_bottom_z[is] += deepest >= 0 ? keel_top - (deepest + 1) * voxel : out.layer_bottom_z;
+      int highest = -1;
+      for (int k = nu - 1; k >= 0 && highest < 0; --k)
+        if (solid_at(out.layer_top_z + (k + 0.5) * voxel, false)) highest = k;
+      out.sail_top_z[is] += out.layer_top_z + (highest + 1) * voxel;
+      out.sail_area_m2 += (highest + 1) * voxel * voxel / nt;
+    }
+    out.keel_bottom_z[is] /= nt;
+    out.sail_top_z[is] /= nt;
+  }
+  const double envelope_m3 = envelope * voxel * voxel * dt;
+  out.keel_area_m2 = envelope_m3 / length;
+  double keel_m3 = 0;
+  for (const Block& bl : blocks)
+    if (bl.keel) keel_m3 += m.bodies[bl.body].section_area * m.bodies[bl.body].thickness_m;
+  out.porosity_by_volume = envelope > 0 ? 1 - keel_m3 / envelope_m3 : 1.0;
+  out.porosity_by_voxels = envelope > 0 ? 1 - static_cast<double>(solid) / static_cast<double>(envelope) : 1.0;
+  return out;
+}
+
+}  // namespace floesim::sim

@@ -1,0 +1,40 @@
+// A ridge as built (issue #36 item 4, PHYSICS.md §9.1 and §9.5): what its settled blocks and its consolidated layer
+// make, measured in a world's state. The rubble's envelope is found, not assumed: the keel's bottom and the sail's
+// top across the line are read from voxels of the blocks themselves, and the porosity is measured inside that
+// envelope, two ways.
+#pragma once
+#include <vector>
+
+#include "sim/engine/model.h"
+#include "sim/engine/state.h"
+
+namespace floesim::sim {
+
+struct RidgeBuilt {
+  int blocks = 0;                      // keel and sail blocks alive
+  double keel_depth_m = 0;             // deepest point of any keel block below the waterline
+  double sail_height_m = 0;            // highest point of any sail block above the waterline (0: no sail blocks)
+  double layer_bottom_z = 0, layer_top_z = 0;  // of the layer as it floats now (its tiles' mean)
+  // Across the line (s, m, left of its direction; bins of voxel_m): the keel's bottom z (the mean over the line of
+  // each column's deepest keel block voxel; the layer's bottom where no block is) and the sail's top z (the layer's top
+  // where none).
+  std::vector<double> profile_s_m, keel_bottom_z, sail_top_z;
+  // Cross-sections (m^2) of the envelopes as built: the keel in each column from the ice's underside (the layer's
+  // bottom within its width; beside it, where rubble spread under thinner ice, the highest keel block) down to its
+  // deepest keel block; the sail between the layer's top and its top profile.
+  double keel_area_m2 = 0, sail_area_m2 = 0;
+  // Macro-porosity of the keel inside its envelope as built: by volume, 1 - (the keel blocks' volume) / (the
+  // envelope's volume); by voxels, the share of the envelope's voxels no block holds. They differ by the voxels'
+  // resolution of the envelope's edge.
+  double porosity_by_volume = 0, porosity_by_voxels = 0;
+  // The ridge's ice (layer and blocks) under and over the waterline: a ridge that floats freely and is at rest
+  // has their ratio rho_i / (rho_w - rho_i) (PHYSICS.md §9.1).
+  double ice_below_m3 = 0, ice_above_m3 = 0;
+  double max_block_speed_mps = 0;      // the fastest block (at rest: settled)
+};
+
+// Measures ridge `ridge` (its index in settings.ridges) in `state`, over its line's first segment (a straight ridge;
+// blocks beyond the segment's ends left out), on voxels of edge voxel_m.
+RidgeBuilt measure_ridge(const Model& model, const State& state, int ridge, double voxel_m);
+
+}  // namespace floesim::sim
