@@ -54,6 +54,10 @@ const std::vector<FieldSpec>& series_fields() {
        "kinetic energy of the floes and pieces (translation and rotation) at the end of the step: a long run's ice "
        "must not gain energy",
        7},
+      {"ice_load_ridge_rubble", 6, "N, N m",
+       "part of ice_load from the rubble of ridges' keels and sails (simulate.ridges), body axes", 10},
+      {"ice_load_ridge_layer", 6, "N, N m",
+       "part of ice_load from ridges' consolidated layers and the pieces broken from them, body axes", 10},
       {"station_offset", 3, "m, m, rad",
        "a moored or DP structure (simulate.vessel.station_keeping): its reference point's offset from its station, "
        "earth frame (x, y), and its heading's change; 0 for a ship or a fixed structure",
@@ -95,6 +99,9 @@ const std::vector<StructureField>& structure_fields() {
       {"ice_force_n", "N", "[3] the ice's force on it (every contact)"},
       {"ice_moment_nm", "N m", "[3] the ice's moment about its reference point (its axis at the water line)"},
       {"level_ice_force_n", "N", "[3] the part of ice_force_n from level ice tiles (breaking the sheet's edge)"},
+      {"ridge_rubble_force_n", "N", "[3] the part of ice_force_n from ridges' rubble (keels and sails; layout /10)"},
+      {"ridge_layer_force_n", "N",
+       "[3] the part of ice_force_n from ridges' consolidated layers and their pieces (layout /10)"},
       {"water_force_n", "N", "[3] buoyancy, damping and the water's resistance (0 for a fixed structure)"},
       {"station_keeping_force_n", "N", "[3] its mooring lines' or thrusters' force (0 for a fixed structure)"},
       {"offset", "m, m, rad", "[3] its reference point's offset x, y from the station, its heading's change"},
@@ -221,7 +228,7 @@ std::vector<T> read_ds(hid_t file_id, const std::string& name, size_t cols, cons
 // plot and render: /1 had no fracture (no /fracture, no lineage), /2 no solver series beyond sweeps and residual,
 // /3 no /states/in_contact, /4 no /geometry/floe_level_ice, /5 no ice_load_level_ice series, /6 every alive body
 // in every frame (which FrameReplay reads like the changed bodies of /7) and no ice_kinetic_energy series.
-constexpr int kLayoutVersion = 9;
+constexpr int kLayoutVersion = 10;
 constexpr const char* kLayoutPrefix = "floesim-results/";
 std::string layout_name(int version) { return kLayoutPrefix + std::to_string(version); }
 

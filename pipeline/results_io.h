@@ -50,7 +50,9 @@
 //                                                   (structure_fields below). Earth axes; NAME/hull_vertices_m
 //                                                   [V x 3] and NAME/hull_triangles [T x 3] its mesh in its body
 //                                                   frame (origin = centre of mass).
-//   Layout "floesim-results/9" (this one) added /structures (none when reading an earlier file). "/8" added the
+//   Layout "floesim-results/10" (this one) added the series ice_load_ridge_rubble and ice_load_ridge_layer (NaN when
+//   reading an earlier file) and the structures' fields ridge_rubble_force_n and ridge_layer_force_n. "/9" added
+//   /structures (none when reading an earlier file). "/8" added the
 //   fracture mode 4, crushing, and the series station_offset, station_keeping_demanded and
 //   station_keeping_delivered (NaN when reading an earlier file). "/7" stores only the
 //   changed bodies in a frame and added the series ice_kinetic_energy (NaN when reading an earlier file); earlier

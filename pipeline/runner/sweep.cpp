@@ -412,16 +412,30 @@ void set_key_path(Json& c, const std::string& path, const Json& value, const std
   for (auto& k : kCaseKeys) known = known || k == parts[0];
   FLOESIM_REQUIRE(known, where, ": key path \"", path, "\": unknown case section \"", parts[0],
                   "\" (known: ", join(kCaseKeys, ", "), ")");
+  // A part names a key of an object, or (all digits) an element of a list the case already has: simulate.ridges.0.
   Json* j = &c;
   std::string at;
+  auto element = [&](const std::string& part) -> Json* {
+    const bool digits = part.find_first_not_of("0123456789") == std::string::npos;
+    FLOESIM_REQUIRE(digits && part.size() < 10 && std::stoul(part) < j->size(), where, ": key path \"", path, "\": ",
+                    at, " is a list of ", j->size(), " in the case, and \"", part,
+                    "\" is not the index of one of its elements (counted from 0)");
+    return &(*j)[std::stoul(part)];
+  };
   for (size_t i = 0; i + 1 < parts.size(); ++i) {
+    if (j->is_array()) {
+      j = element(parts[i]);
+      at += "." + parts[i];
+      continue;
+    }
     at += (i ? "." : "") + parts[i];
     if (!j->contains(parts[i])) (*j)[parts[i]] = Json::object();
-    FLOESIM_REQUIRE((*j)[parts[i]].is_object(), where, ": key path \"", path, "\": ", at,
-                    " is not an object in the case");
+    FLOESIM_REQUIRE((*j)[parts[i]].is_object() || (*j)[parts[i]].is_array(), where, ": key path \"", path, "\": ",
+                    at, " is not an object in the case");
     j = &(*j)[parts[i]];
   }
-  (*j)[parts.back()] = value;
+  if (j->is_array()) *element(parts.back()) = value;
+  else (*j)[parts.back()] = value;
 }
 
 Sweep read_sweep(const fs::path& sweep_dir) {

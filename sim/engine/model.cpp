@@ -1064,12 +1064,11 @@ void add_floe_bodies(const std::vector<FloeGeometry>& geo, const std::vector<int
 }
 
 // 4. The ridges' rubble (settings.ridges): the blocks release_blocks gives each ridge, as floes where they were
-// released (under the layer, to float up; over it, to fall), after the other floes with ids after theirs. A block is
+// released (under the layer, to float up; over it, to fall), after the other floes, ids from next_id (after every
+// floe's, those removed from the vessel's start included: the same with or without a hull). A block is
 // brash (rigid contacts, its crushing force as their ceiling, never broken), so a keel costs contact points rather
 // than crushing rows; it starts awake (World). A block over the vessel's start is an error.
-void add_ridge_blocks(const std::vector<Polygon>& footprint, const EngineSettings& o, Model& model) {
-  int next_id = 1;
-  for (const Body& b : model.bodies) next_id = std::max(next_id, b.id + 1);
+void add_ridge_blocks(int next_id, const std::vector<Polygon>& footprint, const EngineSettings& o, Model& model) {
   for (size_t i = 0; i < o.ridges.size(); ++i) {
     const RidgeOptions& r = o.ridges[i];
     const std::string where = "ridges[" + std::to_string(i) + "]";
@@ -1092,6 +1091,7 @@ void add_ridge_blocks(const std::vector<Polygon>& footprint, const EngineSetting
       b.brash_crush_force_n = o.ice.crushing_strength_pa * k.thickness * 4 * signed_area(local) / perimeter_m(local);
       b.ridge = static_cast<int>(i);
       b.ridge_part = k.keel ? RidgePart::keel : RidgePart::sail;
+      b.start_awake = true;
       model.bodies.push_back(std::move(b));
     }
   }
@@ -1209,7 +1209,9 @@ Model build_model(const FloeField& field, const HullModel* hull, const EngineSet
 
   // 4. Floe bodies: slab of the floe's thickness, body frame at the centre of mass, at hydrostatic equilibrium.
   add_floe_bodies(geo, ridge_of, footprint, o, model);
-  add_ridge_blocks(footprint, o, model);
+  int next_id = 1;
+  for (const Floe& f : floes) next_id = std::max(next_id, f.id + 1);
+  add_ridge_blocks(next_id, footprint, o, model);
 
   // 5. Domain walls outside the sides of the domain rectangle.
   if (!o.domain.walls.empty()) add_walls(field, hull != nullptr, footprint, o, model);

@@ -122,6 +122,8 @@ struct Body {
   // gravity; a layer tile is level ice h_c thick, and the pieces broken from it keep its tags.
   int ridge = -1;
   RidgePart ridge_part = RidgePart::none;
+  // Starts awake even where floes start asleep: rubble released out of equilibrium, not yet settled.
+  bool start_awake = false;
 };
 
 // What the vessel model needs of the hull, computed from the mesh at the design waterline (z = 0).

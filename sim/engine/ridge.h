@@ -72,6 +72,26 @@ struct RidgeOptions {
   }
 };
 
+// How the ridges' rubble is settled before a run (settle_ridges, sim/engine/ridge_build.h): in still water, until
+// every block has been slower than rest_speed_mps (and turning slower than rest_speed_mps per metre) for
+// rest_time_s; the ridge as built is then measured on voxels of edge voxel_m.
+struct RidgeSettlingOptions {
+  double max_s = 300;
+  double rest_speed_mps = 0.01;
+  double rest_time_s = 2.0;
+  double voxel_m = 0.1;
+  template <class V>
+  void visit(V& v) {
+    v.field("max_s", max_s, "s", "simulated time the rubble may take to come to rest (not at rest by then: an error)",
+            positive());
+    v.field("rest_speed_mps", rest_speed_mps, "m/s",
+            "a block is at rest below this speed (and below this many rad/s of turning)", positive());
+    v.field("rest_time_s", rest_time_s, "s", "every block at rest this long: the ridge is built", positive());
+    v.field("voxel_m", voxel_m, "m", "voxel edge of the ridge's measurement as built (profiles, porosity)",
+            in_range(0.01, 1));
+  }
+};
+
 // The cross-section of a ridge as given (before settling), in the segment frame; water and ice densities from the
 // simulation's settings.
 struct RidgeSection {

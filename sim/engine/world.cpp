@@ -86,9 +86,7 @@ World::World(Model built) : model_(std::move(built)), pool_(model_.settings.thre
     state_.position[b] = model.bodies[b].initial_position;
     state_.orientation[b] = model.bodies[b].initial_orientation;
     if (is_fixed_body(model.bodies[b])) state_.awake[b] = 0;  // a wall or level ice: never integrated
-    // A ridge's rubble is released out of equilibrium, to be settled: awake.
-    const RidgePart rp = model.bodies[b].ridge_part;
-    if (rp == RidgePart::keel || rp == RidgePart::sail) state_.awake[b] = 1;
+    if (model.bodies[b].start_awake) state_.awake[b] = 1;  // a ridge's rubble released, not yet settled
     // An established drift: floes start with the current's velocity (horizontal).
     if (model.bodies[b].kind == BodyKind::floe && !model.bodies[b].fixed && o.water.enabled &&
         o.water.floes_start_with_current)
@@ -361,8 +359,10 @@ void World::stage_relax() {
     report_.vessel_part_force_n.assign(model_.bodies[model_.vessel].part_count, Vec3::Zero());
     parts = &report_.vessel_part_force_n;
   }
+  report_.ridge_load = RidgeLoad();
   report_.vessel_contacts = hull_ice_load(contacts_, model_.vessel, &report_.ice_load_rigid,
-                                          &report_.ice_load_compliant, &report_.ice_load_level_ice, parts);
+                                          &report_.ice_load_compliant, &report_.ice_load_level_ice, parts,
+                                          &report_.ridge_load);
   report_.ice_load = report_.ice_load_rigid;
   report_.ice_load += report_.ice_load_compliant;
   for (size_t s = 0; s < model_.structures.size(); ++s) {
@@ -370,8 +370,9 @@ void World::stage_relax() {
     sr.part_force_n.assign(model_.structures[s].part_count, Vec3::Zero());
     Wrench rigid, compliant;
     sr.ice_load_level_ice = Wrench();
+    sr.ridge_load = RidgeLoad();
     sr.contacts = hull_ice_load(contacts_, model_.structures[s].body, &rigid, &compliant, &sr.ice_load_level_ice,
-                                &sr.part_force_n);
+                                &sr.part_force_n, &sr.ridge_load);
     sr.ice_load = rigid;
     sr.ice_load += compliant;
   }
@@ -417,7 +418,7 @@ int World::vessel_ice_load(const std::vector<Contact>& contacts, Wrench* rigid, 
 }
 
 int World::hull_ice_load(const std::vector<Contact>& contacts, int body, Wrench* rigid, Wrench* compliant,
-                         Wrench* level_ice, std::vector<Vec3>* part_force) const {
+                         Wrench* level_ice, std::vector<Vec3>* part_force, RidgeLoad* ridge) const {
   // Contact loads on the body: impulse / dt, about its centre of mass (lever arms of the solve), split by contact
   // law (the seed filters compliant loads over 0.5 s and rigid ones over 20 s, PHYSICS.md §5); and, if asked, the
   // part from level ice tiles (breaking the sheet's edge, against clearing the pieces) and each part's force.
@@ -433,7 +434,10 @@ int World::hull_ice_load(const std::vector<Contact>& contacts, int body, Wrench*
     if (c.body_b == body) w.add_at(p, c.rb);
     else w.add_at(-p, c.ra);
     *(c.type == ContactType::rigid ? rigid : compliant) += w;
-    if (level_ice && model_.bodies[c.body_a == body ? c.body_b : c.body_a].fixed) *level_ice += w;
+    const Body& other = model_.bodies[c.body_a == body ? c.body_b : c.body_a];
+    if (level_ice && other.fixed) *level_ice += w;
+    if (ridge && other.ridge_part == RidgePart::layer) ridge->layer += w;
+    if (ridge && (other.ridge_part == RidgePart::keel || other.ridge_part == RidgePart::sail)) ridge->rubble += w;
     if (part_force) (*part_force)[(c.body_a == body ? c.part_a : c.part_b) - first_part] += w.force;
   }
   return n;

@@ -38,11 +38,18 @@ namespace floesim::sim {
 enum Stage { kCollide, kForces, kSolve, kIntegrate, kRelax, kFracture, kSleep, kStageCount };
 const char* stage_name(int stage);
 
+// The part of a hull body's ice load from ridges (world frame, about its centre of mass): from the rubble of their
+// keels and sails, and from their consolidated layers (the pieces broken from them included).
+struct RidgeLoad {
+  Wrench rubble, layer;
+};
+
 // The loads on a structure beside the vessel in one step (world frame, about its centre of mass) and how it is held.
 struct StructureReport {
   int contacts = 0;
   Wrench ice_load;            // every contact
   Wrench ice_load_level_ice;  // the part from level ice tiles
+  RidgeLoad ridge_load;       // the part from ridges
   Wrench hydro_load, station_keeping_load;
   StationKeeping station_keeping;
   std::vector<Vec3> part_force_n;  // the ice's force on each of its convex parts (in the order of its parts)
@@ -61,6 +68,7 @@ struct StepReport {
   double surge_load_error_n = 0;
   Wrench ice_load, ice_load_rigid, ice_load_compliant;
   Wrench ice_load_level_ice;  // part of ice_load from contacts with level ice tiles (breaking the sheet's edge)
+  RidgeLoad ridge_load;       // part of ice_load from ridges
   Wrench hydro_load, wind_load, propulsion_load;  // propulsion_load: a moored or DP body's station keeping
   double thrust_n = 0;
   StationKeeping station_keeping;  // a moored or DP body: its offset, heading change, demanded and delivered force
@@ -131,9 +139,10 @@ class World {
   int vessel_ice_load(const std::vector<Contact>& contacts, Wrench* rigid, Wrench* compliant,
                       Wrench* level_ice = nullptr) const;
   // The same for any hull body (the vessel's or a structure's), and the force on each of its parts (part_force, if
-  // given: sized to its part count).
+  // given: sized to its part count) and the parts from ridges (ridge, if given: their keels' and sails' rubble,
+  // their consolidated layers and the pieces broken from them).
   int hull_ice_load(const std::vector<Contact>& contacts, int body, Wrench* rigid, Wrench* compliant,
-                    Wrench* level_ice, std::vector<Vec3>* part_force) const;
+                    Wrench* level_ice, std::vector<Vec3>* part_force, RidgeLoad* ridge = nullptr) const;
   // Replaces the floe of `cut` by its pieces (bodies appended at the floe's pose and velocity field) and records
   // the event.
   void apply_fracture(FractureCut& cut);

@@ -72,16 +72,18 @@ constexpr ScalarSeries kScalarSeries[] = {
 // The per-step wrench series (six columns each, body axes) and the load of the step report each comes from.
 struct LoadSeries {
   const char* name;
-  Wrench StepReport::*load;
+  const Wrench& (*load)(const StepReport&);
 };
 constexpr LoadSeries kLoadSeries[] = {
-    {"ice_load", &StepReport::ice_load},
-    {"ice_load_rigid", &StepReport::ice_load_rigid},
-    {"ice_load_compliant", &StepReport::ice_load_compliant},
-    {"ice_load_level_ice", &StepReport::ice_load_level_ice},
-    {"hydro_load", &StepReport::hydro_load},
-    {"wind_load", &StepReport::wind_load},
-    {"propulsion_load", &StepReport::propulsion_load},
+    {"ice_load", [](const StepReport& r) -> const Wrench& { return r.ice_load; }},
+    {"ice_load_rigid", [](const StepReport& r) -> const Wrench& { return r.ice_load_rigid; }},
+    {"ice_load_compliant", [](const StepReport& r) -> const Wrench& { return r.ice_load_compliant; }},
+    {"ice_load_level_ice", [](const StepReport& r) -> const Wrench& { return r.ice_load_level_ice; }},
+    {"ice_load_ridge_rubble", [](const StepReport& r) -> const Wrench& { return r.ridge_load.rubble; }},
+    {"ice_load_ridge_layer", [](const StepReport& r) -> const Wrench& { return r.ridge_load.layer; }},
+    {"hydro_load", [](const StepReport& r) -> const Wrench& { return r.hydro_load; }},
+    {"wind_load", [](const StepReport& r) -> const Wrench& { return r.wind_load; }},
+    {"propulsion_load", [](const StepReport& r) -> const Wrench& { return r.propulsion_load; }},
 };
 
 // A body's id in the results layout: 0 for the vessel, its floe id otherwise.
@@ -252,6 +254,7 @@ void Recorder::record_structures(const World& w) {
     const StructureReport* sr = rs.index >= 0 ? &rep.structures[rs.index] : nullptr;
     const Wrench& ice = sr ? sr->ice_load : rep.ice_load;
     const Wrench& level_ice = sr ? sr->ice_load_level_ice : rep.ice_load_level_ice;
+    const RidgeLoad& ridge = sr ? sr->ridge_load : rep.ridge_load;
     const Wrench& water = sr ? sr->hydro_load : rep.hydro_load;
     const Wrench& keeping = sr ? sr->station_keeping_load : rep.propulsion_load;
     const StationKeeping& sk = sr ? sr->station_keeping : rep.station_keeping;
@@ -273,6 +276,8 @@ void Recorder::record_structures(const World& w) {
     put({ice.force.x(), ice.force.y(), ice.force.z()});
     put({moment.x(), moment.y(), moment.z()});
     put({level_ice.force.x(), level_ice.force.y(), level_ice.force.z()});
+    put({ridge.rubble.force.x(), ridge.rubble.force.y(), ridge.rubble.force.z()});
+    put({ridge.layer.force.x(), ridge.layer.force.y(), ridge.layer.force.z()});
     put({water.force.x(), water.force.y(), water.force.z()});
     put({keeping.force.x(), keeping.force.y(), keeping.force.z()});
     put({sk.offset.x(), sk.offset.y(), sk.heading_change_rad});
@@ -304,7 +309,7 @@ void Recorder::record_step(const World& w, long k) {
   c_quat_->insert(c_quat_->end(), {q.w(), q.x(), q.y(), q.z()});
   c_vel_->insert(c_vel_->end(), {vb.x(), vb.y(), vb.z()});
   c_omega_->insert(c_omega_->end(), {wb.x(), wb.y(), wb.z()});
-  for (size_t i = 0; i < c_loads_.size(); ++i) push_body_wrench(*c_loads_[i], R, rep.*kLoadSeries[i].load);
+  for (size_t i = 0; i < c_loads_.size(); ++i) push_body_wrench(*c_loads_[i], R, kLoadSeries[i].load(rep));
   for (size_t i = 0; i < c_scalar_.size(); ++i) c_scalar_[i]->push_back(kScalarSeries[i].get(rep));
   c_kinetic_->push_back(ice_kinetic_energy(w));
   const StationKeeping& sk = rep.station_keeping;

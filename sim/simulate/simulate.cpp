@@ -14,9 +14,11 @@
 #include "pipeline/interrupt.h"
 #include "pipeline/provenance.h"
 #include "pipeline/units.h"
+#include "sim/engine/ridge_build.h"
 #include "sim/engine/world.h"
 #include "sim/simulate/checkpoint.h"
 #include "sim/simulate/recorder.h"
+#include "sim/simulate/ridge_summary.h"
 
 namespace floesim::sim {
 
@@ -158,6 +160,11 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
     }
   }
   Model model = build_model(field, &hull, o, structures);
+  // The ridges' rubble settled before the run (the same on a resumed run: deterministic).
+  const RidgeSettling settled = settle_ridges(field, model, &std::cout);
+  if (settled.blocks > 0)
+    std::cout << "floesim-simulate: " << settled.blocks << " blocks of rubble settled in " << settled.time_s
+              << " s (" << settled.steps << " steps, " << settled.wall_s << " s wall)\n";
 
   std::ostringstream out;
   out << "floesim-simulate: " << model.floe_count() << " floes in " << model.parts.size() << " convex parts ("
@@ -187,6 +194,7 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   // The series before the last checkpoint are read back from its chunks, one at a time.
   const CheckpointSeries series(checkpoints.dir, prov, static_cast<long>(results.series_first_step), results);
   nlohmann::json summary = summarize(o, world->model(), results, series);
+  if (!o.ridges.empty()) summary["ridges"] = ridge_summary(o, world->model(), settled, series);
   summary["settings"] = options_to_json(o);
   summary["provenance"] = prov;
 

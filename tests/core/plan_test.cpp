@@ -6,6 +6,7 @@
 
 #include "pipeline/error.h"
 #include "pipeline/runner/plan.h"
+#include "pipeline/runner/sweep.h"
 
 using namespace floesim;
 namespace fs = std::filesystem;
@@ -78,4 +79,21 @@ TEST(Plan, EachStructureGetsItsHullStageAndItsSimulateEntry) {
   c["structures"][0]["name"] = "a/b";
   EXPECT_NE(plan_error(c, dir).find("structures[0].name \"a/b\" may hold only"), std::string::npos);
   fs::remove_all(dir);
+}
+
+// A sweep's key path reaches into a list the case has by an element's index (simulate.ridges.0.keel_depth_m); an
+// index the list does not have is named with the list's length.
+TEST(Plan, SweepKeyPathsReachListElementsByIndex) {
+  nlohmann::json c = {{"simulate", {{"ridges", {{{"keel_depth_m", 5.0}}, {{"keel_depth_m", 6.0}}}}}}};
+  runner::set_key_path(c, "simulate.ridges.1.keel_depth_m", 7.0, "sweep.json");
+  EXPECT_EQ(c["simulate"]["ridges"][1]["keel_depth_m"], 7.0);
+  EXPECT_EQ(c["simulate"]["ridges"][0]["keel_depth_m"], 5.0);
+  std::string error;
+  try {
+    runner::set_key_path(c, "simulate.ridges.2.keel_depth_m", 7.0, "sweep.json");
+  } catch (const Error& e) {
+    error = e.what();
+  }
+  EXPECT_NE(error.find("simulate.ridges is a list of 2"), std::string::npos) << error;
+  EXPECT_NE(error.find("sweep.json"), std::string::npos) << error;
 }

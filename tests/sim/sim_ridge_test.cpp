@@ -13,7 +13,7 @@
 #include "pipeline/error.h"
 #include "pipeline/options.h"
 #include "sim/engine/ridge.h"
-#include "sim/engine/ridge_built.h"
+#include "sim/engine/ridge_build.h"
 #include "tests/sim/sim_fixtures.h"
 
 namespace floesim::sim {
@@ -321,6 +321,43 @@ TEST(RidgeSettling, AKeelSettlesUnderItsLayerWhichCarriesItsNetBuoyancy) {
   EXPECT_FALSE(below_layer);                                         // no sail block fell through it
   EXPECT_NEAR(built.porosity_by_volume, built.porosity_by_voxels, 0.03);
   EXPECT_NEAR(push, net_n, 0.01 * net_n);
+}
+
+// A ridge that no sheet holds floats freely: its layer is a free floe, and once its rubble has settled (settle_ridges)
+// the whole ridge floats at rest, so its ice under the waterline over that above it is rho_i / (rho_w - rho_i) = 7.2
+// (PHYSICS.md §9.1's hydrostatic check: the sail's weight carried by the keel's net buoyancy). The settled poses are
+// the run's model's, matched by id, and its blocks no longer start awake. A free ridge keeps a drift of a few cm/s
+// from its settling (and blocks that came out from under the layer float off), which quadratic drag stops slowly:
+// rest here is below 5 cm/s.
+TEST(RidgeSettling, AFreeFloatingRidgeSettlesToItsHydrostaticRatio) {
+  SimulateOptions o = testing::floe_options();
+  o.fracture.enabled = false;
+  o.ridge_settling.rest_speed_mps = 0.05;
+  RidgeOptions r = small_ridge(-3, 3);
+  r.keel_depth_m = 2.2;
+  r.keel_width_m = 7;
+  r.sail_height_m = 0.6;
+  r.consolidated_thickness_m = 0.6;
+  o.ridges = {r};
+  Model m = build_model(FloeField{}, nullptr, o);
+  const RidgeSettling settled = settle_ridges(FloeField{}, m, nullptr);
+  ASSERT_EQ(settled.ridges.size(), 1u);
+  const RidgeBuilt& b = settled.ridges[0];
+  const double ratio = b.ice_below_m3 / b.ice_above_m3;
+  std::printf("[measured] free ridge of %d blocks settled in %.1f s: ice under / over the waterline %.4f (%.2f / %.2f "
+              "m^3) against %.4f; keel %.2f m deep, porosity %.3f by volume, %.3f by voxels\n",
+              b.blocks, settled.time_s, ratio, b.ice_below_m3, b.ice_above_m3, kIce / (kWater - kIce), b.keel_depth_m,
+              b.porosity_by_volume, b.porosity_by_voxels);
+  EXPECT_NEAR(ratio, kIce / (kWater - kIce), 0.01 * kIce / (kWater - kIce));
+  EXPECT_LT(b.max_block_speed_mps, o.ridge_settling.rest_speed_mps);
+  const Model released = build_model(FloeField{}, nullptr, o);
+  int moved = 0;
+  for (size_t k = 0; k < m.bodies.size(); ++k) {
+    if (m.bodies[k].ridge_part != RidgePart::keel && m.bodies[k].ridge_part != RidgePart::sail) continue;
+    EXPECT_FALSE(m.bodies[k].start_awake);
+    moved += (m.bodies[k].initial_position - released.bodies[k].initial_position).norm() > 0.1;
+  }
+  EXPECT_GT(moved, b.blocks / 2);  // the run starts from the settled rubble, not the released
 }
 
 TEST(RidgeSection, BadInputNamesTheKey) {

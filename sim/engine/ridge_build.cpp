@@ -1,9 +1,13 @@
-#include "sim/engine/ridge_built.h"
+#include "sim/engine/ridge_build.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <iomanip>
+#include <map>
 
 #include "pipeline/error.h"
+#include "sim/engine/world.h"
 
 namespace floesim::sim {
 
@@ -159,6 +163,70 @@ RidgeBuilt measure_ridge(const Model& m, const State& st, int ridge, double voxe
     if (bl.keel) keel_m3 += m.bodies[bl.body].section_area * m.bodies[bl.body].thickness_m;
   out.porosity_by_volume = envelope > 0 ? 1 - keel_m3 / envelope_m3 : 1.0;
   out.porosity_by_voxels = envelope > 0 ? 1 - static_cast<double>(solid) / static_cast<double>(envelope) : 1.0;
+  return out;
+}
+
+RidgeSettling settle_ridges(const FloeField& field, Model& model, std::ostream* progress) {
+  RidgeSettling out;
+  if (model.settings.ridges.empty()) return out;
+  const RidgeSettlingOptions& rs = model.settings.ridge_settling;
+  // 1. The settling world: the floes and ridges without hulls, fracture off, the water at rest in the ice's frame.
+  EngineSettings o = model.settings;
+  o.fracture.enabled = false;
+  o.structures.clear();
+  o.water.current_speed_mps = o.drift.speed_mps;
+  o.water.current_direction_deg = o.drift.direction_deg;
+  o.wind.speed_mps = 0;
+  World w(build_model(field, nullptr, o));
+  const Model& m = w.model();
+  std::vector<int> rubble;
+  for (size_t b = 0; b < m.bodies.size(); ++b)
+    if (m.bodies[b].ridge_part == RidgePart::keel || m.bodies[b].ridge_part == RidgePart::sail)
+      rubble.push_back(static_cast<int>(b));
+  out.blocks = static_cast<int>(rubble.size());
+  // 2. Steps until every block has been at rest for rest_time_s.
+  const auto t0 = std::chrono::steady_clock::now();
+  const double dt = o.time_step_s;
+  const long max_steps = std::lround(rs.max_s / dt), rest_steps = std::lround(rs.rest_time_s / dt);
+  const long report_every = std::max(1L, std::lround(10.0 / dt));
+  long at_rest = 0;
+  double fastest = 0;
+  while (at_rest < rest_steps) {
+    FLOESIM_REQUIRE(out.steps < max_steps, "ridge_settling.max_s: the ridges' rubble is not at rest after ",
+                    rs.max_s, " s of settling (the fastest block moves at ", fastest,
+                    " m/s): raise ridge_settling.max_s or ridge_settling.rest_speed_mps");
+    w.step();
+    ++out.steps;
+    fastest = 0;
+    for (int b : rubble) {
+      if (!w.state().alive[b]) continue;
+      fastest = std::max({fastest, w.state().velocity[b].norm(), w.state().angular_velocity[b].norm()});
+    }
+    at_rest = fastest < rs.rest_speed_mps ? at_rest + 1 : 0;
+    if (progress && out.steps % report_every == 0)
+      *progress << "  settling the ridges: t = " << std::fixed << std::setprecision(1) << w.state().time_s
+                << " s, fastest block " << std::setprecision(3) << fastest << " m/s, awake floes "
+                << w.report().awake_floes << std::defaultfloat << std::endl;
+  }
+  out.time_s = w.state().time_s;
+  out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // 3. The settled poses into the run's model, by id; they start asleep where floes may.
+  std::map<int, int> index_of;
+  for (size_t b = 0; b < model.bodies.size(); ++b)
+    if (model.bodies[b].ridge_part == RidgePart::keel || model.bodies[b].ridge_part == RidgePart::sail)
+      index_of[model.bodies[b].id] = static_cast<int>(b);
+  FLOESIM_REQUIRE(index_of.size() == rubble.size(), "internal: the settling world has ", rubble.size(),
+                  " blocks, the run's model ", index_of.size());
+  for (int b : rubble) {
+    const auto it = index_of.find(m.bodies[b].id);
+    FLOESIM_REQUIRE(it != index_of.end(), "internal: block ", m.bodies[b].id, " is not in the run's model");
+    Body& target = model.bodies[it->second];
+    target.initial_position = w.state().position[b];
+    target.initial_orientation = w.state().orientation[b];
+    target.start_awake = false;
+  }
+  for (size_t r = 0; r < o.ridges.size(); ++r)
+    out.ridges.push_back(measure_ridge(m, w.state(), static_cast<int>(r), rs.voxel_m));
   return out;
 }
 

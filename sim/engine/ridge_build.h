@@ -1,10 +1,12 @@
-// A ridge as built (issue #36 item 4, PHYSICS.md §9.1 and §9.5): what its settled blocks and its consolidated layer
-// make, measured in a world's state. The rubble's envelope is found, not assumed: the keel's bottom and the sail's
-// top across the line are read from voxels of the blocks themselves, and the porosity is measured inside that
-// envelope, two ways.
+// Building a ridge (issue #36 items 2 and 4, PHYSICS.md §9.1 and §9.5): its released rubble settled by buoyancy and
+// gravity before the run, and what its settled blocks and its consolidated layer make, measured in a world's state.
+// The rubble's envelope is found, not assumed: the keel's bottom and the sail's top across the line are read from
+// voxels of the blocks themselves, and the porosity is measured inside that envelope, two ways.
 #pragma once
+#include <ostream>
 #include <vector>
 
+#include "pipeline/floes_io.h"
 #include "sim/engine/model.h"
 #include "sim/engine/state.h"
 
@@ -36,5 +38,21 @@ struct RidgeBuilt {
 // Measures ridge `ridge` (its index in settings.ridges) in `state`, over its line's first segment (a straight ridge;
 // blocks beyond the segment's ends left out), on voxels of edge voxel_m.
 RidgeBuilt measure_ridge(const Model& model, const State& state, int ridge, double voxel_m);
+
+// What settling did: how long it took (simulated and wall), and each ridge as built (settings.ridges' order).
+struct RidgeSettling {
+  double time_s = 0, wall_s = 0;
+  long steps = 0;
+  int blocks = 0;
+  std::vector<RidgeBuilt> ridges;
+};
+
+// Settles the rubble of `model`'s ridges (settings.ridge_settling) in a world of its own: the same floes and
+// settings (and threads) without the hull bodies, with fracture off, in still water and air in the ice's frame (the
+// case's current and wind act from the run's start). It steps until every block has been at rest for rest_time_s,
+// then gives `model`'s blocks their settled poses (matched by id) and lets them start asleep, and measures each
+// ridge. Throws floesim::Error naming ridge_settling.max_s when the rubble is not at rest by then. `progress`: a
+// line every 10 s of settling (null: none). Deterministic: the same inputs and threads give the same poses.
+RidgeSettling settle_ridges(const FloeField& field, Model& model, std::ostream* progress);
 
 }  // namespace floesim::sim
