@@ -139,6 +139,12 @@ std::string run_ice_actions(const IceActionsOptions& o, const fs::path& config_f
                          {"cohesion_kN", kn(r.cohesion_n)},
                          {"surcharge_bound_kN", kn(r.surcharge_bound_n)},
                          {"ridge_total_kN", kn(layer_n + r.force_n)}});
+        if (o.ridge.ship_beam_m > 0) {
+          RidgeKeel draft = o.ridge.keel;
+          draft.depth_m = hk + hc;  // the keel's draft from the waterline
+          keels.back()["ship_keel_bound_kN"] = kn(keel_ship_bound_n(draft, o.ridge.ship_beam_m, o.ridge.ship_draught_m,
+                                                                    hc, structure_ice(o, hc > 0 ? hc : 1.0)));
+        }
         ridge_text << "| " << shortest(hk) << " | " << fixed(kn(r.force_n), 1) << " | " << fixed(kn(r.friction_n), 1)
                    << " | " << fixed(kn(r.cohesion_n), 1) << " | " << fixed(kn(r.surcharge_bound_n), 1) << " | "
                    << fixed(kn(layer_n + r.force_n), 1) << " |\n";

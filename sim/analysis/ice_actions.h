@@ -97,6 +97,7 @@ struct IceActionsRidgeOptions {
   std::vector<double> keel_depths_m;  // none: no ridge figures
   RidgeKeel keel;
   double consolidated_thickness_m = 0;
+  double ship_beam_m = 0, ship_draught_m = 0;  // 0: no ship figures
   template <class V>
   void visit(V& v) {
     v.field("keel_depths_m", keel_depths_m, "m",
@@ -113,6 +114,13 @@ struct IceActionsRidgeOptions {
     v.field("consolidated_thickness_m", consolidated_thickness_m, "m",
             "consolidated layer thickness h_c, loading the structure as level ice of that thickness (0: none)",
             non_negative());
+    v.field("ship_beam_m", ship_beam_m, "m",
+            "a ship's waterline beam B: each keel's bound on the ship (PHYSICS.md 9.4, Rankine's passive force over "
+            "the bow's vertical projection, the keel's draft h_k + h_c; 0: none)",
+            non_negative());
+    v.field("ship_draught_m", ship_draught_m, "m", "the ship's draught T (with ship_beam_m)", non_negative());
+    if ((ship_beam_m > 0) != (ship_draught_m > 0))
+      v.problem("ship_draught_m", "give both ship_beam_m and it, or neither");
   }
 };
 

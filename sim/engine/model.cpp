@@ -1180,6 +1180,9 @@ Model build_model(const FloeField& field, const HullModel* hull, const EngineSet
                   const std::vector<HullModel>& structures) {
   Model model;
   model.settings = o;
+  // The ridges of the ridge field join the listed ones: from here on the model's settings list them all.
+  for (RidgeOptions& r : ridge_field_ridges(o.ridge_field)) model.settings.ridges.push_back(std::move(r));
+  model.settings.ridge_field = RidgeFieldOptions();
   const double g = o.water.gravity_mps2;
   model.gravity = Vec3(0, 0, -g);
   const double cdir = o.water.current_direction_deg * kPi / 180, wdir = o.wind.direction_deg * kPi / 180;
@@ -1192,7 +1195,7 @@ Model build_model(const FloeField& field, const HullModel* hull, const EngineSet
   // 1. Floe geometry in the world: cleaned outline and convex pieces. The level ice sheets come as tiles (fixed
   // floes) after the free floes.
   std::vector<int> ridge_of;
-  const std::vector<Floe> floes = model_floes(field, o, ridge_of);
+  const std::vector<Floe> floes = model_floes(field, model.settings, ridge_of);
   const std::vector<FloeGeometry> geo = floe_geometry(floes);
   FLOESIM_REQUIRE(o.drift.speed_mps == 0 || !floes.empty(), "drift.speed_mps is ", o.drift.speed_mps,
                   " m/s but there is no ice to drift (no floes, no level_ice.extent_m): give the ice, or set "
@@ -1211,7 +1214,7 @@ Model build_model(const FloeField& field, const HullModel* hull, const EngineSet
   add_floe_bodies(geo, ridge_of, footprint, o, model);
   int next_id = 1;
   for (const Floe& f : floes) next_id = std::max(next_id, f.id + 1);
-  add_ridge_blocks(next_id, footprint, o, model);
+  add_ridge_blocks(next_id, footprint, model.settings, model);
 
   // 5. Domain walls outside the sides of the domain rectangle.
   if (!o.domain.walls.empty()) add_walls(field, hull != nullptr, footprint, o, model);

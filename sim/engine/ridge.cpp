@@ -108,6 +108,37 @@ std::vector<RidgeBlock> release_blocks(const RidgeOptions& r, const RidgeSection
   return out;
 }
 
+std::vector<RidgeOptions> ridge_field_ridges(const RidgeFieldOptions& f) {
+  std::vector<RidgeOptions> out;
+  if (!(f.density_per_km > 0)) return out;
+  std::mt19937_64 rng(static_cast<std::uint64_t>(f.seed) ^ 0x9e3779b97f4a7c15ULL);
+  const double spacing = 1000.0 / f.density_per_km, scale = f.keel_depth_mean_m - f.keel_depth_min_m;
+  double x = f.route_x_m[0], last_edge = -1e300;
+  for (int k = 0; k < 100000; ++k) {
+    x += -spacing * std::log(1 - unit(rng));
+    double depth = f.keel_depth_max_m + 1;
+    while (depth > f.keel_depth_max_m) depth = f.keel_depth_min_m - scale * std::log(1 - unit(rng));
+    const double width = f.width_over_depth * depth;
+    if (x - 0.5 * width < last_edge) continue;  // its layer would overlap the one before: not a ridge of its own
+    if (x + 0.5 * width > f.route_x_m[1]) break;
+    RidgeOptions r;
+    r.line = {{x, f.across_y_m[0]}, {x, f.across_y_m[1]}};
+    r.keel_depth_m = depth;
+    r.keel_width_m = width;
+    r.sail_height_m = depth / f.depth_over_sail;
+    r.consolidated_thickness_m = f.consolidated_thickness_m;
+    r.keel_angle_deg = f.keel_angle_deg;
+    r.sail_angle_deg = f.sail_angle_deg;
+    r.porosity = f.porosity;
+    r.block_thickness_m = f.block_thickness_m;
+    r.block_size_m = f.block_size_m;
+    r.seed = f.seed + static_cast<int>(out.size()) + 1;
+    out.push_back(r);
+    last_edge = x + 0.5 * width;
+  }
+  return out;
+}
+
 bool block_contains(const RidgeBlock& k, const Vec2& p, double z) {
   if (std::abs(z - k.z) > 0.5 * k.thickness) return false;
   const Vec2 d = p - k.centre;

@@ -72,6 +72,70 @@ struct RidgeOptions {
   }
 };
 
+// Ridges along a route at a stated density (issue #36 item 1): their positions a Poisson process along x over
+// route_x_m (exponential spacings of mean 1000 / density_per_km, a ridge's layer never overlapping the one before),
+// each straight across y over across_y_m; keel depths drawn from an exponential distribution of mean
+// keel_depth_mean_m above keel_depth_min_m, cut at keel_depth_max_m (Wadhams' keel-draft statistics); width, sail
+// and consolidated layer from the depth by the ratios of PHYSICS.md §9.1. The same seed gives the same ridges.
+struct RidgeFieldOptions {
+  double density_per_km = 0;  // 0: none
+  std::vector<double> route_x_m = {0, 1000};
+  std::vector<double> across_y_m = {-50, 50};
+  double keel_depth_min_m = 3.0;
+  double keel_depth_mean_m = 4.5;
+  double keel_depth_max_m = 10.0;
+  double width_over_depth = 3.9;
+  double depth_over_sail = 4.4;
+  double consolidated_thickness_m = 1.0;
+  double keel_angle_deg = 30;
+  double sail_angle_deg = 21;
+  double porosity = 0.3;
+  double block_thickness_m = 0.5;
+  std::vector<double> block_size_m = {0.5, 2.5};
+  int seed = 1;
+  template <class V>
+  void visit(V& v) {
+    auto range = [](bool increasing) {
+      return Check<std::vector<double>>([increasing](const std::vector<double>& a) -> std::string {
+        if (a.size() != 2 || !std::isfinite(a[0]) || !std::isfinite(a[1])) return "must be [from, to], finite";
+        if (increasing && !(a[1] > a[0])) return "needs from < to";
+        return "";
+      });
+    };
+    v.field("density_per_km", density_per_km, "1/km", "mean ridges per km of route (0: none)", in_range(0, 100));
+    v.field("route_x_m", route_x_m, "m", "[from, to] along x where ridges lie", range(true));
+    v.field("across_y_m", across_y_m, "m", "[from, to] across: each ridge's line runs over it at its x", range(true));
+    v.field("keel_depth_min_m", keel_depth_min_m, "m", "smallest keel depth (the exponential's cut-off)", positive());
+    v.field("keel_depth_mean_m", keel_depth_mean_m, "m",
+            "mean keel depth: min plus the exponential's mean", positive());
+    v.field("keel_depth_max_m", keel_depth_max_m, "m", "deepest keel (draws beyond are drawn again)", positive());
+    v.field("width_over_depth", width_over_depth, "-", "keel width over keel depth (3.9, PHYSICS.md 9.1)",
+            positive());
+    v.field("depth_over_sail", depth_over_sail, "-", "keel depth over sail height (4.4 first-year)", positive());
+    v.field("consolidated_thickness_m", consolidated_thickness_m, "m", "each ridge's consolidated layer thickness",
+            positive());
+    v.field("keel_angle_deg", keel_angle_deg, "deg", "slope of the keels' sides", in_range(5, 85));
+    v.field("sail_angle_deg", sail_angle_deg, "deg", "slope of the sails' sides", in_range(5, 85));
+    v.field("porosity", porosity, "-", "macro-porosity of keels and sails", Check<double>([](const double& e) {
+              return std::string(e > 0 && e < 1 ? "" : "must be in (0, 1)");
+            }));
+    v.field("block_thickness_m", block_thickness_m, "m", "thickness of the rubble blocks", positive());
+    v.field("block_size_m", block_size_m, "m", "[min, max] of a block's plan sides, drawn log-uniformly",
+            Check<std::vector<double>>([](const std::vector<double>& a) -> std::string {
+              if (a.size() != 2) return "must be [min, max]";
+              if (!(a[0] > 0 && a[1] >= a[0] && std::isfinite(a[1]))) return "must be 0 < min <= max";
+              return "";
+            }));
+    v.field("seed", seed, "-", "seed of the ridges' places and sizes (and of their blocks)",
+            int_in_range(0, 2147483647));
+    if (keel_depth_mean_m <= keel_depth_min_m) v.problem("keel_depth_mean_m", "must exceed keel_depth_min_m");
+    if (keel_depth_max_m <= keel_depth_mean_m) v.problem("keel_depth_max_m", "must exceed keel_depth_mean_m");
+  }
+};
+
+// The ridges of a ridge field, in order along x.
+std::vector<RidgeOptions> ridge_field_ridges(const RidgeFieldOptions& f);
+
 // How the ridges' rubble is settled before a run (settle_ridges, sim/engine/ridge_build.h): in still water, until
 // every block has been slower than rest_speed_mps (and turning slower than rest_speed_mps per metre) for
 // rest_time_s; the ridge as built is then measured on voxels of edge voxel_m.

@@ -194,7 +194,8 @@ RidgeSettling settle_ridges(const FloeField& field, Model& model, std::ostream* 
   while (at_rest < rest_steps) {
     FLOESIM_REQUIRE(out.steps < max_steps, "ridge_settling.max_s: the ridges' rubble is not at rest after ",
                     rs.max_s, " s of settling (the fastest block moves at ", fastest,
-                    " m/s): raise ridge_settling.max_s or ridge_settling.rest_speed_mps");
+                    " m/s): raise ridge_settling.max_s or ridge_settling.rest_speed_mps (rubble that floats out "
+                    "from under the ice drifts on in open water: end a ridge's line inside its sheet)");
     w.step();
     ++out.steps;
     fastest = 0;

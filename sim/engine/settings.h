@@ -844,6 +844,7 @@ struct EngineSettings {
   DriftOptions drift;
   std::vector<StructureOptions> structures;  // hull bodies beside the vessel's (see StructureOptions)
   std::vector<RidgeOptions> ridges;          // ridges in the level ice (sim/engine/ridge.h, issue #36)
+  RidgeFieldOptions ridge_field;             // more ridges along a route at a density (after `ridges`)
   RidgeSettlingOptions ridge_settling;       // how their rubble is settled before the run
 
   long reference_horizon_steps() const { return std::lround(solver.reference_horizon_s / time_step_s); }  // 0: none

@@ -57,6 +57,8 @@ struct SimulateOptions : EngineSettings {
            "ridges in the level ice sheet, each a consolidated layer cut out of the sheet along its line and the "
            "rubble of its keel and sail released around it to settle: [{\"line\", cross-section, porosity, "
            "blocks}] (PHYSICS.md §9)");
+    v.section("ridge_field", ridge_field,
+              "more ridges (after those of ridges) along a route at a stated density, their sizes drawn, seeded");
     v.section("ridge_settling", ridge_settling,
               "how the ridges' rubble is settled in still water before the run, and the ridge as built measured");
     for (size_t i = 0; i < structures.size(); ++i)

@@ -119,11 +119,15 @@ nlohmann::json ridge_summary(const SimulateOptions& o, const Model& model, const
                              const SeriesSource& series) {
   nlohmann::json list = nlohmann::json::array();
   const double rho_i = o.ice.density_kg_m3, rho_w = o.water.density_kg_m3;
-  for (size_t k = 0; k < o.ridges.size(); ++k) {
-    const RidgeOptions& r = o.ridges[k];
+  const std::vector<RidgeOptions>& ridges = model.settings.ridges;  // the ridge field's among them
+  for (size_t k = 0; k < ridges.size(); ++k) {
+    const RidgeOptions& r = ridges[k];
     const RidgeSection s = ridge_section(r, rho_i, rho_w, "ridges[" + std::to_string(k) + "]");
     nlohmann::json j;
-    j["design"] = {{"keel_depth_m", r.keel_depth_m},
+    nlohmann::json line = nlohmann::json::array();
+    for (const RidgePoint& p : r.line) line.push_back({p.x_m, p.y_m});
+    j["design"] = {{"line_m", line},
+                   {"keel_depth_m", r.keel_depth_m},
                    {"keel_width_m", r.keel_width_m},
                    {"sail_height_m", r.sail_height_m},
                    {"consolidated_thickness_m", r.consolidated_thickness_m},

@@ -194,7 +194,7 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   // The series before the last checkpoint are read back from its chunks, one at a time.
   const CheckpointSeries series(checkpoints.dir, prov, static_cast<long>(results.series_first_step), results);
   nlohmann::json summary = summarize(o, world->model(), results, series);
-  if (!o.ridges.empty()) summary["ridges"] = ridge_summary(o, world->model(), settled, series);
+  if (!world->model().settings.ridges.empty()) summary["ridges"] = ridge_summary(o, world->model(), settled, series);
   summary["settings"] = options_to_json(o);
   summary["provenance"] = prov;
 

@@ -201,6 +201,26 @@ TEST(SimInput, BadInputsNameFileAndItemAndWriteNothing) {
   std::ofstream(dir / "piece.json") << R"({"duration_s": 1.0, "steady_start_s": 0.5,
                                            "fracture": {"min_piece_area_m2": -1}})";
   run("floes.geojson", "hull.obj", "piece.json", {"piece.json", "fracture.min_piece_area_m2"});
+  // Ridges (issue #36): a keel shallower than its consolidated layer, a porosity outside (0, 1), blocks larger than
+  // the keel, an unknown key, a ridge off its sheet's edge: each named by file and ridge.
+  auto ridge_case = [&](const std::string& ridge, std::initializer_list<const char*> pieces) {
+    std::ofstream(dir / "ridge.json")
+        << R"({"duration_s": 1.0, "steady_start_s": 0.5, "level_ice": {"extent_m": [200, -40, 280, 40],
+              "tile_m": 40}, "ridges": [{"line": [{"x_m": 240, "y_m": -30}, {"x_m": 240, "y_m": 30}], )"
+        << ridge << "}]}";
+    run("floes.geojson", "hull.obj", "ridge.json", pieces);
+  };
+  ridge_case(R"("keel_depth_m": 0.5, "consolidated_thickness_m": 1.0)", {"ridges[0]", "keel_depth_m", "layer"});
+  ridge_case(R"("porosity": 1.2)", {"ridge.json", "ridges[0].porosity", "(0, 1)"});
+  ridge_case(R"("block_size_m": [1, 30])", {"ridges[0]", "block_size_m", "smaller"});
+  ridge_case(R"("keel_draught_m": 6)", {"ridge.json", "ridges[0].keel_draught_m"});
+  std::ofstream(dir / "ridge.json")
+      << R"({"duration_s": 1.0, "steady_start_s": 0.5, "level_ice": {"extent_m": [200, -40, 280, 40], "tile_m": 40},
+            "ridges": [{"line": [{"x_m": 240, "y_m": -30}, {"x_m": 240, "y_m": 60}]}]})";
+  run("floes.geojson", "hull.obj", "ridge.json", {"ridges[0]", "segment 0", "sheet"});
+  std::ofstream(dir / "ridge.json") << R"({"duration_s": 1.0, "steady_start_s": 0.5,
+                                           "ridge_field": {"density_per_km": 5, "keel_depth_mean_m": 2}})";
+  run("floes.geojson", "hull.obj", "ridge.json", {"ridge.json", "ridge_field.keel_depth_mean_m", "keel_depth_min_m"});
   // A thrust series with a gap (an empty line, a missing value) or with time going back.
   auto thrust_case = [&](const std::string& csv, std::initializer_list<const char*> pieces) {
     std::ofstream(dir / "thrust.csv") << csv;

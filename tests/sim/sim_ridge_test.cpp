@@ -360,6 +360,43 @@ TEST(RidgeSettling, AFreeFloatingRidgeSettlesToItsHydrostaticRatio) {
   EXPECT_GT(moved, b.blocks / 2);  // the run starts from the settled rubble, not the released
 }
 
+// Ridges along a route (simulate.ridge_field): over a long route the count per km is the stated density less what
+// the rule against overlapping layers drops, the keel depths are the stated exponential (its mean above the cut-off
+// within a few standard errors), widths and sails follow the depth by §9.1's ratios, and the same seed gives the
+// same ridges.
+TEST(RidgeField, RidgesAlongARouteFollowTheirDensityAndDepthDistribution) {
+  RidgeFieldOptions f;
+  f.density_per_km = 5;
+  f.route_x_m = {0, 200000};  // 200 km
+  f.keel_depth_min_m = 2;
+  f.keel_depth_mean_m = 4;
+  f.keel_depth_max_m = 60;
+  const std::vector<RidgeOptions> ridges = ridge_field_ridges(f);
+  double sum = 0, last_edge = -1e300;
+  bool overlap = false, ratios = true;
+  for (const RidgeOptions& r : ridges) {
+    sum += r.keel_depth_m - 2;
+    overlap = overlap || r.line[0].x_m - 0.5 * r.keel_width_m < last_edge;
+    last_edge = r.line[0].x_m + 0.5 * r.keel_width_m;
+    ratios = ratios && std::abs(r.keel_width_m - 3.9 * r.keel_depth_m) < 1e-9 &&
+             std::abs(r.sail_height_m - r.keel_depth_m / 4.4) < 1e-9;
+  }
+  const double n = static_cast<double>(ridges.size()), mean = sum / n;
+  // By hand: spacings of mean 200 m, and a ridge dropped when its layer (3.9 x depth wide, 15.6 m on average) would
+  // overlap the one before: about 1 - exp(-15.6 / 200) = 7.5 % of them, so about 925 ridges in 200 km.
+  std::printf("[measured] %zu ridges over 200 km (%.2f per km); keel depth above the cut-off %.3f m (mean 2)\n",
+              ridges.size(), n / 200, mean);
+  EXPECT_NEAR(n / 200, 5 * 0.925, 0.25);             // Poisson count: s.d. 0.15 per km
+  EXPECT_NEAR(mean, 2.0, 4 * 2.0 / std::sqrt(n));    // an exponential's s.d. is its mean
+  EXPECT_FALSE(overlap);
+  EXPECT_TRUE(ratios);
+  const std::vector<RidgeOptions> again = ridge_field_ridges(f);
+  ASSERT_EQ(again.size(), ridges.size());
+  EXPECT_EQ(again.back().line[0].x_m, ridges.back().line[0].x_m);
+  f.seed = 2;
+  EXPECT_NE(ridge_field_ridges(f).front().line[0].x_m, ridges.front().line[0].x_m);
+}
+
 TEST(RidgeSection, BadInputNamesTheKey) {
   RidgeOptions shallow = first_year();
   shallow.keel_depth_m = 0.5;  // the 1 m layer floats 0.88 m deep
