@@ -115,6 +115,8 @@ RidgeBuilt measure_ridge(const Model& m, const State& st, int ridge, double voxe
   out.keel_bottom_z.assign(ns, 0.0);
   out.sail_top_z.assign(ns, 0.0);
   long envelope = 0, solid = 0;
+  std::vector<double> middle(ns, 0.0);  // the keel's bottom over the middle half of the line
+  std::vector<int> middle_n(ns, 0);
   for (int is = 0; is < ns; ++is) {
     const double s = s_lo + (is + 0.5) * voxel;
     out.profile_s_m[is] = s;
@@ -146,7 +148,9 @@ RidgeBuilt measure_ridge(const Model& m, const State& st, int ridge, double voxe
         }
       envelope += deepest >= top ? deepest - top + 1 : 0;
       solid += count;
-      out.keel_bottom_z[is] += deepest >= 0 ? keel_top - (deepest + 1) * voxel : out.layer_bottom_z;
+      const double bottom = deepest >= 0 ? keel_top - (deepest + 1) * voxel : out.layer_bottom_z;
+      out.keel_bottom_z[is] += bottom;
+      if (4 * it >= nt && 4 * it < 3 * nt) middle[is] += bottom, ++middle_n[is];
       int highest = -1;
       for (int k = nu - 1; k >= 0 && highest < 0; --k)
         if (solid_at(out.layer_top_z + (k + 0.5) * voxel, false)) highest = k;
@@ -155,6 +159,7 @@ RidgeBuilt measure_ridge(const Model& m, const State& st, int ridge, double voxe
     }
     out.keel_bottom_z[is] /= nt;
     out.sail_top_z[is] /= nt;
+    if (middle_n[is] > 0) out.keel_depth_middle_m = std::max(out.keel_depth_middle_m, -middle[is] / middle_n[is]);
   }
   const double envelope_m3 = envelope * voxel * voxel * dt;
   out.keel_area_m2 = envelope_m3 / length;

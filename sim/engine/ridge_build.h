@@ -15,6 +15,9 @@ namespace floesim::sim {
 struct RidgeBuilt {
   int blocks = 0;                      // keel and sail blocks alive
   double keel_depth_m = 0;             // deepest point of any keel block below the waterline
+  // The keel's depth away from its ends, where rubble slumps lengthwise: the deepest point of its bottom profile
+  // over the middle half of the line (each column's deepest keel block voxel, averaged along the line).
+  double keel_depth_middle_m = 0;
   double sail_height_m = 0;            // highest point of any sail block above the waterline (0: no sail blocks)
   double layer_bottom_z = 0, layer_top_z = 0;  // of the layer as it floats now (its tiles' mean)
   // Across the line (s, m, left of its direction; bins of voxel_m): the keel's bottom z (the mean over the line of

@@ -18,6 +18,7 @@ double mean_of(const std::vector<double>& v) {
 nlohmann::json ridge_as_built(const RidgeBuilt& b, double ice_density, double water_density) {
   nlohmann::json j = {{"blocks", b.blocks},
                       {"keel_depth_m", b.keel_depth_m},
+                      {"keel_depth_middle_m", b.keel_depth_middle_m},
                       {"sail_height_m", b.sail_height_m},
                       {"layer_bottom_z_m", b.layer_bottom_z},
                       {"layer_top_z_m", b.layer_top_z},
@@ -40,13 +41,14 @@ nlohmann::json ridge_as_built(const RidgeBuilt& b, double ice_density, double wa
   return j;
 }
 
-// The hull body's passage through ridge k, for a ship: where its bow is across the ridge (the distance past the
-// near edge of the layer, along the line's normal toward the far side), how far it got, how fast it went while its
-// bow was in the layer's width, whether it came through or stopped (slower than 0.05 m/s with its bow in the ridge).
+// The hull body's passage through a ridge, for a ship: where its bow is across the ridge (the distance past the near
+// edge of the layer, along the line's normal toward the far side), how far it got, when its bow came through the far
+// edge, and while any of its hull was in the layer's width (from its bow's entry to its stern's exit) its speed and
+// the surge loads from all ice, the ridge's rubble and its layer; stopped: slower than 0.05 m/s in there.
 nlohmann::json ship_in_ridge(const Model& model, const RidgeOptions& r, const SeriesSource& series) {
   const Body& hull = model.bodies[model.vessel];
-  double bow_x = -1e300;
-  for (const Vec3& v : hull.buoyancy_mesh.vertices) bow_x = std::max(bow_x, v.x());
+  double bow_x = -1e300, stern_x = 1e300;
+  for (const Vec3& v : hull.buoyancy_mesh.vertices) bow_x = std::max(bow_x, v.x()), stern_x = std::min(stern_x, v.x());
   const Vec2 a(r.line[0].x_m, r.line[0].y_m), b(r.line[1].x_m, r.line[1].y_m);
   const Vec2 t = (b - a).normalized();
   Vec2 n(-t.y(), t.x());
@@ -62,13 +64,14 @@ nlohmann::json ship_in_ridge(const Model& model, const RidgeOptions& r, const Se
     return (Vec2(bow.x(), bow.y()) - a).dot(n);
   };
   if (bow_s(0) > 0) n = -n;  // toward the far side from where the ship starts
-  const double half = 0.5 * r.keel_width_m;
-  double reach = -1e300, stop_t = -1;
+  const double half = 0.5 * r.keel_width_m, length = bow_x - stern_x;
+  double reach = -1e300, through_t = -1, stop_t = -1;
   std::vector<double> speed_in, rubble_in, layer_in, total_in;
   for (size_t k = 0; k < steps; ++k) {
     const double pen = bow_s(k) + half;  // past the near edge
     reach = std::max(reach, pen);
-    if (pen < 0 || pen > r.keel_width_m) continue;
+    if (through_t < 0 && pen > r.keel_width_m) through_t = time[k];
+    if (pen < 0 || pen > r.keel_width_m + length) continue;  // no part of the hull in the layer's width
     const double u = vel[3 * k];
     speed_in.push_back(u);
     rubble_in.push_back(rubble[6 * k]);
@@ -76,11 +79,14 @@ nlohmann::json ship_in_ridge(const Model& model, const RidgeOptions& r, const Se
     total_in.push_back(ice[6 * k]);
     if (stop_t < 0 && u < 0.05 && time[k] > 1.0) stop_t = time[k];
   }
-  nlohmann::json j = {{"what", "the bow's passage across the layer's width (penetration: the bow's distance past its "
-                               "near edge along the line's normal); surge loads in body axes, negative astern"},
-                      {"penetration_max_m", reach},
-                      {"through", reach > r.keel_width_m},
-                      {"stopped_at_s", stop_t >= 0 ? nlohmann::json(stop_t) : nlohmann::json(nullptr)}};
+  auto or_null = [](double x) { return x >= 0 ? nlohmann::json(x) : nlohmann::json(nullptr); };
+  nlohmann::json j = {{"what", "the hull's passage across the layer's width (penetration: the bow's distance past its "
+                               "near edge along the line's normal; in the ridge: from the bow's entry to the stern's "
+                               "exit); surge loads in body axes, negative astern"},
+                      {"through", through_t >= 0},
+                      {"bow_through_at_s", or_null(through_t)},
+                      {"penetration_max_m", through_t >= 0 ? r.keel_width_m : reach},
+                      {"stopped_at_s", or_null(stop_t)}};
   if (!speed_in.empty()) {
     j["in_ridge"] = {{"steps", speed_in.size()},
                      {"mean_speed_mps", mean_of(speed_in)},

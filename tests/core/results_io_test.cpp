@@ -412,9 +412,9 @@ TEST(ResultsIo, LayoutOneFilesFromBeforeFractureReadWithDefaults) {
 
   // A layout from the future is refused, naming it.
   write_results(p, small_results(2));
-  replace_attributes(p, {{"layout", "floesim-results/10"}});
+  replace_attributes(p, {{"layout", "floesim-results/11"}});
   const std::string e = error_of([&] { read_results(p); });
-  EXPECT_NE(e.find("floesim-results/10"), std::string::npos) << e;
+  EXPECT_NE(e.find("floesim-results/11"), std::string::npos) << e;
   fs::remove(p);
 }
 

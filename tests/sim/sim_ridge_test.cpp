@@ -316,6 +316,7 @@ TEST(RidgeSettling, AKeelSettlesUnderItsLayerWhichCarriesItsNetBuoyancy) {
               built.sail_area_m2, built.porosity_by_volume, built.porosity_by_voxels, push, net_n);
   EXPECT_LT(built.max_block_speed_mps, 0.02);                        // at rest
   EXPECT_LT(built.keel_depth_m, deepest_released - 0.3);             // it rose
+  EXPECT_LE(built.keel_depth_middle_m, built.keel_depth_m);          // the profile's deepest is not below any block
   EXPECT_GT(built.keel_depth_m, -layer_bottom + 0.3);                // and stays a keel
   EXPECT_FALSE(above_layer);                                         // no keel block came through the layer
   EXPECT_FALSE(below_layer);                                         // no sail block fell through it
@@ -395,6 +396,45 @@ TEST(RidgeField, RidgesAlongARouteFollowTheirDensityAndDepthDistribution) {
   EXPECT_EQ(again.back().line[0].x_m, ridges.back().line[0].x_m);
   f.seed = 2;
   EXPECT_NE(ridge_field_ridges(f).front().line[0].x_m, ridges.front().line[0].x_m);
+}
+
+// The same ridge settles to the same poses, bit for bit, on one thread and on two (the engine's results do not
+// depend on the thread count), and a run from them is the same again.
+TEST(RidgeSettling, SettlingIsBitIdenticalOnAnyThreadCount) {
+  SimulateOptions o = testing::floe_options();
+  o.fracture.enabled = false;
+  o.level_ice.extent_m = {-10, -2, 10, 2};
+  o.level_ice.thickness_m = 0.4;
+  o.level_ice.tile_m = 4;
+  o.domain.extent_m = {-10, -2, 10, 2};
+  o.domain.walls = {"north", "south"};
+  RidgeOptions r = small_ridge(-2, 2);
+  r.keel_depth_m = 1.6;
+  r.keel_width_m = 5;
+  r.sail_height_m = 0;
+  r.consolidated_thickness_m = 0.5;
+  r.block_thickness_m = 0.25;
+  r.block_size_m = {0.5, 0.8};
+  o.ridges = {r};
+  auto settled = [&](int threads) {
+    SimulateOptions t = o;
+    t.threads = threads;
+    Model m = build_model(FloeField{}, nullptr, t);
+    const RidgeSettling s = settle_ridges(FloeField{}, m, nullptr);
+    World w(m);
+    for (int k = 0; k < 100; ++k) w.step();
+    return std::make_pair(s, w.state());
+  };
+  const auto one = settled(1), two = settled(2);
+  std::printf("[measured] %d blocks settled in %.2f s\n", one.first.blocks, one.first.time_s);
+  EXPECT_GT(one.first.blocks, 20);
+  EXPECT_EQ(one.first.steps, two.first.steps);
+  ASSERT_EQ(one.second.position.size(), two.second.position.size());
+  for (size_t b = 0; b < one.second.position.size(); ++b) {
+    EXPECT_EQ(one.second.position[b], two.second.position[b]) << "body " << b;
+    EXPECT_EQ(one.second.orientation[b].coeffs(), two.second.orientation[b].coeffs()) << "body " << b;
+  }
+  EXPECT_EQ(one.first.ridges[0].porosity_by_voxels, two.first.ridges[0].porosity_by_voxels);
 }
 
 TEST(RidgeSection, BadInputNamesTheKey) {
