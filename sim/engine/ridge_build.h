@@ -52,7 +52,8 @@ struct RidgeSettling {
 
 // Settles the rubble of `model`'s ridges (settings.ridge_settling) in a world of its own: the same floes and
 // settings (and threads) without the hull bodies, with fracture off, in still water and air in the ice's frame (the
-// case's current and wind act from the run's start). It steps until every block has been at rest for rest_time_s,
+// case's current and wind act from the run's start). It steps until every block has been at rest for rest_time_s
+// (a block touching nothing counts by its heave and turning alone: one that came out from under the ice drifts on),
 // then gives `model`'s blocks their settled poses (matched by id) and lets them start asleep, and measures each
 // ridge. Throws floesim::Error naming ridge_settling.max_s when the rubble is not at rest by then. `progress`: a
 // line every 10 s of settling (null: none). Deterministic: the same inputs and threads give the same poses.
