@@ -26,6 +26,19 @@ struct RidgePoint {
   }
 };
 
+// The checks a ridge's rubble takes wherever it is given: a macro-porosity in (0, 1), and block sizes [min, max]
+// with 0 < min <= max.
+inline Check<double> porosity_range() {
+  return Check<double>([](const double& e) -> std::string { return e > 0 && e < 1 ? "" : "must be in (0, 1)"; });
+}
+inline Check<std::vector<double>> block_size_range() {
+  return Check<std::vector<double>>([](const std::vector<double>& a) -> std::string {
+    if (a.size() != 2) return "must be [min, max]";
+    if (!(a[0] > 0 && a[1] >= a[0] && std::isfinite(a[1]))) return "must be 0 < min <= max";
+    return "";
+  });
+}
+
 // One ridge. Its cross-section: a consolidated layer of thickness h_c floating freely (draft h_c rho_i / rho_w)
 // and keel_width_m wide; under it a keel whose sides slope at keel_angle_deg down to keel_depth_m below the
 // waterline (a trapezoid; its bottom at least 0 wide); over it a sail, a triangle of sail_height_m with sides at
@@ -56,17 +69,11 @@ struct RidgeOptions {
             "thickness h_c of the refrozen layer at the waterline (a level sheet broken by the fracture module)",
             positive());
     v.field("porosity", porosity, "-", "macro-porosity e of keel and sail (0.25-0.35 measured)",
-            Check<double>([](const double& e) -> std::string {
-              return e > 0 && e < 1 ? "" : "must be in (0, 1)";
-            }));
+            porosity_range());
     v.field("block_thickness_m", block_thickness_m, "m", "thickness of the rubble blocks (about the parent ice's)",
             positive());
     v.field("block_size_m", block_size_m, "m", "[min, max] of a block's plan sides, drawn log-uniformly",
-            Check<std::vector<double>>([](const std::vector<double>& a) -> std::string {
-              if (a.size() != 2) return "must be [min, max]";
-              if (!(a[0] > 0 && a[1] >= a[0] && std::isfinite(a[1]))) return "must be 0 < min <= max";
-              return "";
-            }));
+            block_size_range());
     v.field("seed", seed, "-", "seed of the blocks' sizes and placement", int_in_range(0, 2147483647));
     if (line.size() < 2) v.problem("line", "needs at least two points");
   }
@@ -116,16 +123,10 @@ struct RidgeFieldOptions {
             positive());
     v.field("keel_angle_deg", keel_angle_deg, "deg", "slope of the keels' sides", in_range(5, 85));
     v.field("sail_angle_deg", sail_angle_deg, "deg", "slope of the sails' sides", in_range(5, 85));
-    v.field("porosity", porosity, "-", "macro-porosity of keels and sails", Check<double>([](const double& e) {
-              return std::string(e > 0 && e < 1 ? "" : "must be in (0, 1)");
-            }));
+    v.field("porosity", porosity, "-", "macro-porosity of keels and sails", porosity_range());
     v.field("block_thickness_m", block_thickness_m, "m", "thickness of the rubble blocks", positive());
     v.field("block_size_m", block_size_m, "m", "[min, max] of a block's plan sides, drawn log-uniformly",
-            Check<std::vector<double>>([](const std::vector<double>& a) -> std::string {
-              if (a.size() != 2) return "must be [min, max]";
-              if (!(a[0] > 0 && a[1] >= a[0] && std::isfinite(a[1]))) return "must be 0 < min <= max";
-              return "";
-            }));
+            block_size_range());
     v.field("seed", seed, "-", "seed of the ridges' places and sizes (and of their blocks)",
             int_in_range(0, 2147483647));
     if (keel_depth_mean_m <= keel_depth_min_m) v.problem("keel_depth_mean_m", "must exceed keel_depth_min_m");

@@ -206,6 +206,29 @@ RidgeOptions small_ridge(double y0, double y1) {
   return r;
 }
 
+// Options for settling a ridge in a strip of level ice h thick over [-x, x] x [-y, y] in tiles of `tile` m, walls at
+// its ends (north, south) so that no rubble floats off there; fracture off.
+SimulateOptions strip_options(double x, double y, double h, double tile) {
+  SimulateOptions o = testing::floe_options();
+  o.fracture.enabled = false;
+  o.level_ice.extent_m = {-x, -y, x, y};
+  o.level_ice.thickness_m = h;
+  o.level_ice.tile_m = tile;
+  o.domain.extent_m = {-x, -y, x, y};
+  o.domain.walls = {"north", "south"};
+  return o;
+}
+
+// The settling tests' keel: small_ridge's 2.2 m deep and 7 m wide under a 0.6 m layer, a 0.6 m sail.
+RidgeOptions settling_ridge(double y0, double y1) {
+  RidgeOptions r = small_ridge(y0, y1);
+  r.keel_depth_m = 2.2;
+  r.keel_width_m = 7;
+  r.sail_height_m = 0.6;
+  r.consolidated_thickness_m = 0.6;
+  return r;
+}
+
 // A case's ridge (settings.ridges) in a model: its consolidated layer cut out of the level ice sheet along its line
 // (h_c thick, the sheet's ice elsewhere), its rubble as released blocks carrying (1 - e) of the keel's and the sail's
 // envelopes, all of it ice: the model's ice is the sheet's plus the rubble's.
@@ -267,19 +290,8 @@ TEST(RidgeModel, TheLayerIsCutOutOfTheSheetAndTheRubbleCarriesTheRidgesIce) {
 // to rest against it, the sail's fall onto it. At rest the contacts press the sheet up with the keel's net buoyancy
 // less the sail's weight, the closed form of the blocks' volumes.
 TEST(RidgeSettling, AKeelSettlesUnderItsLayerWhichCarriesItsNetBuoyancy) {
-  SimulateOptions o = testing::floe_options();
-  o.fracture.enabled = false;
-  o.level_ice.extent_m = {-15, -3, 15, 3};
-  o.level_ice.thickness_m = 0.5;
-  o.level_ice.tile_m = 10;
-  o.domain.extent_m = {-15, -3, 15, 3};
-  o.domain.walls = {"north", "south"};
-  RidgeOptions r = small_ridge(-3, 3);
-  r.keel_depth_m = 2.2;
-  r.keel_width_m = 7;
-  r.sail_height_m = 0.6;
-  r.consolidated_thickness_m = 0.6;
-  o.ridges = {r};
+  SimulateOptions o = strip_options(15, 3, 0.5, 10);
+  o.ridges = {settling_ridge(-3, 3)};
   World w(build_model(FloeField{}, nullptr, o));
   const Model& m = w.model();
   const double layer_bottom = -0.6 * kIce / kWater, layer_top = 0.6 + layer_bottom;
@@ -334,12 +346,7 @@ TEST(RidgeSettling, AFreeFloatingRidgeSettlesToItsHydrostaticRatio) {
   SimulateOptions o = testing::floe_options();
   o.fracture.enabled = false;
   o.ridge_settling.rest_speed_mps = 0.05;
-  RidgeOptions r = small_ridge(-3, 3);
-  r.keel_depth_m = 2.2;
-  r.keel_width_m = 7;
-  r.sail_height_m = 0.6;
-  r.consolidated_thickness_m = 0.6;
-  o.ridges = {r};
+  o.ridges = {settling_ridge(-3, 3)};
   Model m = build_model(FloeField{}, nullptr, o);
   const RidgeSettling settled = settle_ridges(FloeField{}, m, nullptr);
   ASSERT_EQ(settled.ridges.size(), 1u);
@@ -400,13 +407,7 @@ TEST(RidgeField, RidgesAlongARouteFollowTheirDensityAndDepthDistribution) {
 // The same ridge settles to the same poses, bit for bit, on one thread and on two (the engine's results do not
 // depend on the thread count), and a run from them is the same again.
 TEST(RidgeSettling, SettlingIsBitIdenticalOnAnyThreadCount) {
-  SimulateOptions o = testing::floe_options();
-  o.fracture.enabled = false;
-  o.level_ice.extent_m = {-10, -2, 10, 2};
-  o.level_ice.thickness_m = 0.4;
-  o.level_ice.tile_m = 4;
-  o.domain.extent_m = {-10, -2, 10, 2};
-  o.domain.walls = {"north", "south"};
+  SimulateOptions o = strip_options(10, 2, 0.4, 4);
   RidgeOptions r = small_ridge(-2, 2);
   r.keel_depth_m = 1.6;
   r.keel_width_m = 5;
