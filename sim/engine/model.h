@@ -16,6 +16,7 @@
 #include "sim/vessel/hull.h"
 #include "sim/geometry/mesh.h"
 #include "sim/engine/settings.h"
+#include "sim/engine/state.h"
 #include "sim/vessel/open_water.h"
 
 namespace floesim::sim {
@@ -188,6 +189,10 @@ struct Model {
   Station station;  // the vessel's, when it is a structure (vessel.station_keeping held)
   // The structures beside it (settings.structures, in order): bodies right after the vessel's, before the floes.
   std::vector<StructureBody> structures;
+
+  // Freeze bonds the run starts with (settle_ridges freezes the settled rubble, settings.freeze_bonds): a world's
+  // State::bonds begin as these.
+  std::vector<FreezeBond> initial_bonds;
 
   int wall_count = 0;                 // domain walls, the last bodies of the model as built
   // The bodies build_model made: the vessel, the input floes (and level ice tiles) and the walls. A world appends

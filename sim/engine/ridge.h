@@ -157,6 +157,38 @@ struct RidgeSettlingOptions {
   }
 };
 
+// Freeze bonds between the ridges' blocks (PHYSICS.md §9.5, issue #36 item 2): once the rubble has settled, every
+// pair of blocks that touch freezes together, one bond at the middle of their contact over its area (the polygon of
+// its points, at least min_area_m2: blocks that meet at an edge or a corner freeze over that). One bond per pair, not
+// one per contact point: between rigid blocks the points' shares of a load are not determined (any shares that
+// balance will do), and the contact solver's would break a pair point by point below its strength. A bond pulls in
+// tension with at most tensile_strength_pa and in shear with at most shear_strength_pa over its area, and pushes
+// without limit; it takes no moment (the pair's contact points do, in compression). Loaded beyond its strength it
+// cannot hold its two points together: once they have parted (opened or slid) by break_opening_m it has broken, for
+// good. Off while both strengths are 0.
+struct FreezeBondOptions {
+  double tensile_strength_pa = 0;
+  double shear_strength_pa = 0;
+  double min_area_m2 = 0.01;
+  double break_opening_m = 0.005;
+  bool enabled() const { return tensile_strength_pa > 0; }
+  template <class V>
+  void visit(V& v) {
+    v.field("tensile_strength_pa", tensile_strength_pa, "Pa",
+            "a freeze bond's tensile strength sigma_t over its area (0 with shear_strength_pa 0: no bonds)",
+            non_negative());
+    v.field("shear_strength_pa", shear_strength_pa, "Pa", "a freeze bond's shear strength tau over its area",
+            non_negative());
+    v.field("min_area_m2", min_area_m2, "m^2",
+            "the area a pair of blocks touching at an edge or a corner freezes over (the least of any pair)",
+            positive());
+    v.field("break_opening_m", break_opening_m, "m",
+            "a bond whose two points have parted (opened or slid) this far has broken", positive());
+    if ((tensile_strength_pa > 0) != (shear_strength_pa > 0))
+      v.problem("shear_strength_pa", "freeze bonds need both strengths > 0 (or both 0: no bonds)");
+  }
+};
+
 // The cross-section of a ridge as given (before settling), in the segment frame; water and ice densities from the
 // simulation's settings.
 struct RidgeSection {

@@ -171,6 +171,46 @@ RidgeBuilt measure_ridge(const Model& m, const State& st, int ridge, double voxe
   return out;
 }
 
+std::vector<FreezeBond> freeze_touching(const Model& model, const State& state, const std::vector<Contact>& contacts,
+                                        const std::vector<uint8_t>& freezes, const FreezeBondOptions& o) {
+  std::vector<FreezeBond> bonds;
+  for (size_t i = 0; i < contacts.size();) {
+    // The contact points of one body pair (contacts come sorted by pair).
+    size_t e = i;
+    while (e < contacts.size() && contacts[e].body_a == contacts[i].body_a && contacts[e].body_b == contacts[i].body_b)
+      ++e;
+    const Contact& c0 = contacts[i];
+    const int a = c0.body_a, b = c0.body_b;
+    if (!freezes[a] || !freezes[b] || c0.type != ContactType::rigid) {
+      i = e;
+      continue;
+    }
+    // Their polygon's area in the plane of the mean normal.
+    Vec3 n = Vec3::Zero();
+    for (size_t k = i; k < e; ++k) n += contacts[k].normal;
+    n.normalize();
+    const Vec3 u = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized(), v = n.cross(u);
+    Polygon pts;
+    for (size_t k = i; k < e; ++k) pts.push_back(Vec2(contacts[k].point.dot(u), contacts[k].point.dot(v)));
+    const Polygon hull = pts.size() >= 3 ? convex_hull_2d(pts) : Polygon();
+    const double area = std::max(hull.size() >= 3 ? std::abs(signed_area(hull)) : 0.0, o.min_area_m2);
+    Vec3 point = Vec3::Zero();
+    for (size_t k = i; k < e; ++k) point += contacts[k].point;
+    point /= static_cast<double>(e - i);
+    const Quat qa_inv = state.orientation[a].conjugate(), qb_inv = state.orientation[b].conjugate();
+    FreezeBond fb;
+    fb.body_a = a;
+    fb.body_b = b;
+    fb.anchor_a = qa_inv * (point - state.position[a]);
+    fb.anchor_b = qb_inv * (point - state.position[b]);
+    fb.normal_a = (qa_inv * n).normalized();
+    fb.area_m2 = area;
+    bonds.push_back(fb);
+    i = e;
+  }
+  return bonds;
+}
+
 RidgeSettling settle_ridges(const FloeField& field, Model& model, std::ostream* progress) {
   RidgeSettling out;
   if (model.settings.ridges.empty()) return out;
@@ -219,9 +259,21 @@ RidgeSettling settle_ridges(const FloeField& field, Model& model, std::ostream* 
                 << " s, fastest block " << std::setprecision(3) << fastest << " m/s, awake floes "
                 << w.report().awake_floes << std::defaultfloat << std::endl;
   }
+  // 3. Freeze bonds: the blocks woken for one more step, so that every pair that touches is found (a pair of
+  // sleepers is not looked at), and frozen at the poses that step found them in.
+  std::vector<FreezeBond> bonds;
+  if (o.freeze_bonds.enabled()) {
+    for (int b : rubble) w.wake(b);
+    const State before = w.state();
+    w.step();
+    ++out.steps;
+    std::vector<uint8_t> freezes(m.bodies.size(), 0);
+    for (int b : rubble) freezes[b] = 1;
+    bonds = freeze_touching(m, before, w.contacts(), freezes, o.freeze_bonds);
+  }
   out.time_s = w.state().time_s;
   out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  // 3. The settled poses into the run's model, by id; they start asleep where floes may.
+  // 4. The settled poses and the bonds into the run's model, by id; they start asleep where floes may.
   std::map<int, int> index_of;
   for (size_t b = 0; b < model.bodies.size(); ++b)
     if (model.bodies[b].ridge_part == RidgePart::keel || model.bodies[b].ridge_part == RidgePart::sail)
@@ -236,6 +288,19 @@ RidgeSettling settle_ridges(const FloeField& field, Model& model, std::ostream* 
     target.initial_orientation = w.state().orientation[b];
     target.start_awake = false;
   }
+  model.initial_bonds.clear();
+  for (FreezeBond fb : bonds) {
+    fb.body_a = index_of.at(m.bodies[fb.body_a].id);
+    fb.body_b = index_of.at(m.bodies[fb.body_b].id);
+    if (fb.body_a > fb.body_b) {
+      std::swap(fb.body_a, fb.body_b);
+      std::swap(fb.anchor_a, fb.anchor_b);
+      fb.normal_a = -(model.bodies[fb.body_a].initial_orientation.conjugate() *
+                      (model.bodies[fb.body_b].initial_orientation * fb.normal_a));
+    }
+    model.initial_bonds.push_back(fb);
+  }
+  out.bonds = static_cast<int>(bonds.size());
   for (size_t r = 0; r < o.ridges.size(); ++r)
     out.ridges.push_back(measure_ridge(m, w.state(), static_cast<int>(r), rs.voxel_m));
   return out;

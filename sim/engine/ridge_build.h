@@ -42,11 +42,20 @@ struct RidgeBuilt {
 // blocks beyond the segment's ends left out), on voxels of edge voxel_m.
 RidgeBuilt measure_ridge(const Model& model, const State& state, int ridge, double voxel_m);
 
-// What settling did: how long it took (simulated and wall), and each ridge as built (settings.ridges' order).
+// Freeze bonds (PHYSICS.md §9.5) between the bodies of `freezes` (per body: may freeze) that touch in `contacts`
+// (rigid contacts found at the poses of `state`): each touching pair becomes one bond at the mean of its contact
+// points, held as a material point of each block, along the mean of their normals, over the pair's contact area (the
+// polygon of its points in the contact plane, at least o.min_area_m2).
+std::vector<FreezeBond> freeze_touching(const Model& model, const State& state, const std::vector<Contact>& contacts,
+                                        const std::vector<uint8_t>& freezes, const FreezeBondOptions& o);
+
+// What settling did: how long it took (simulated and wall), each ridge as built (settings.ridges' order) and how many
+// freeze bonds the settled rubble made.
 struct RidgeSettling {
   double time_s = 0, wall_s = 0;
   long steps = 0;
   int blocks = 0;
+  int bonds = 0;
   std::vector<RidgeBuilt> ridges;
 };
 
@@ -54,8 +63,8 @@ struct RidgeSettling {
 // settings (and threads) without the hull bodies, with fracture off, in still water and air in the ice's frame (the
 // case's current and wind act from the run's start). It steps until every block has been at rest for rest_time_s
 // (a block touching nothing counts by its heave and turning alone: one that came out from under the ice drifts on),
-// then gives `model`'s blocks their settled poses (matched by id) and lets them start asleep, and measures each
-// ridge. Throws floesim::Error naming ridge_settling.max_s when the rubble is not at rest by then. `progress`: a
+// then gives `model`'s blocks their settled poses (matched by id) and lets them start asleep, freezes the blocks
+// that touch together (settings.freeze_bonds: Model::initial_bonds) and measures each ridge. Throws floesim::Error naming ridge_settling.max_s when the rubble is not at rest by then. `progress`: a
 // line every 10 s of settling (null: none). Deterministic: the same inputs and threads give the same poses.
 RidgeSettling settle_ridges(const FloeField& field, Model& model, std::ostream* progress);
 

@@ -846,6 +846,7 @@ struct EngineSettings {
   std::vector<RidgeOptions> ridges;          // ridges in the level ice (sim/engine/ridge.h, issue #36)
   RidgeFieldOptions ridge_field;             // more ridges along a route at a density (after `ridges`)
   RidgeSettlingOptions ridge_settling;       // how their rubble is settled before the run
+  FreezeBondOptions freeze_bonds;            // and frozen together once settled
 
   long reference_horizon_steps() const { return std::lround(solver.reference_horizon_s / time_step_s); }  // 0: none
 };

@@ -127,6 +127,13 @@ inline Vec3 rel_velocity(const State& s, const Contact& c) {
 }
 inline double rel_velocity(const State& s, const Contact& c, const Vec3& d) { return d.dot(rel_velocity(s, c)); }
 
+// The bounds of a contact's impulses: the normal impulse's floor (0; a bond's -dt sigma_t A) and the radius of the
+// tangential impulse's disk (Coulomb's mu p_n; a bond's dt tau A, whatever the normal impulse).
+inline double normal_floor(const Contact& c) { return c.type == ContactType::bond ? -c.tension_limit : 0.0; }
+inline double shear_radius(const Contact& c, double pn) {
+  return c.type == ContactType::bond ? c.shear_limit : c.mu * pn;
+}
+
 // The normal impulse of a crushing row given its current normal velocity vn (PHYSICS.md §1.8(c)), the local
 // three-branch update of a Gauss-Seidel sweep (velocities counted from the bias, see below). With W = 1/m_eff and
 // v0 = vn - W p the velocity without this row's impulse, the end-of-step velocity is v = v0 + W p and
@@ -201,8 +208,10 @@ ContactIslands prepare_contacts(const Model& model, const SolverBodies& sb, Stat
     // 1. Auxiliary data: lever arms, tangents, I^-1 (r x d) per row and body, effective masses 1/W.
     c.ra = c.point - state.position[c.body_a];
     c.rb = c.point - state.position[c.body_b];
-    c.fixed_a = is_fixed(sb, c.body_a);
-    c.fixed_b = is_fixed(sb, c.body_b);
+    // Fixed: a wall, a tile of level ice, or a body asleep in a contact with an awake one (rubble the touch left at
+    // rest, World::touch_wakes): the impulses do not move them.
+    c.fixed_a = is_fixed(sb, c.body_a) || !state.awake[c.body_a];
+    c.fixed_b = is_fixed(sb, c.body_b) || !state.awake[c.body_b];
     tangents(c.normal, c.t1, c.t2);
     const Mat3& Ia = sb.inv_inertia_world[c.body_a];
     const Mat3& Ib = sb.inv_inertia_world[c.body_b];
@@ -231,6 +240,13 @@ ContactIslands prepare_contacts(const Model& model, const SolverBodies& sb, Stat
                                                             std::sqrt(k_pair / w_pair) * c.crush_stiffness_npm / k_pair
                                                       : 0.0;
       c.max_normal_impulse = dt * c.crush_force_n;  // the cap at the start-of-step penetration (warm start clamp)
+    } else if (c.type == ContactType::bond) {
+      // A bond pulls its two material points together at ERP per step, along the normal and the tangents.
+      auto pull = [&](double d) { return std::clamp(-o.erp * d / dt, -o.max_push_mps, o.max_push_mps); };
+      const Vec3& d = c.bond_separation;
+      c.bias = pull(d.dot(c.normal));
+      c.bias_t1 = pull(d.dot(c.t1));
+      c.bias_t2 = pull(d.dot(c.t2));
     } else if (c.gap > 0) c.bias = -c.gap / dt;
     else c.bias = std::min(o.erp * std::max(0.0, -c.gap - o.slop_m) / dt, o.max_push_mps);
     c.local_a = state.orientation[c.body_a].conjugate() * c.ra;
@@ -240,7 +256,12 @@ ContactIslands prepare_contacts(const Model& model, const SolverBodies& sb, Stat
     if (!o.warm_start) continue;
     const std::vector<CachedContact>& cache = state.contact_cache;
     const CachedContact* best = nullptr;
-    if (c.type == ContactType::crushing) {
+    CachedContact bonded;
+    if (c.type == ContactType::bond) {
+      // A bond's own impulse of the last step, turned with its body a.
+      bonded.impulse = state.orientation[c.body_a] * state.bonds[c.bond].impulse_a;
+      best = &bonded;
+    } else if (c.type == ContactType::crushing) {
       // A crushing row carries a half of a contact of the body pair, whose part pairs may come and go and whose
       // centroid may slide: its predecessor is the cached row of the same pair and half whose crushed normal is
       // in the same direction (kSameContactCos), the nearest.
@@ -263,10 +284,10 @@ ContactIslands prepare_contacts(const Model& model, const SolverBodies& sb, Stat
       }
     }
     if (!best) continue;
-    c.pn = std::clamp(best->impulse.dot(c.normal), 0.0, c.max_normal_impulse);
+    c.pn = std::clamp(best->impulse.dot(c.normal), normal_floor(c), c.max_normal_impulse);
     c.pt1 = best->impulse.dot(c.t1);
     c.pt2 = best->impulse.dot(c.t2);
-    const double lim = c.mu * c.pn, pt = std::sqrt(c.pt1 * c.pt1 + c.pt2 * c.pt2);
+    const double lim = shear_radius(c, c.pn), pt = std::sqrt(c.pt1 * c.pt1 + c.pt2 * c.pt2);
     if (pt > lim) {
       const double s = pt > 0 ? lim / pt : 0.0;
       c.pt1 *= s;
@@ -284,21 +305,24 @@ namespace {
 // The normal velocity a rigid row aims at: the bias (push-out, speculative gap) in the solve; in the relax pass
 // only non-penetration (or the speculative gap).
 inline double rigid_target(const Contact& c, double dt, bool use_bias) {
+  if (c.type == ContactType::bond) return use_bias ? c.bias : 0.0;
   return use_bias ? c.bias : (c.gap > 0 ? -c.gap / dt : 0.0);
 }
 
 // The new normal impulse of one contact's normal row from its current normal velocity vn: the local law.
 inline double normal_update(const Contact& c, double vn, double dt, bool use_bias) {
   if (c.type == ContactType::crushing) return crushing_impulse(c, vn, dt);
-  return std::clamp(c.pn + c.mass_n * (rigid_target(c, dt, use_bias) - vn), 0.0, c.max_normal_impulse);
+  return std::clamp(c.pn + c.mass_n * (rigid_target(c, dt, use_bias) - vn), normal_floor(c), c.max_normal_impulse);
 }
 
 // The new friction impulses from the current tangential velocities, projected together onto the Coulomb disk of
-// radius mu p_n (the exact cone section, no polyhedral anisotropy).
-inline void friction_update(const Contact& c, double v1, double v2, double& p1, double& p2) {
-  const double lim = c.mu * c.pn;
-  p1 = c.pt1 - c.mass_t1 * v1;
-  p2 = c.pt2 - c.mass_t2 * v2;
+// radius mu p_n (the exact cone section, no polyhedral anisotropy); a bond's aim at its tangential bias, in the disk
+// of its shear strength.
+inline void friction_update(const Contact& c, double v1, double v2, bool use_bias, double& p1, double& p2) {
+  const double lim = shear_radius(c, c.pn);
+  const bool pull = use_bias && c.type == ContactType::bond;
+  p1 = c.pt1 - c.mass_t1 * (v1 - (pull ? c.bias_t1 : 0.0));
+  p2 = c.pt2 - c.mass_t2 * (v2 - (pull ? c.bias_t2 : 0.0));
   const double pt = std::sqrt(p1 * p1 + p2 * p2);
   if (pt > lim) {
     const double s = pt > 0 ? lim / pt : 0.0;
@@ -328,7 +352,7 @@ double sweep_contact(State& state, const SolverBodies& sb, Contact& c, double dt
   }
   double p1, p2;
   const Vec3 dv = rel_velocity(state, c);  // once for both friction rows
-  friction_update(c, c.t1.dot(dv), c.t2.dot(dv), p1, p2);
+  friction_update(c, c.t1.dot(dv), c.t2.dot(dv), use_bias, p1, p2);
   const double d1 = p1 - c.pt1, d2 = p2 - c.pt2;
   if (d1 != 0) {
     apply(state, sb, c, c.t1, c.ia_t1, c.ib_t1, d1);
@@ -355,7 +379,7 @@ double law_violation(const State& state, const Island& island, double dt, bool u
     const Contact& c = island[i];
     const double pn = normal_update(c, rel_velocity(state, c, c.normal), dt, use_bias);
     double p1, p2;
-    friction_update(c, rel_velocity(state, c, c.t1), rel_velocity(state, c, c.t2), p1, p2);
+    friction_update(c, rel_velocity(state, c, c.t1), rel_velocity(state, c, c.t2), use_bias, p1, p2);
     const double e[3] = {std::abs(pn - c.pn) * c.inv_mass_n, std::abs(p1 - c.pt1) / std::max(c.mass_t1, 1e-300),
                          std::abs(p2 - c.pt2) / std::max(c.mass_t2, 1e-300)};
     for (double x : e) {
@@ -398,6 +422,16 @@ int subspace_step(const SolverBodies& sb, State& state, const Island& island, do
   for (int i = 0; i < island.n; ++i) {
     const int ci = island.index[i];
     const Contact& c = contacts[ci];
+    if (c.type == ContactType::bond) {
+      // A bond: its normal row while above its tension floor, its tangent rows while inside its shear disk.
+      if (c.mass_n <= 0) continue;
+      if (c.pn > -c.tension_limit * (1 - 1e-9)) rows.push_back({ci, 0, 0.0, rigid_target(c, dt, use_bias)});
+      if (std::hypot(c.pt1, c.pt2) < c.shear_limit * (1 - 1e-9)) {
+        rows.push_back({ci, 1, 0.0, use_bias ? c.bias_t1 : 0.0});
+        rows.push_back({ci, 2, 0.0, use_bias ? c.bias_t2 : 0.0});
+      }
+      continue;
+    }
     if (c.mass_n <= 0 || c.pn <= 0) continue;  // between two fixed bodies, or not pressing: held (at zero)
     if (c.type == ContactType::rigid) {
       rows.push_back({ci, 0, 0.0, rigid_target(c, dt, use_bias)});
@@ -511,10 +545,10 @@ int subspace_step(const SolverBodies& sb, State& state, const Island& island, do
       Contact& c = contacts[rows[r].contact];
       Vec3 p = old[r];
       for (const int ci = rows[r].contact; r < m && rows[r].contact == ci; ++r) p[rows[r].k] += dp[r];
-      // Rigid rows keep their bound; a crushing row's bound is its law, which the next sweep applies.
-      const double pn = c.type == ContactType::rigid ? std::clamp(p.x(), 0.0, c.max_normal_impulse)
-                                                     : std::max(p.x(), 0.0);
-      const double lim = c.mu * pn, pt = std::hypot(p.y(), p.z());
+      // Rigid rows and bonds keep their bounds; a crushing row's bound is its law, which the next sweep applies.
+      const double pn = c.type != ContactType::crushing ? std::clamp(p.x(), normal_floor(c), c.max_normal_impulse)
+                                                        : std::max(p.x(), 0.0);
+      const double lim = shear_radius(c, pn), pt = std::hypot(p.y(), p.z());
       const double s = pt > lim ? (pt > 0 ? lim / pt : 0.0) : 1.0;
       set_impulses(c, pn, s * p.y(), s * p.z());
     }
@@ -637,10 +671,16 @@ SolverReport solve_contacts(const Model& model, const SolverBodies& sb, State& s
 
 void store_impulses(const Model& model, State& state, const std::vector<Contact>& contacts) {
   state.contact_cache.clear();
-  for (const Contact& c : contacts)
+  for (const Contact& c : contacts) {
+    if (c.type == ContactType::bond) {  // kept with the bond, in a's frame
+      state.bonds[c.bond].impulse_a =
+          state.orientation[c.body_a].conjugate() * (c.pn * c.normal + c.pt1 * c.t1 + c.pt2 * c.t2);
+      continue;
+    }
     state.contact_cache.push_back(CachedContact{c.body_a, c.part_a, c.body_b, c.part_b, c.row, c.local_a,
                                                 c.pn * c.normal + c.pt1 * c.t1 + c.pt2 * c.t2, c.type,
                                                 c.crush_normal_a, c.crush_point_a, c.crush_point_b});
+  }
 }
 
 }  // namespace floesim::sim

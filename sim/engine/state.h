@@ -17,7 +17,9 @@ using Quat = Eigen::Quaterniond;
 // Rigid: non-penetration with ERP push-out. Crushing: compliant ice crushing (PHYSICS.md §1.8(c)): rigid while the
 // normal force is below the crushing force p_c(A) A of the overlap, crushing (hardening with K_t) above it, never
 // pushed out and never pulling. Which law a pair gets is chosen per pair of body classes (options.contact).
-enum class ContactType : uint8_t { rigid, crushing };
+// Bond: a freeze bond (PHYSICS.md §9.5) holding two material points together, in tension up to tension_limit and in
+// shear up to shear_limit (its strengths times its area, per step), in compression without limit.
+enum class ContactType : uint8_t { rigid, crushing, bond };
 
 // One contact point between body a and body b (a < b). Written by collide, completed and solved by solve.
 struct Contact {
@@ -65,6 +67,26 @@ struct Contact {
   double pn = 0, pt1 = 0, pt2 = 0;                    // accumulated impulses (N s)
   Vec3 local_a = Vec3::Zero();                        // point in a's body frame (warm-start matching)
   bool fixed_a = false, fixed_b = false;              // a body the impulses cannot move (a wall)
+  // Bond rows (the world adds them after collide): the bond's index in State::bonds, how far its material point on b
+  // is from the one on a (world), the smallest normal impulse (-dt sigma_t A: tension), the radius of the shear
+  // impulse's disk (dt tau A), and (solve) the tangential velocities that pull the two points back together (the ERP
+  // bias of the tangents; the normal's is `bias`).
+  int bond = -1;
+  Vec3 bond_separation = Vec3::Zero();
+  double tension_limit = 0, shear_limit = 0;          // N s
+  double bias_t1 = 0, bias_t2 = 0;                    // m/s
+};
+
+// A freeze bond between two blocks of rubble (PHYSICS.md §9.5): where they froze together, as a material point of
+// each (body frames) and the contact normal in a's frame, and the area it holds. It takes tension up to
+// tensile_strength_pa x area and shear up to shear_strength_pa x area (EngineSettings::freeze_bonds); once either is
+// reached it breaks, for good. Its impulse of the last step (in a's frame) warm-starts the next.
+struct FreezeBond {
+  int body_a = -1, body_b = -1;  // a < b
+  Vec3 anchor_a = Vec3::Zero(), anchor_b = Vec3::Zero();
+  Vec3 normal_a = Vec3::UnitZ();
+  double area_m2 = 0;
+  Vec3 impulse_a = Vec3::Zero();
 };
 
 // The part pairs of a body pair whose vector areas point within this cosine (26 deg) of each other press in one
@@ -109,6 +131,8 @@ struct State {
                                           // (heave_radiation_force); 0 while asleep, a piece takes its parent's
   std::vector<CachedContact> contact_cache;  // sorted by (body_a, body_b, part_a, part_b)
   std::vector<PairLoadHistory> pair_loads;   // the fracture stage's, sorted by (floe, other), then as made
+  std::vector<FreezeBond> bonds;             // the freeze bonds not yet broken, in the order they froze
+  long bonds_broken = 0;                     // freeze bonds broken since the start
   // Vessel controllers.
   double speed_error_integral = 0;      // m, integral of the speed error (PI thrust controller)
   double heading_ref_rad = 0;           // course held by the autopilot

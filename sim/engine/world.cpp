@@ -105,6 +105,11 @@ World::World(Model built) : model_(std::move(built)), pool_(model_.settings.thre
     state_.velocity[sb.body] = -model.frame_velocity;
   }
   state_.structure_dp_memory.assign(model.structures.size(), {});
+  for (const FreezeBond& fb : model.initial_bonds)
+    FLOESIM_REQUIRE(fb.body_a >= 0 && fb.body_a < fb.body_b && static_cast<size_t>(fb.body_b) < n &&
+                        fb.area_m2 > 0,
+                    "internal: a freeze bond between bodies ", fb.body_a, " and ", fb.body_b, " of ", n);
+  state_.bonds = model.initial_bonds;
   // Inverse mass matrices (world) as the solver sees them; the forces stage refreshes those of awake bodies.
   solver_bodies_.inv_mass.assign(n, Mat3::Zero());
   solver_bodies_.inv_inertia_world.assign(n, Mat3::Zero());
@@ -194,11 +199,12 @@ void World::step_branch() {
 void World::stage_collide() {
   collision_->update_bodies(state_, moved_);
   collision_->find_contacts(state_, contacts_);
-  // A contact with an awake body wakes a sleeper; its pose is current, its velocity zero.
+  // A contact with an awake body wakes a sleeper (rubble: a touch that moves); its pose is current, its velocity zero.
   for (const Contact& c : contacts_) {
-    if (!state_.awake[c.body_a]) wake(c.body_a);
-    if (!state_.awake[c.body_b]) wake(c.body_b);
+    if (!state_.awake[c.body_a] && touch_wakes(c.body_b, c.body_a, c.point)) wake(c.body_a);
+    if (!state_.awake[c.body_b] && touch_wakes(c.body_a, c.body_b, c.point)) wake(c.body_b);
   }
+  add_bond_rows();
   // A sleeping floe that a propeller jet reaches wakes: the water moves there (the jets of the last step).
   if (!jets_.empty())
     for (size_t b = 0; b < model_.bodies.size(); ++b)
@@ -208,6 +214,77 @@ void World::stage_collide() {
   awake_list_.clear();
   for (size_t b = 0; b < model_.bodies.size(); ++b)
     if (state_.awake[b]) awake_list_.push_back(static_cast<int>(b));
+}
+
+bool World::touch_wakes(int toucher, int sleeper, const Vec3& at) const {
+  const RidgePart part = model_.bodies[sleeper].ridge_part;
+  if (part != RidgePart::keel && part != RidgePart::sail) return true;
+  if (toucher < model_.hull_count()) return true;
+  const Vec3 v = state_.velocity[toucher] + state_.angular_velocity[toucher].cross(at - state_.position[toucher]);
+  return v.norm() >= model_.settings.sleep.linear_mps;
+}
+
+void World::add_bond_rows() {
+  // A bond with an awake block that moves wakes the other (touch_wakes: the bond passes the push on, one bond further
+  // each step); a bond between two sleepers costs nothing.
+  const double dt = model_.settings.time_step_s;
+  const FreezeBondOptions& fo = model_.settings.freeze_bonds;
+  if (state_.bonds.empty()) return;
+  // Blocks frozen together are held where they froze, their overlap of then included: their contacts do not push
+  // them apart (which only the bond would resist, until it broke), they only keep them from closing further.
+  std::vector<std::pair<int, int>> bonded;
+  for (const FreezeBond& fb : state_.bonds) bonded.emplace_back(fb.body_a, fb.body_b);
+  std::sort(bonded.begin(), bonded.end());
+  for (Contact& c : contacts_)
+    if (c.gap < 0 && std::binary_search(bonded.begin(), bonded.end(), std::make_pair(c.body_a, c.body_b))) c.gap = 0;
+  for (size_t k = 0; k < state_.bonds.size(); ++k) {
+    const FreezeBond& fb = state_.bonds[k];
+    const int a = fb.body_a, b = fb.body_b;
+    if (!state_.awake[a] && !state_.awake[b]) continue;
+    if (!state_.alive[a] || !state_.alive[b]) continue;  // a block gone: the bond holds nothing
+    const Vec3 pa = state_.position[a] + state_.orientation[a] * fb.anchor_a;
+    const Vec3 pb = state_.position[b] + state_.orientation[b] * fb.anchor_b;
+    if (!state_.awake[a] && touch_wakes(b, a, pa)) wake(a);
+    if (!state_.awake[b] && touch_wakes(a, b, pb)) wake(b);
+    Contact c;
+    c.type = ContactType::bond;
+    c.bond = static_cast<int>(k);
+    c.body_a = a;
+    c.body_b = b;
+    c.part_a = model_.bodies[a].first_part;
+    c.part_b = model_.bodies[b].first_part;
+    c.point = 0.5 * (pa + pb);
+    c.span_lo = c.span_hi = c.point;
+    c.normal = state_.orientation[a] * fb.normal_a;
+    c.bond_separation = pb - pa;
+    c.gap = c.bond_separation.dot(c.normal);
+    c.mu = 0;
+    c.tension_limit = dt * fo.tensile_strength_pa * fb.area_m2;
+    c.shear_limit = dt * fo.shear_strength_pa * fb.area_m2;
+    contacts_.push_back(c);
+  }
+}
+
+void World::break_bonds() {
+  // A bond whose points have parted by break_opening_m (its strength could not hold them) has broken, for good.
+  // Measured at the step's end poses of its awake blocks (a bond between sleepers has not moved).
+  const double opening = model_.settings.freeze_bonds.break_opening_m;
+  std::vector<uint8_t> broken(state_.bonds.size(), 0);
+  int count = 0;
+  for (const Contact& c : contacts_) {
+    if (c.type != ContactType::bond) continue;
+    const FreezeBond& fb = state_.bonds[c.bond];
+    const Vec3 pa = state_.position[fb.body_a] + state_.orientation[fb.body_a] * fb.anchor_a;
+    const Vec3 pb = state_.position[fb.body_b] + state_.orientation[fb.body_b] * fb.anchor_b;
+    if ((pb - pa).norm() > opening) broken[c.bond] = 1, ++count;
+  }
+  report_.bonds_broken = count;
+  if (count == 0) return;
+  size_t kept = 0;
+  for (size_t k = 0; k < state_.bonds.size(); ++k)
+    if (!broken[k]) state_.bonds[kept++] = state_.bonds[k];
+  state_.bonds.resize(kept);
+  state_.bonds_broken += count;
 }
 
 void World::stage_forces() {
@@ -382,6 +459,8 @@ void World::stage_relax() {
     const Vec3 surge = state_.orientation[model_.vessel] * Vec3::UnitX();
     report_.surge_load_error_n = surge.dot(report_.ice_load.force) - reference_surge_load(surge);
   }
+  break_bonds();
+  report_.bonds = static_cast<int>(state_.bonds.size());
 }
 
 double World::reference_surge_load(const Vec3& surge) {
@@ -599,6 +678,7 @@ void World::stage_sleep() {
   for (const Contact& c : contacts_) {
     if (is_fixed_body(model_.bodies[c.body_a]) || is_fixed_body(model_.bodies[c.body_b])) continue;
     if (!state_.alive[c.body_a] || !state_.alive[c.body_b]) continue;  // broke up in this step
+    if (!state_.awake[c.body_a] || !state_.awake[c.body_b]) continue;  // resting rubble left asleep: a support
     const int ra = find(c.body_a), rb = find(c.body_b);
     if (ra != rb) island_[std::max(ra, rb)] = std::min(ra, rb);
   }
@@ -747,6 +827,17 @@ void World::save(ByteWriter& w) const {
     w.mat(l.point);
     put_vec3s(w, l.force);
   }
+  w.size(s.bonds.size());
+  for (const FreezeBond& fb : s.bonds) {
+    w.pod<int32_t>(fb.body_a);
+    w.pod<int32_t>(fb.body_b);
+    w.mat(fb.anchor_a);
+    w.mat(fb.anchor_b);
+    w.mat(fb.normal_a);
+    w.pod(fb.area_m2);
+    w.mat(fb.impulse_a);
+  }
+  w.pod<int64_t>(s.bonds_broken);
   w.pod(s.speed_error_integral);
   w.pod(s.heading_ref_rad);
   w.vec(s.dp_memory);
@@ -902,6 +993,22 @@ std::unique_ptr<World> World::restore(const Model& base, ByteReader& r) {
                         static_cast<size_t>(l.other) < n && !l.force.empty(),
                     r.what(), ": damaged (a fracture load history names a body that does not exist)");
   }
+  s.bonds.resize(r.size(2 * sizeof(int32_t) + 13 * sizeof(double)));
+  for (FreezeBond& fb : s.bonds) {
+    fb.body_a = r.pod<int32_t>();
+    fb.body_b = r.pod<int32_t>();
+    r.mat(fb.anchor_a);
+    r.mat(fb.anchor_b);
+    r.mat(fb.normal_a);
+    fb.area_m2 = r.pod<double>();
+    r.mat(fb.impulse_a);
+    FLOESIM_REQUIRE(fb.body_a >= 0 && fb.body_a < fb.body_b && static_cast<size_t>(fb.body_b) < n &&
+                        fb.anchor_a.allFinite() && fb.anchor_b.allFinite() && fb.impulse_a.allFinite() &&
+                        std::abs(fb.normal_a.norm() - 1) < 1e-9 && fb.area_m2 > 0 && std::isfinite(fb.area_m2),
+                    r.what(), ": damaged (a freeze bond names a body that does not exist or has no area)");
+  }
+  s.bonds_broken = r.pod<int64_t>();
+  FLOESIM_REQUIRE(s.bonds_broken >= 0, r.what(), ": damaged (a negative count of broken bonds)");
   s.speed_error_integral = r.pod<double>();
   s.heading_ref_rad = r.pod<double>();
   s.dp_memory = r.vec<double>();

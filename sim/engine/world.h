@@ -61,6 +61,8 @@ struct StepReport {
   int awake_floes = 0;
   int fracture_events = 0;   // floes broken in this step
   int floe_bodies = 0;       // floe bodies alive at the end of the step
+  int bonds = 0;             // freeze bonds left at the end of the step
+  int bonds_broken = 0;      // freeze bonds broken in this step
   SolverReport solve, relax;
   // Vessel surge ice load minus the same from the reference of solver.reference (the relax pass converged, twice
   // the sweep caps, the other sweep order or every contact in every sweep: the step solved again, or with
@@ -134,6 +136,15 @@ class World {
   void stage_relax();
   void stage_fracture();
   void stage_sleep();
+  // Whether awake body `toucher` wakes `sleeper` where they touch (`at`, world): always, unless the sleeper is a
+  // ridge's rubble, which only a hull body or a toucher moving there at sleep.linear_mps or faster wakes. Resting
+  // rubble is a dense pile: a touch that does not move would otherwise wake the whole keel, block by block, and keep
+  // it awake beside the hull. A sleeper left asleep holds still in the solve, as a support.
+  bool touch_wakes(int toucher, int sleeper, const Vec3& at) const;
+  // Collide: a solver row for each freeze bond with an awake block (waking the other by touch_wakes).
+  void add_bond_rows();
+  // Relax: removes the bonds whose impulse reached their strength this step.
+  void break_bonds();
   // Sums the contact loads on the vessel (world frame, about its centre of mass) by contact law, and the part from
   // level ice tiles if `level_ice` is given; returns how many contacts touch it.
   int vessel_ice_load(const std::vector<Contact>& contacts, Wrench* rigid, Wrench* compliant,

@@ -20,7 +20,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kCheckpointMagic = "floesim-checkpoint/8\n";
+constexpr const char* kCheckpointMagic = "floesim-checkpoint/9\n";
 constexpr const char* kRecordsMagic = "floesim-checkpoint-records/1\n";
 constexpr size_t kHashChars = 64;  // SHA-256, hex
 

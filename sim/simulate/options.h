@@ -61,6 +61,8 @@ struct SimulateOptions : EngineSettings {
               "more ridges (after those of ridges) along a route at a stated density, their sizes drawn, seeded");
     v.section("ridge_settling", ridge_settling,
               "how the ridges' rubble is settled in still water before the run, and the ridge as built measured");
+    v.section("freeze_bonds", freeze_bonds,
+              "freeze bonds between the ridges' blocks once settled: tensile and shear strength (PHYSICS.md §9.5)");
     for (size_t i = 0; i < structures.size(); ++i)
       for (size_t j = 0; j < i; ++j)
         if (structures[i].name == structures[j].name)

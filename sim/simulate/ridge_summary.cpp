@@ -122,7 +122,7 @@ nlohmann::json structure_in_ridges(const SimulateOptions& o, const SeriesSource&
 }  // namespace
 
 nlohmann::json ridge_summary(const SimulateOptions& o, const Model& model, const RidgeSettling& settled,
-                             const SeriesSource& series) {
+                             const SeriesSource& series, const State& end) {
   nlohmann::json list = nlohmann::json::array();
   const double rho_i = o.ice.density_kg_m3, rho_w = o.water.density_kg_m3;
   const std::vector<RidgeOptions>& ridges = model.settings.ridges;  // the ridge field's among them
@@ -147,6 +147,12 @@ nlohmann::json ridge_summary(const SimulateOptions& o, const Model& model, const
   nlohmann::json out = {{"settling", {{"time_s", settled.time_s}, {"steps", settled.steps},
                                       {"blocks", settled.blocks}}},
                         {"ridges", list}};
+  if (o.freeze_bonds.enabled())
+    out["freeze_bonds"] = {{"tensile_strength_pa", o.freeze_bonds.tensile_strength_pa},
+                           {"shear_strength_pa", o.freeze_bonds.shear_strength_pa},
+                           {"formed", settled.bonds},
+                           {"broken", end.bonds_broken},
+                           {"left_at_end", end.bonds.size()}};
   if (model.vessel >= 0 && o.vessel.station_keeping.held()) out["structure_loads"] = structure_in_ridges(o, series);
   return out;
 }

@@ -165,6 +165,8 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   if (settled.blocks > 0)
     std::cout << "floesim-simulate: " << settled.blocks << " blocks of rubble settled in " << settled.time_s
               << " s (" << settled.steps << " steps, " << settled.wall_s << " s wall)\n";
+  if (settled.bonds > 0)
+    std::cout << "floesim-simulate: " << settled.bonds << " freeze bonds between the settled blocks\n";
 
   std::ostringstream out;
   out << "floesim-simulate: " << model.floe_count() << " floes in " << model.parts.size() << " convex parts ("
@@ -194,7 +196,8 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   // The series before the last checkpoint are read back from its chunks, one at a time.
   const CheckpointSeries series(checkpoints.dir, prov, static_cast<long>(results.series_first_step), results);
   nlohmann::json summary = summarize(o, world->model(), results, series);
-  if (!world->model().settings.ridges.empty()) summary["ridges"] = ridge_summary(o, world->model(), settled, series);
+  if (!world->model().settings.ridges.empty())
+    summary["ridges"] = ridge_summary(o, world->model(), settled, series, world->state());
   summary["settings"] = options_to_json(o);
   summary["provenance"] = prov;
 

@@ -45,7 +45,7 @@ namespace {
 
 constexpr char kSeparator[] = "\n=floesim-fuzz-file=\n";
 constexpr size_t kMaxParts = 8;  // checkpoint.bin and up to 7 chunks
-constexpr char kCheckpointMagic[] = "floesim-checkpoint/8\n";
+constexpr char kCheckpointMagic[] = "floesim-checkpoint/9\n";
 constexpr char kRecordsMagic[] = "floesim-checkpoint-records/1\n";
 constexpr size_t kHashChars = 64;
 

@@ -35,7 +35,7 @@ void seal(const fs::path& p, const std::string& magic, const std::string& payloa
 
 
 const char kRecordsMagic[] = "floesim-checkpoint-records/1\n";
-const char kCheckpointMagic[] = "floesim-checkpoint/8\n";
+const char kCheckpointMagic[] = "floesim-checkpoint/9\n";
 
 // Element `index` of the array `name` in a records chunk set to `value` (of the array's element type T), the chunk
 // re-sealed and checkpoint.bin re-sealed naming its new hash: the hashes all agree and the array sizes still add up.

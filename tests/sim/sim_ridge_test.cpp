@@ -416,6 +416,8 @@ TEST(RidgeSettling, SettlingIsBitIdenticalOnAnyThreadCount) {
   r.block_thickness_m = 0.25;
   r.block_size_m = {0.5, 0.8};
   o.ridges = {r};
+  o.freeze_bonds.tensile_strength_pa = 2e3;  // frozen once settled, and stepped with the run
+  o.freeze_bonds.shear_strength_pa = 1e3;
   auto settled = [&](int threads) {
     SimulateOptions t = o;
     t.threads = threads;
@@ -426,8 +428,13 @@ TEST(RidgeSettling, SettlingIsBitIdenticalOnAnyThreadCount) {
     return std::make_pair(s, w.state());
   };
   const auto one = settled(1), two = settled(2);
-  std::printf("[measured] %d blocks settled in %.2f s\n", one.first.blocks, one.first.time_s);
+  std::printf("[measured] %d blocks settled in %.2f s, %d freeze bonds, %zu left after 1 s\n", one.first.blocks,
+              one.first.time_s, one.first.bonds, one.second.bonds.size());
   EXPECT_GT(one.first.blocks, 20);
+  EXPECT_GT(one.first.bonds, one.first.blocks / 2);  // most blocks touch two others or more
+  EXPECT_EQ(one.first.bonds, two.first.bonds);
+  EXPECT_EQ(one.second.bonds.size(), two.second.bonds.size());
+  EXPECT_EQ(one.second.bonds_broken, two.second.bonds_broken);
   EXPECT_EQ(one.first.steps, two.first.steps);
   ASSERT_EQ(one.second.position.size(), two.second.position.size());
   for (size_t b = 0; b < one.second.position.size(); ++b) {
@@ -435,6 +442,78 @@ TEST(RidgeSettling, SettlingIsBitIdenticalOnAnyThreadCount) {
     EXPECT_EQ(one.second.orientation[b].coeffs(), two.second.orientation[b].coeffs()) << "body " << b;
   }
   EXPECT_EQ(one.first.ridges[0].porosity_by_voxels, two.first.ridges[0].porosity_by_voxels);
+}
+
+// Two 1 x 1 x 0.5 m blocks of rubble floating side by side, touching over the face x = 0 (1 m x 0.5 m), frozen
+// together where they touch (freeze_touching), then pulled by opposite forces at their centres: `dir` x (apart) or y
+// (in shear), F each, for 100 steps. Returns the bonds left and how far the blocks moved apart along dir.
+struct PullResult {
+  size_t bonds_before = 0, bonds_after = 0;
+  double area_m2 = 0, moved_m = 0;
+};
+PullResult pull_bonded_pair(const Vec3& dir, double force_n, double tensile_pa, double shear_pa) {
+  SimulateOptions o = testing::floe_options();
+  o.fracture.min_piece_area_m2 = 2;  // 1 m^2 blocks are brash: rigid contacts, as rubble
+  o.freeze_bonds.tensile_strength_pa = tensile_pa;
+  o.freeze_bonds.shear_strength_pa = shear_pa;
+  FloeField field;
+  field.floes.push_back(testing::rect_floe(1, -1, -0.5, 1, 1, 0.5));
+  field.floes.push_back(testing::rect_floe(2, -0.005, -0.5, 1, 1, 0.5));  // 5 mm into the first: touching
+  World w(build_model(field, nullptr, o));
+  const int a = 0, b = 1;
+  EXPECT_TRUE(w.model().bodies[a].brash && w.model().bodies[b].brash);
+  const State before = w.state();
+  w.step();
+  PullResult r;
+  w.mutable_state().bonds =
+      freeze_touching(w.model(), before, w.contacts(), std::vector<uint8_t>(2, 1), o.freeze_bonds);
+  r.bonds_before = w.state().bonds.size();
+  for (const FreezeBond& fb : w.state().bonds) r.area_m2 += fb.area_m2;
+  const double x0 = dir.dot(w.state().position[b] - w.state().position[a]), dt = o.time_step_s;
+  // The forces act at the bond's point (on the line of the face), so that they make no couple.
+  const FreezeBond bond = w.state().bonds.at(0);
+  auto push = [&](int body, const Vec3& f) {
+    State& s = w.mutable_state();
+    const Vec3 arm = s.orientation[body] * (body == bond.body_a ? bond.anchor_a : bond.anchor_b);
+    const Mat3 R = s.orientation[body].toRotationMatrix();
+    const Body& bd = w.model().bodies[body];
+    s.velocity[body] += f * dt / bd.mass_kg;
+    s.angular_velocity[body] += R * bd.inv_inertia_added * R.transpose() * arm.cross(f) * dt;
+  };
+  for (int k = 0; k < 100; ++k) {
+    push(a, -force_n * dir);
+    push(b, force_n * dir);
+    w.step();
+  }
+  r.bonds_after = w.state().bonds.size();
+  r.moved_m = dir.dot(w.state().position[b] - w.state().position[a]) - x0;
+  return r;
+}
+
+TEST(FreezeBonds, TwoBlocksHoldBelowTheirStrengthAndBreakAboveIt) {
+  const double sigma_t = 20e3, tau = 10e3;  // Pa
+  // By hand: the face they froze over is 1 m x 0.5 m; in tension it holds sigma_t A = 10 kN, in shear tau A = 5 kN
+  // (sheared, their forces' couple is taken by the bond's tension and the contact's compression at the face's end).
+  const double area = 0.5;
+  const Vec3 apart = Vec3::UnitX(), along = Vec3::UnitY();
+  const PullResult hold_t = pull_bonded_pair(apart, 0.9 * sigma_t * area, sigma_t, 10 * tau);
+  const PullResult break_t = pull_bonded_pair(apart, 1.1 * sigma_t * area, sigma_t, 10 * tau);
+  const PullResult hold_s = pull_bonded_pair(along, 0.9 * tau * area, 10 * sigma_t, tau);
+  const PullResult break_s = pull_bonded_pair(along, 1.1 * tau * area, 10 * sigma_t, tau);
+  std::printf("[measured] %zu bonds over %.4f m^2; in tension at 0.9 / 1.1 of sigma_t A: %zu / %zu bonds left, moved "
+              "%.2e / %.3f m; in shear at 0.9 / 1.1 of tau A: %zu / %zu left, moved %.2e / %.3f m\n",
+              hold_t.bonds_before, hold_t.area_m2, hold_t.bonds_after, break_t.bonds_after, hold_t.moved_m,
+              break_t.moved_m, hold_s.bonds_after, break_s.bonds_after, hold_s.moved_m, break_s.moved_m);
+  EXPECT_EQ(hold_t.bonds_before, 1u);  // one bond for the pair
+  EXPECT_NEAR(hold_t.area_m2, area, 1e-6);
+  for (const PullResult* r : {&hold_t, &hold_s}) {
+    EXPECT_EQ(r->bonds_after, r->bonds_before);
+    EXPECT_LT(std::abs(r->moved_m), 0.005);  // within break_opening_m: held
+  }
+  for (const PullResult* r : {&break_t, &break_s}) {
+    EXPECT_EQ(r->bonds_after, 0u);
+    EXPECT_GT(r->moved_m, 0.05);  // free: F / m t^2 / 2 = 0.3 m less the water's drag
+  }
 }
 
 TEST(RidgeSection, BadInputNamesTheKey) {
@@ -455,6 +534,9 @@ TEST(RidgeSection, BadInputNamesTheKey) {
                {"line", "two points"});
   expect_error([&] { read_options<RidgeOptions>({{"line", line}, {"keel_draught_m", 6}}, "ridge.json"); },
                {"keel_draught_m"});
+  // Freeze bonds with one strength but not the other.
+  expect_error([&] { read_options<FreezeBondOptions>({{"tensile_strength_pa", 1e4}}, "case.json"); },
+               {"case.json", "shear_strength_pa", "both"});
   // A ridge running off the sheet's edge (its layer half on the sheet): named, with the fix.
   SimulateOptions o = testing::floe_options();
   o.level_ice.extent_m = {-40, -10, 40, 10};
