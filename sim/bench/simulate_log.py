@@ -5,7 +5,8 @@ import re
 PROGRESS = re.compile(r't = ([0-9.]+) s\s+\(\s*([0-9]+) %, ([0-9.]+) s wall, awake floes ([0-9]+), contacts ([0-9]+)\)')
 TOTAL = re.compile(r'steps ([0-9]+), wall ([0-9.]+) s, ([0-9.]+) ms/step, ([0-9.]+) simulated s per wall s')
 PEAK = re.compile(r'^peak memory ([0-9.]+) MB$', re.MULTILINE)
-AWAKE = re.compile(r'^mean awake floes ([0-9.]+),', re.MULTILINE)
+AWAKE = re.compile(r'^mean awake floes ([0-9.]+)[ ,]', re.MULTILINE)
+AWAKE_RUBBLE = re.compile(r'^mean awake floes [0-9.]+ \(of them, blocks of rubble ([0-9.]+)\)', re.MULTILINE)
 
 
 def progress(text):
@@ -30,3 +31,9 @@ def mean_awake_floes(text):
     summary's mean_awake_floes is over the steady part only)."""
     m = AWAKE.search(text)
     return float(m.group(1)) if m else None
+
+
+def mean_awake_rubble(text):
+    """Of the mean awake floes, the blocks of ridges' rubble; 0 when the run reports none."""
+    m = AWAKE_RUBBLE.search(text)
+    return float(m.group(1)) if m else 0.0

@@ -260,7 +260,7 @@ RidgeSettling settle_ridges(const FloeField& field, Model& model, std::ostream* 
                 << w.report().awake_floes << std::defaultfloat << std::endl;
   }
   // 3. Freeze bonds: the blocks woken for one more step, so that every pair that touches is found (a pair of
-  // sleepers is not looked at), and frozen at the poses that step found them in.
+  // sleepers is not looked at), and frozen at the poses that step found them in, to each other and to the layer.
   std::vector<FreezeBond> bonds;
   if (o.freeze_bonds.enabled()) {
     for (int b : rubble) w.wake(b);
@@ -268,7 +268,7 @@ RidgeSettling settle_ridges(const FloeField& field, Model& model, std::ostream* 
     w.step();
     ++out.steps;
     std::vector<uint8_t> freezes(m.bodies.size(), 0);
-    for (int b : rubble) freezes[b] = 1;
+    for (size_t b = 0; b < m.bodies.size(); ++b) freezes[b] = m.bodies[b].ridge_part != RidgePart::none;
     bonds = freeze_touching(m, before, w.contacts(), freezes, o.freeze_bonds);
   }
   out.time_s = w.state().time_s;
@@ -289,9 +289,12 @@ RidgeSettling settle_ridges(const FloeField& field, Model& model, std::ostream* 
     target.start_awake = false;
   }
   model.initial_bonds.clear();
+  std::map<int, int> ridge_index_of;  // the layers' bodies too
+  for (size_t b = 0; b < model.bodies.size(); ++b)
+    if (model.bodies[b].ridge_part != RidgePart::none) ridge_index_of[model.bodies[b].id] = static_cast<int>(b);
   for (FreezeBond fb : bonds) {
-    fb.body_a = index_of.at(m.bodies[fb.body_a].id);
-    fb.body_b = index_of.at(m.bodies[fb.body_b].id);
+    fb.body_a = ridge_index_of.at(m.bodies[fb.body_a].id);
+    fb.body_b = ridge_index_of.at(m.bodies[fb.body_b].id);
     if (fb.body_a > fb.body_b) {
       std::swap(fb.body_a, fb.body_b);
       std::swap(fb.anchor_a, fb.anchor_b);

@@ -64,7 +64,8 @@ struct RidgeSettling {
 // case's current and wind act from the run's start). It steps until every block has been at rest for rest_time_s
 // (a block touching nothing counts by its heave and turning alone: one that came out from under the ice drifts on),
 // then gives `model`'s blocks their settled poses (matched by id) and lets them start asleep, freezes the blocks
-// that touch together (settings.freeze_bonds: Model::initial_bonds) and measures each ridge. Throws floesim::Error naming ridge_settling.max_s when the rubble is not at rest by then. `progress`: a
+// that touch together and to their consolidated layer (settings.freeze_bonds: Model::initial_bonds) and measures
+// each ridge. Throws floesim::Error naming ridge_settling.max_s when the rubble is not at rest by then. `progress`: a
 // line every 10 s of settling (null: none). Deterministic: the same inputs and threads give the same poses.
 RidgeSettling settle_ridges(const FloeField& field, Model& model, std::ostream* progress);
 

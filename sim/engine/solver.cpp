@@ -119,6 +119,9 @@ inline void apply(State& s, const SolverBodies& sb, const Contact& c, const Vec3
 // A body the contact impulses cannot move (zero inverse mass and inertia: a domain wall).
 bool is_fixed(const SolverBodies& sb, int b) { return sb.inv_mass[b].isZero(0) && sb.inv_inertia_world[b].isZero(0); }
 
+// A body asleep (a state without awake flags, as a solver test's, has every body awake).
+bool asleep(const State& s, int b) { return static_cast<size_t>(b) < s.awake.size() && !s.awake[b]; }
+
 // Relative velocity of b with respect to a at the contact, and its component along d.
 inline Vec3 rel_velocity(const State& s, const Contact& c) {
   const Vec3 va = s.velocity[c.body_a] + s.angular_velocity[c.body_a].cross(c.ra);
@@ -210,8 +213,8 @@ ContactIslands prepare_contacts(const Model& model, const SolverBodies& sb, Stat
     c.rb = c.point - state.position[c.body_b];
     // Fixed: a wall, a tile of level ice, or a body asleep in a contact with an awake one (rubble the touch left at
     // rest, World::touch_wakes): the impulses do not move them.
-    c.fixed_a = is_fixed(sb, c.body_a) || !state.awake[c.body_a];
-    c.fixed_b = is_fixed(sb, c.body_b) || !state.awake[c.body_b];
+    c.fixed_a = is_fixed(sb, c.body_a) || asleep(state, c.body_a);
+    c.fixed_b = is_fixed(sb, c.body_b) || asleep(state, c.body_b);
     tangents(c.normal, c.t1, c.t2);
     const Mat3& Ia = sb.inv_inertia_world[c.body_a];
     const Mat3& Ib = sb.inv_inertia_world[c.body_b];

@@ -59,6 +59,7 @@ struct StructureReport {
 struct StepReport {
   int contacts = 0, vessel_contacts = 0;
   int awake_floes = 0;
+  int awake_rubble = 0;      // of them, blocks of ridges' rubble (keels and sails)
   int fracture_events = 0;   // floes broken in this step
   int floe_bodies = 0;       // floe bodies alive at the end of the step
   int bonds = 0;             // freeze bonds left at the end of the step

@@ -319,6 +319,7 @@ void Recorder::record_step(const World& w, long k) {
   record_structures(w);
   // 2. The run's sums.
   sums_.awake += rep.awake_floes;
+  sums_.awake_rubble += rep.awake_rubble;
   sums_.contacts += rep.contacts;
   sums_.iterations += rep.solve.iterations;
   sums_.pairs += w.collision_stats().broadphase_pairs;

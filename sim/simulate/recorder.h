@@ -16,7 +16,7 @@ namespace floesim::sim {
 
 // Sums over the steps for the run's statistics (RunStats), carried in checkpoints.
 struct RecorderSums {
-  double awake = 0, contacts = 0, iterations = 0, pairs = 0, touching = 0, edges = 0, crushing = 0;
+  double awake = 0, awake_rubble = 0, contacts = 0, iterations = 0, pairs = 0, touching = 0, edges = 0, crushing = 0;
   double record_s = 0;  // wall time of the recording, s
   double wall_s = 0;    // wall time of the steps before this process's first, s
 };

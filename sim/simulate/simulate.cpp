@@ -52,6 +52,7 @@ void fill_run_stats(const World& w, const RecorderSums& sums, long steps, double
   stats.stage_s[kStageCount] = sums.record_s;
   stats.steps = steps;
   stats.mean_awake_floes = sums.awake / steps;
+  stats.mean_awake_rubble = sums.awake_rubble / steps;
   stats.mean_contacts = sums.contacts / steps;
   stats.mean_iterations = sums.iterations / steps;
   stats.mean_pairs = sums.pairs / steps;
@@ -218,7 +219,9 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   if (stats.checkpoints > 0)
     rep << stats.checkpoints << " checkpoints written (every " << o.checkpoint_interval_s << " s of simulated time), "
         << 1e3 * stats.checkpoint_s / stats.checkpoints << " ms each on average\n";
-  rep << "mean awake floes " << stats.mean_awake_floes << ", mean contacts " << stats.mean_contacts
+  rep << "mean awake floes " << stats.mean_awake_floes;
+  if (stats.mean_awake_rubble > 0) rep << " (of them, blocks of rubble " << stats.mean_awake_rubble << ")";
+  rep << ", mean contacts " << stats.mean_contacts
       << ", mean solver sweeps " << stats.mean_iterations << "\n";
   rep << "mean part pairs per step: " << stats.mean_pairs << " from the broad phase, " << stats.mean_touching
       << " touching (" << stats.mean_edge_pairs << " edge-on-edge, single point; " << stats.mean_crushing_pairs

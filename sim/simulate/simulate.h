@@ -22,6 +22,7 @@ struct RunStats {
   double wall_s = 0;
   double stage_s[8] = {};     // per World stage, then the recorder
   double mean_awake_floes = 0, mean_contacts = 0, mean_iterations = 0;
+  double mean_awake_rubble = 0;  // of the awake floes, blocks of ridges' rubble
   double mean_pairs = 0, mean_touching = 0, mean_edge_pairs = 0;  // broad-phase pairs, touching pairs, edge ones
   double mean_crushing_pairs = 0;  // touching pairs with a compliant (crushing) contact
   long steps = 0;

@@ -2,7 +2,8 @@
 // and by its physics (a freely floating layer, sides at the keel angle); the keel's macro-porosity measured two ways
 // (the blocks' volumes, the envelope's voxels) on arrangements of known solid volume; the blocks released for
 // settling (the ice they carry, none overlapping, keel under and sail over the layer, the same for the same seed);
-// bad input named by its key; a block released under the layer rising to rest against it.
+// bad input named by its key; a block released under the layer rising to rest against it; settling a keel, a free
+// ridge's hydrostatics; freeze bonds holding and breaking at their strength; the punch rig's buoyant plug.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,6 +15,7 @@
 #include "pipeline/options.h"
 #include "sim/engine/ridge.h"
 #include "sim/engine/ridge_build.h"
+#include "sim/engine/ridge_punch.h"
 #include "tests/sim/sim_fixtures.h"
 
 namespace floesim::sim {
@@ -514,6 +516,29 @@ TEST(FreezeBonds, TwoBlocksHoldBelowTheirStrengthAndBreakAboveIt) {
     EXPECT_EQ(r->bonds_after, 0u);
     EXPECT_GT(r->moved_m, 0.05);  // free: F / m t^2 / 2 = 0.3 m less the water's drag
   }
+}
+
+// The punch rig of sim/bench/ridge-punch on a shallow keel: at rest, the rubble's net buoyancy (rho_w - rho_i) g V of
+// its blocks is held down by the punch, the sheet and the walls together (its balance at rest: what the punch
+// carries of it depends on how the column under it leans on its neighbours); pushed down, the plug's sides resist
+// and the punch's load rises above what it carried at rest.
+TEST(RidgePunch, TheRubbleIsHeldAtRestAndThePlugResists) {
+  PunchSpec p;
+  p.keel_depth_m = 2.0;
+  p.travel_m = 0.1;
+  p.rest_s = 1.0;
+  p.window_s = 0.2;
+  const PunchResult r = punch_test(p, nullptr);
+  std::printf("[measured] punch on a %d-block keel %.2f m under the sheet (porosity %.3f): held down with %.1f kN "
+              "against its net buoyancy %.1f kN; the punch's share F_0 %.1f kN (a free column: %.1f kN); peak "
+              "%.1f kN at %.3f m, tau %.0f Pa\n",
+              r.blocks, r.plug_height_m, r.porosity, r.held_down_n / 1e3, r.rubble_buoyancy_n / 1e3, r.f0_n / 1e3,
+              r.f0_by_hand_n / 1e3, r.fpeak_n / 1e3, r.peak_at_m, r.tau_pa);
+  EXPECT_GT(r.blocks, 100);
+  EXPECT_NEAR(r.held_down_n, r.rubble_buoyancy_n, 0.01 * r.rubble_buoyancy_n);
+  EXPECT_GT(r.f0_n, 0);
+  EXPECT_GT(r.fpeak_n, 1.2 * r.f0_n);
+  EXPECT_GT(r.tau_pa, 0);
 }
 
 TEST(RidgeSection, BadInputNamesTheKey) {
