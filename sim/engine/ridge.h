@@ -159,14 +159,14 @@ struct RidgeSettlingOptions {
 
 // Freeze bonds between the ridges' blocks (PHYSICS.md §9.5, issue #36 item 2): once the rubble has settled, every
 // pair of blocks that touch freezes together, and every block touching its consolidated layer freezes to it (a bond
-// to a tile of the layer holds until the tile breaks), one bond at the middle of their contact over its area (the polygon of
-// its points, at least min_area_m2: blocks that meet at an edge or a corner freeze over that). One bond per pair, not
-// one per contact point: between rigid blocks the points' shares of a load are not determined (any shares that
-// balance will do), and the contact solver's would break a pair point by point below its strength. A bond pulls in
-// tension with at most tensile_strength_pa and in shear with at most shear_strength_pa over its area, and pushes
-// without limit; it takes no moment (the pair's contact points do, in compression). Loaded beyond its strength it
-// cannot hold its two points together: once they have parted (opened or slid) by break_opening_m it has broken, for
-// good. Off while both strengths are 0.
+// to a tile of the layer holds until the tile breaks), one bond at the middle of their contact over its area (the
+// polygon of its points, at least min_area_m2: blocks that meet at an edge or a corner freeze over that). One bond
+// per pair, not one per contact point: between rigid blocks the points' shares of a load are not determined (any
+// shares that balance will do), and the contact solver's would break a pair point by point below its strength. A
+// bond pulls in tension with at most tensile_strength_pa and in shear with at most shear_strength_pa over its area,
+// and pushes without limit; it takes no moment (the pair's contact points do, in compression). Loaded beyond its
+// strength it cannot hold its two points together: once they have parted (opened or slid) by break_opening_m it has
+// broken, for good. Off while both strengths are 0.
 struct FreezeBondOptions {
   double tensile_strength_pa = 0;
   double shear_strength_pa = 0;

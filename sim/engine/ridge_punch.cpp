@@ -74,8 +74,8 @@ PunchResult punch_test(const PunchSpec& p, std::ostream* progress) {
   Model m = build_model(FloeField{}, &hull, o);
   const RidgeSettling settled = settle_ridges(FloeField{}, m, nullptr);
   const RidgeBuilt& built = settled.ridges.at(0);
-  // The sheet's middle tile leaves the rig (moved far off: a fixed body, it never comes back), and the rubble's bonds to
-  // it with it (the punch is not frozen to the plug: it pushes).
+  // The sheet's middle tile leaves the rig (moved far off: a fixed body, it never comes back), and the rubble's bonds
+  // to it with it (the punch is not frozen to the plug: it pushes).
   std::vector<int> taken;
   for (size_t b = 0; b < m.bodies.size(); ++b) {
     Body& body = m.bodies[b];

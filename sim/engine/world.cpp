@@ -650,8 +650,10 @@ void World::stage_sleep() {
   if (!std::isfinite(report_.solve.residual) || !std::isfinite(report_.relax.residual))
     fail(-1, "the contact solver diverged (residual is not finite)");
   report_.awake_floes = static_cast<int>(awake_list_.size()) - model_.hull_count();
-  for (int b : awake_list_)
-    report_.awake_rubble += model_.bodies[b].ridge_part == RidgePart::keel || model_.bodies[b].ridge_part == RidgePart::sail;
+  for (int b : awake_list_) {
+    const RidgePart part = model_.bodies[b].ridge_part;
+    report_.awake_rubble += part == RidgePart::keel || part == RidgePart::sail;
+  }
   report_.floe_bodies = floes_alive_;
   for (int b : awake_list_) {
     if (!state_.alive[b]) continue;  // broke up in this step
