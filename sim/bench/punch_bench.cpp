@@ -5,9 +5,10 @@
 //   punch_bench --keel-depth 3 [--tensile-pa 0] [--shear-pa 0] [--speed 0.05] [--travel 1.5] [--rest 2]
 //               [--window 0.5] [--threads 2] [--seed 1]
 //
-// It prints the keel as built, F_0 against the plug's net buoyancy by hand, the load's peak, and last a line
+// It prints the keel as built, F_0 against the plug's net buoyancy by hand, the load's peak and residual, and last a
+// line
 //   punch keel_depth <m> plug_height <m> porosity <-> gamma_e <N/m^3> f0 <N> f0_by_hand <N> fpeak <N> at <m> tau <Pa>
-//   bonds <formed> <broken>
+//   bonds <formed> <broken> tau_residual <Pa>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
@@ -51,10 +52,12 @@ int main(int argc, char** argv) {
                 "shear stress on the plug's sides %.0f Pa; mean vertical stress there gamma_e h_p / 2 = %.0f Pa\n",
                 r.f0_n / 1e3, r.f0_by_hand_n / 1e3, r.fpeak_n / 1e3, r.peak_at_m, r.tau_pa,
                 r.gamma_e * r.plug_height_m / 2);
+    std::printf("residual load over the push's last third %.1f kN: %.0f Pa on the plug's sides\n", r.fresidual_n / 1e3,
+                r.tau_residual_pa);
     std::printf("punch keel_depth %.3f plug_height %.4f porosity %.4f gamma_e %.2f f0 %.1f f0_by_hand %.1f fpeak %.1f "
-                "at %.4f tau %.2f bonds %d %ld\n",
+                "at %.4f tau %.2f bonds %d %ld tau_residual %.2f\n",
                 p.keel_depth_m, r.plug_height_m, r.porosity, r.gamma_e, r.f0_n, r.f0_by_hand_n, r.fpeak_n,
-                r.peak_at_m, r.tau_pa, r.bonds, r.bonds_broken);
+                r.peak_at_m, r.tau_pa, r.bonds, r.bonds_broken, r.tau_residual_pa);
     return 0;
   } catch (const Error& e) {
     std::fprintf(stderr, "punch_bench: %s\n", e.what());

@@ -115,7 +115,8 @@ PunchResult punch_test(const PunchSpec& p, std::ostream* progress) {
   const long rest_steps = std::lround(p.rest_s / dt), push_steps = std::lround(p.travel_m / p.speed_mps / dt);
   const long window = std::max(1L, std::lround(p.window_s / dt)), second = std::max(1L, std::lround(1.0 / dt));
   std::deque<double> recent;
-  double sum = 0;
+  double sum = 0, residual_sum = 0;
+  long residual_steps = 0;
   r.fpeak_n = -1e300;
   for (long k = 0; k < rest_steps + push_steps; ++k) {
     const bool pushing = k >= rest_steps;
@@ -136,6 +137,7 @@ PunchResult punch_test(const PunchSpec& p, std::ostream* progress) {
         if (holds_b && !holds_a) r.held_down_n += p.z();
       }
     }
+    if (pushing && 3 * (k - rest_steps) >= 2 * push_steps) residual_sum += fz, ++residual_steps;
     if (pushing && k - rest_steps + 1 >= window && mean > r.fpeak_n) {  // windows of the push alone
       r.fpeak_n = mean;
       r.peak_at_m = (k + 1 - rest_steps) * dt * p.speed_mps;
@@ -148,6 +150,8 @@ PunchResult punch_test(const PunchSpec& p, std::ostream* progress) {
   r.bonds_broken = w.state().bonds_broken;
   r.f0_by_hand_n = r.gamma_e * kPunch * kPunch * r.plug_height_m;
   r.tau_pa = (r.fpeak_n - r.f0_n) / (4 * kPunch * r.plug_height_m);
+  r.fresidual_n = residual_steps > 0 ? residual_sum / static_cast<double>(residual_steps) : r.f0_n;
+  r.tau_residual_pa = (r.fresidual_n - r.f0_n) / (4 * kPunch * r.plug_height_m);
   return r;
 }
 

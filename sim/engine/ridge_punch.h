@@ -37,6 +37,9 @@ struct PunchResult {
   double rubble_buoyancy_n = 0, held_down_n = 0;
   double fpeak_n = 0, peak_at_m = 0;
   double tau_pa = 0;               // (F_p - F_0) / (4 a h_p)
+  // The residual: the mean load over the last third of the push, once the plug slides (its bonds broken), and the
+  // same as a shear stress on the plug's sides, (F_r - F_0) / (4 a h_p).
+  double fresidual_n = 0, tau_residual_pa = 0;
 };
 
 // Builds the keel and punches it; `progress` (null: none) gets a line per simulated second. Throws floesim::Error
