@@ -88,6 +88,9 @@ struct FreezeBond {
   double area_m2 = 0;
   Vec3 impulse_a = Vec3::Zero();
 };
+inline bool bond_pair_less(const FreezeBond& x, const FreezeBond& y) {
+  return x.body_a != y.body_a ? x.body_a < y.body_a : x.body_b < y.body_b;
+}
 
 // The part pairs of a body pair whose vector areas point within this cosine (26 deg) of each other press in one
 // direction and make one crushing contact (collide); the warm start takes a crushing row's predecessor from the
@@ -131,7 +134,7 @@ struct State {
                                           // (heave_radiation_force); 0 while asleep, a piece takes its parent's
   std::vector<CachedContact> contact_cache;  // sorted by (body_a, body_b, part_a, part_b)
   std::vector<PairLoadHistory> pair_loads;   // the fracture stage's, sorted by (floe, other), then as made
-  std::vector<FreezeBond> bonds;             // the freeze bonds not yet broken, in the order they froze
+  std::vector<FreezeBond> bonds;             // the freeze bonds not yet broken, sorted by (body_a, body_b)
   long bonds_broken = 0;                     // freeze bonds broken since the start
   // Vessel controllers.
   double speed_error_integral = 0;      // m, integral of the speed error (PI thrust controller)

@@ -110,6 +110,7 @@ World::World(Model built) : model_(std::move(built)), pool_(model_.settings.thre
                         fb.area_m2 > 0,
                     "internal: a freeze bond between bodies ", fb.body_a, " and ", fb.body_b, " of ", n);
   state_.bonds = model.initial_bonds;
+  std::stable_sort(state_.bonds.begin(), state_.bonds.end(), bond_pair_less);  // State::bonds' order
   // Inverse mass matrices (world) as the solver sees them; the forces stage refreshes those of awake bodies.
   solver_bodies_.inv_mass.assign(n, Mat3::Zero());
   solver_bodies_.inv_inertia_world.assign(n, Mat3::Zero());
@@ -232,11 +233,13 @@ void World::add_bond_rows() {
   if (state_.bonds.empty()) return;
   // Blocks frozen together are held where they froze, their overlap of then included: their contacts do not push
   // them apart (which only the bond would resist, until it broke), they only keep them from closing further.
-  std::vector<std::pair<int, int>> bonded;
-  for (const FreezeBond& fb : state_.bonds) bonded.emplace_back(fb.body_a, fb.body_b);
-  std::sort(bonded.begin(), bonded.end());
-  for (Contact& c : contacts_)
-    if (c.gap < 0 && std::binary_search(bonded.begin(), bonded.end(), std::make_pair(c.body_a, c.body_b))) c.gap = 0;
+  for (Contact& c : contacts_) {
+    if (c.gap >= 0) continue;
+    FreezeBond key;
+    key.body_a = c.body_a;
+    key.body_b = c.body_b;
+    if (std::binary_search(state_.bonds.begin(), state_.bonds.end(), key, bond_pair_less)) c.gap = 0;
+  }
   for (size_t k = 0; k < state_.bonds.size(); ++k) {
     const FreezeBond& fb = state_.bonds[k];
     const int a = fb.body_a, b = fb.body_b;
