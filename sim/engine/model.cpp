@@ -1074,24 +1074,15 @@ void add_ridge_blocks(int next_id, const std::vector<Polygon>& footprint, const 
     const std::string where = "ridges[" + std::to_string(i) + "]";
     const RidgeSection section = ridge_section(r, o.ice.density_kg_m3, o.water.density_kg_m3, where);
     for (const RidgeBlock& k : release_blocks(r, section)) {
-      const double c = std::cos(k.yaw_rad), s = std::sin(k.yaw_rad), hx = 0.5 * k.size_x, hy = 0.5 * k.size_y;
-      Polygon local;
-      for (const Vec2& corner : {Vec2(-hx, -hy), Vec2(hx, -hy), Vec2(hx, hy), Vec2(-hx, hy)})
-        local.emplace_back(c * corner.x() - s * corner.y(), s * corner.x() + c * corner.y());
       Polygon world;
-      for (const Vec2& v : local) world.push_back(v + k.centre);
+      for (const Vec2& v : rubble_block_outline(k)) world.push_back(v + k.centre);
       for (const Polygon& fp : footprint)
         FLOESIM_REQUIRE(convex_intersection_area(fp, world) <= 1e-9, where, ": a block of its rubble at (",
                         k.centre.x(), ", ", k.centre.y(), ") m lies under the vessel's start (vessel.x_m, "
                         "vessel.y_m): start the vessel clear of the ridge");
-      Body b = make_floe_body(local, k.thickness, next_id++, static_cast<int>(model.bodies.size()), k.centre, o,
-                              model.parts);
-      b.initial_position.z() = k.z;
-      b.brash = true;  // p_c h x the plan width 4 A / perimeter, as make_floe_body's brash
-      b.brash_crush_force_n = o.ice.crushing_strength_pa * k.thickness * 4 * signed_area(local) / perimeter_m(local);
+      Body b = make_rubble_block(k, next_id++, static_cast<int>(model.bodies.size()), o, model.parts);
       b.ridge = static_cast<int>(i);
       b.ridge_part = k.keel ? RidgePart::keel : RidgePart::sail;
-      b.start_awake = true;
       model.bodies.push_back(std::move(b));
     }
   }
@@ -1175,6 +1166,25 @@ void add_walls(const FloeField& field, bool has_vessel, const std::vector<Polygo
 }
 
 }  // namespace
+
+Polygon rubble_block_outline(const RidgeBlock& k) {
+  const double c = std::cos(k.yaw_rad), s = std::sin(k.yaw_rad), hx = 0.5 * k.size_x, hy = 0.5 * k.size_y;
+  Polygon local;
+  for (const Vec2& corner : {Vec2(-hx, -hy), Vec2(hx, -hy), Vec2(hx, hy), Vec2(-hx, hy)})
+    local.emplace_back(c * corner.x() - s * corner.y(), s * corner.x() + c * corner.y());
+  return local;
+}
+
+Body make_rubble_block(const RidgeBlock& k, int id, int body_index, const EngineSettings& o,
+                       std::vector<ConvexPart>& parts) {
+  const Polygon local = rubble_block_outline(k);
+  Body b = make_floe_body(local, k.thickness, id, body_index, k.centre, o, parts);
+  b.initial_position.z() = k.z;
+  b.brash = true;  // p_c h x the plan width 4 A / perimeter, as make_floe_body's brash
+  b.brash_crush_force_n = o.ice.crushing_strength_pa * k.thickness * 4 * signed_area(local) / perimeter_m(local);
+  b.start_awake = true;
+  return b;
+}
 
 Model build_model(const FloeField& field, const HullModel* hull, const EngineSettings& o,
                   const std::vector<HullModel>& structures) {

@@ -231,6 +231,14 @@ Ittc57 ittc57_of(const VesselParticulars& v, const VesselOptions& vo, const Engi
 Body make_floe_body(const Polygon& outline, double thickness_m, int id, int body_index, const Vec2& centre,
                     const EngineSettings& o, std::vector<ConvexPart>& parts);
 
+// A block of rubble as released (sim/engine/ridge.h) as a body: a floe body of the block's box, where it was released
+// (under water or over the ice, out of equilibrium: it starts awake), brash (rigid contacts, its crushing force p_c h
+// times its plan width 4 A / perimeter as their ceiling, never broken). Its outline in its body frame is
+// rubble_block_outline's.
+Body make_rubble_block(const RidgeBlock& k, int id, int body_index, const EngineSettings& o,
+                       std::vector<ConvexPart>& parts);
+Polygon rubble_block_outline(const RidgeBlock& k);
+
 // Whether a floe's outline is brash rather than a plate: smaller than min_area_m2, or narrower than the ice is thick
 // (plan width 4 A / perimeter below h: a block, whose tiny inertia about its long axis the crushing rows of a plate
 // would only destabilise).

@@ -3,7 +3,8 @@
 // (the blocks' volumes, the envelope's voxels) on arrangements of known solid volume; the blocks released for
 // settling (the ice they carry, none overlapping, keel under and sail over the layer, the same for the same seed);
 // bad input named by its key; a block released under the layer rising to rest against it; settling a keel, a free
-// ridge's hydrostatics; freeze bonds holding and breaking at their strength; the punch rig's buoyant plug.
+// ridge's hydrostatics; freeze bonds holding and breaking at their strength; the punch rig's buoyant plug; the shear
+// box's balance at rest.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -16,6 +17,7 @@
 #include "sim/engine/ridge.h"
 #include "sim/engine/ridge_build.h"
 #include "sim/engine/ridge_punch.h"
+#include "sim/engine/ridge_shear_box.h"
 #include "tests/sim/sim_fixtures.h"
 
 namespace floesim::sim {
@@ -539,6 +541,41 @@ TEST(RidgePunch, TheRubbleIsHeldAtRestAndThePlugResists) {
   EXPECT_GT(r.f0_n, 0);
   EXPECT_GT(r.fpeak_n, 1.2 * r.f0_n);
   EXPECT_GT(r.tau_pa, 0);
+}
+
+// The shear box of sim/bench/ridge-shear-box, small: consolidated and at rest, the rubble's net buoyancy
+// (rho_w - rho_i) g V of its blocks and the loading plate's push are held by the top frame (its balance at rest);
+// sheared, the rubble resists with more than the blocks' own friction
+// (a granular assembly's friction angle is never below its grains' contact friction, atan 0.15 = 8.5 deg here).
+TEST(ShearBox, TheSampleIsHeldAtRestAndResistsMoreThanItsBlocksFriction) {
+  ShearBoxSpec p;
+  p.box_m = 4.0;
+  p.sample_height_m = 1.6;
+  p.normal_stress_pa = 4000;
+  p.travel_m = 0.2;
+  p.speed_mps = 0.05;
+  p.window_s = 0.2;
+  const ShearBoxResult r = shear_box_test(p, nullptr);
+  std::printf("[measured] shear box of %d blocks, sample %.2f m high (porosity %.3f): the top frame holds %.1f kN "
+              "against the buoyancy and the plate's push %.1f kN; normal stress %.0f Pa consolidated; peak shear "
+              "stress %.0f Pa at %.0f Pa\n",
+              r.blocks, r.sample_height_m, r.porosity, r.held_down_n / 1e3, r.pushed_up_n / 1e3,
+              r.sigma_consolidated_pa, r.tau_peak_pa, r.sigma_at_peak_pa);
+  EXPECT_GT(r.blocks, 20);
+  EXPECT_GT(r.pushed_up_n, r.buoyancy_n);  // the plate pushes
+  EXPECT_NEAR(r.held_down_n, r.pushed_up_n, 0.01 * r.pushed_up_n);
+  EXPECT_GT(r.porosity, 0);
+  EXPECT_LT(r.porosity, 1);
+  EXPECT_GT(r.tau_peak_pa, 0.15 * r.sigma_at_peak_pa);
+}
+
+TEST(ShearBox, BadSpecNamesTheField) {
+  ShearBoxSpec small;
+  small.box_m = 2.0;  // the largest block is 1.6 m
+  expect_error([&] { shear_box_test(small, nullptr); }, {"box_m", "largest block"});
+  ShearBoxSpec far;
+  far.travel_m = 5.0;
+  expect_error([&] { shear_box_test(far, nullptr); }, {"travel_m"});
 }
 
 TEST(RidgeSection, BadInputNamesTheKey) {
