@@ -67,6 +67,11 @@ nlohmann::json ship_in_ridge(const Model& model, const RidgeOptions& r, const Se
   const double half = 0.5 * r.keel_width_m, length = bow_x - stern_x;
   double reach = -1e300, through_t = -1, stop_t = -1;
   std::vector<double> speed_in, rubble_in, layer_in, total_in;
+  // The work the hull does on the layer's ice and on the rubble while it is in the ridge (the surge load against
+  // the surge speed, over each step's time), and the distances it sails there: along its track and across the
+  // ridge (along the line's normal).
+  double layer_work = 0, rubble_work = 0, track_m = 0, across_m = 0;
+  long previous = -1;
   for (size_t k = 0; k < steps; ++k) {
     const double pen = bow_s(k) + half;  // past the near edge
     reach = std::max(reach, pen);
@@ -78,11 +83,21 @@ nlohmann::json ship_in_ridge(const Model& model, const RidgeOptions& r, const Se
     layer_in.push_back(layer[6 * k]);
     total_in.push_back(ice[6 * k]);
     if (stop_t < 0 && u < 0.05 && time[k] > 1.0) stop_t = time[k];
+    if (previous >= 0 && static_cast<size_t>(previous) == k - 1) {
+      const double dt = time[k] - time[k - 1];
+      layer_work -= 0.5 * dt * (layer[6 * k] * u + layer[6 * (k - 1)] * vel[3 * (k - 1)]);
+      rubble_work -= 0.5 * dt * (rubble[6 * k] * u + rubble[6 * (k - 1)] * vel[3 * (k - 1)]);
+      track_m += std::hypot(pos[3 * k] - pos[3 * (k - 1)], pos[3 * k + 1] - pos[3 * (k - 1) + 1]);
+      across_m += bow_s(k) - bow_s(k - 1);
+    }
+    previous = static_cast<long>(k);
   }
   auto or_null = [](double x) { return x >= 0 ? nlohmann::json(x) : nlohmann::json(nullptr); };
   nlohmann::json j = {{"what", "the hull's passage across the layer's width (penetration: the bow's distance past its "
                                "near edge along the line's normal; in the ridge: from the bow's entry to the stern's "
-                               "exit); surge loads in body axes, negative astern"},
+                               "exit); surge loads in body axes, negative astern; work per metre: the work done on "
+                               "the layer's ice (on the rubble) in the ridge over the ridge's width along the track, "
+                               "a resistance"},
                       {"through", through_t >= 0},
                       {"bow_through_at_s", or_null(through_t)},
                       {"penetration_max_m", through_t >= 0 ? r.keel_width_m : reach},
@@ -95,6 +110,16 @@ nlohmann::json ship_in_ridge(const Model& model, const RidgeOptions& r, const Se
                      {"mean_surge_rubble_load_N", mean_of(rubble_in)},
                      {"mean_surge_layer_load_N", mean_of(layer_in)},
                      {"min_surge_rubble_load_N", *std::min_element(rubble_in.begin(), rubble_in.end())}};
+    // Per metre of ridge crossed along the track (its width along the normal, times track over across): in level
+    // ice the work per metre advanced is the mean resistance, so the layer's equals Lindqvist's at h_c if the layer
+    // breaks as level ice does, whatever its width (each metre of it is broken and its pieces pushed along the whole
+    // hull while the hull is in the ridge). Only for a hull that came through.
+    if (through_t >= 0 && across_m > 0) {
+      const double crossed = r.keel_width_m * track_m / across_m;
+      j["in_ridge"]["crossed_along_track_m"] = crossed;
+      j["in_ridge"]["layer_work_per_metre_N"] = layer_work / crossed;
+      j["in_ridge"]["rubble_work_per_metre_N"] = rubble_work / crossed;
+    }
   }
   return j;
 }
