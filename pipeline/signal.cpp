@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include <boost/math/distributions/students_t.hpp>
@@ -106,16 +107,62 @@ double batch_means_standard_error(const std::vector<double>& x, size_t batches) 
   FLOESIM_REQUIRE(batches >= 2, "batch means need at least 2 batches, got ", batches);
   FLOESIM_REQUIRE(x.size() >= batches, "batch means: ", x.size(), " samples cannot fill ", batches,
                   " batches; a longer steady part is needed");
-  const size_t m = x.size() / batches;
-  const size_t first = x.size() - batches * m;  // the remainder, dropped at the start
+  return mean_interval(x, 1.0, batches).standard_error;
+}
+
+MeanInterval mean_interval(const std::vector<double>& x, double dt_s, size_t batches, double level) {
+  FLOESIM_REQUIRE(dt_s > 0, "mean interval: the sample step must be positive, got ", dt_s);
+  FLOESIM_REQUIRE(!x.empty(), "mean interval: no samples");
+  FLOESIM_REQUIRE(batches >= 2, "mean interval: at least 2 batches, got ", batches);
+  MeanInterval m;
+  m.samples = x.size();
+  m.batches = batches;
+  m.level = level;
+  const ConfidenceInterval all = student_t_interval(x, level);  // checks every sample is finite
+  m.mean = all.mean;
+  const double nan = std::nan("");
+  m.standard_error = m.t_quantile = m.half_width = m.batch_lag1 = nan;
+  m.batch_samples = x.size() / batches;
+  m.dropped_samples = x.size() - batches * m.batch_samples;
+  m.batch_s = static_cast<double>(m.batch_samples) * dt_s;
+  if (m.batch_samples == 0) {
+    m.note = "the steady part holds " + std::to_string(x.size()) + " samples, fewer than the " +
+             std::to_string(batches) + " batches: no interval";
+    return m;
+  }
   std::vector<double> means(batches);
   for (size_t b = 0; b < batches; ++b) {
     long double sum = 0;
-    for (size_t i = first + b * m; i < first + (b + 1) * m; ++i) sum += x[i];
-    means[b] = static_cast<double>(sum / static_cast<long double>(m));
+    for (size_t i = m.dropped_samples + b * m.batch_samples; i < m.dropped_samples + (b + 1) * m.batch_samples; ++i)
+      sum += x[i];
+    means[b] = static_cast<double>(sum / static_cast<long double>(m.batch_samples));
   }
-  const ConfidenceInterval ci = student_t_interval(means);
-  return ci.std / std::sqrt(static_cast<double>(batches));
+  const ConfidenceInterval ci = student_t_interval(means, level);
+  m.standard_error = ci.std / std::sqrt(static_cast<double>(batches));
+  m.t_quantile = ci.t_quantile;
+  m.half_width = ci.t_quantile * m.standard_error;
+  long double num = 0, den = 0;
+  for (size_t b = 0; b < batches; ++b) {
+    den += (means[b] - ci.mean) * static_cast<long double>(means[b] - ci.mean);
+    if (b > 0) num += (means[b] - ci.mean) * static_cast<long double>(means[b - 1] - ci.mean);
+  }
+  m.batch_lag1 = den > 0 ? static_cast<double>(num / den) : 0.0;
+  const double limit = 1.645 / std::sqrt(static_cast<double>(batches));
+  if (m.batch_samples < 2) {
+    m.note = "the steady part holds " + std::to_string(x.size()) + " samples, fewer than 2 per batch: the run is " +
+             "too short for its interval to mean anything";
+  } else if (m.batch_lag1 > limit) {
+    char buf[1024];
+    std::snprintf(buf, sizeof buf,
+                  "the batch means are correlated (lag-1 autocorrelation %.2f above 1.645 / sqrt(%zu) = %.2f): "
+                  "batches of %.3g s are shorter than the load's correlation time, the run too short for its "
+                  "interval to mean anything",
+                  m.batch_lag1, batches, limit, m.batch_s);
+    m.note = buf;
+  } else {
+    m.meaningful = true;
+  }
+  return m;
 }
 
 ConfidenceInterval student_t_interval(const std::vector<double>& x, double level) {

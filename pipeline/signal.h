@@ -2,6 +2,7 @@
 // uniformly sampled series, so that tests can check them against closed-form answers.
 #pragma once
 #include <cstddef>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -47,6 +48,30 @@ std::vector<double> running_mean(const std::vector<double>& x);
 // signal. The n - batches * m leftover samples are dropped at the START: in a steady part those are the samples
 // nearest the start-up transient. Error if batches < 2 or there are fewer samples than batches.
 double batch_means_standard_error(const std::vector<double>& x, size_t batches);
+
+// The uncertainty of one run's steady mean (issue #37): batch means (above) with kMeanBatches batches, the interval
+// mean +- t_{(1+level)/2, b-1} SE (the b batch means are taken as independent and normal, so Student's t with b - 1
+// degrees of freedom; Schmeiser 1982). Whether the interval means anything: the batches must be longer than the
+// series' correlation time, which the lag-1 autocorrelation r1 of the batch means tests (Fishman 1978: independent
+// means give r1 about -1/b with a spread of 1/sqrt(b); r1 above 1.645 / sqrt(b) rejects independence at 5 %, one
+// sided). A steady part of fewer than 2 b samples, or correlated batch means, makes `meaningful` false and `note`
+// say why: the run is too short for its interval.
+inline constexpr size_t kMeanBatches = 20;  // Schmeiser (1982): 10 to 30 batches
+inline constexpr double kMeanConfidence = 0.95;
+struct MeanInterval {
+  size_t samples = 0;
+  size_t batches = 0, batch_samples = 0, dropped_samples = 0;  // the remainder dropped at the start
+  double batch_s = 0;                                          // one batch's length in time
+  double mean = 0;                                             // of all the samples
+  double level = kMeanConfidence;
+  double standard_error = 0, t_quantile = 0, half_width = 0;   // NaN with fewer samples than batches
+  double batch_lag1 = 0;                                       // r1 of the batch means; NaN as above
+  bool meaningful = false;
+  std::string note;  // "" when meaningful
+};
+// Error if dt_s <= 0, a sample is not finite or `x` is empty.
+MeanInterval mean_interval(const std::vector<double>& x, double dt_s, size_t batches = kMeanBatches,
+                           double level = kMeanConfidence);
 
 // Student-t confidence interval of the mean of independent samples (e.g. the members of an ensemble):
 // mean +- t_{(1+level)/2, n-1} s / sqrt(n), with s the sample standard deviation (n - 1 denominator).

@@ -100,6 +100,10 @@ void steady_statistics(const Results& r, const PlotOptions& o, const std::vector
   const SteadyMean sm = mean_from(t, res, s.steady_start_s);
   s.mean_kN = sm.mean;
   s.steady_samples = sm.samples;
+  std::vector<double> steady;
+  for (size_t i = 0; i < t.size(); ++i)
+    if (t[i] >= s.steady_start_s) steady.push_back(res[i]);
+  s.interval = mean_interval(steady, s.time_step_s);
   double sum2 = 0, mx = -1e300;
   size_t c = 0;
   for (size_t i = m.f0; i < m.f1; ++i)
@@ -188,9 +192,12 @@ void write_plot_data(const AtomicFile& data, const std::vector<double>& t, const
       mm(m.ma.begin() + static_cast<long>(m.f0), m.ma.begin() + static_cast<long>(m.f1));
   write_decimated(os, tm, scaled(mm, to_unit), bins);
   os << "\n\n";
+  // The mean's line and its 95 % band (collapsed onto the line when there is no interval).
   const double t_mean0 = std::max(s.steady_start_s, t.front());
-  os << fmt("%.9g", t_mean0) << ' ' << fmt("%.9g", s.mean_kN * to_unit) << '\n'
-     << fmt("%.9g", t.back()) << ' ' << fmt("%.9g", s.mean_kN * to_unit) << '\n';
+  const double hw = std::isfinite(s.interval.half_width) ? s.interval.half_width : 0.0;
+  for (double tm : {t_mean0, t.back()})
+    os << fmt("%.9g", tm) << ' ' << fmt("%.9g", s.mean_kN * to_unit) << ' '
+       << fmt("%.9g", (s.mean_kN - hw) * to_unit) << ' ' << fmt("%.9g", (s.mean_kN + hw) * to_unit) << '\n';
   // Event times only: the script places the markers along the bottom of the plot area.
   for (const auto* times : {&ev.split_t, &ev.bend_t}) {
     if (times->empty()) continue;  // an empty block would be an empty plot element (a gnuplot error)
@@ -274,13 +281,18 @@ void script_plot_command(std::ostream& gp, const AtomicFile& data, const SurgeLo
   const std::string mean_title =
       (s.steady_start_s > t.front() ? "mean for t ≥ " + fmt("%g", s.steady_start_s) + " s: "
                                     : std::string("mean: ")) +
-      load_text_in(s.mean_kN, s.display_unit);
+      load_text_in(s.mean_kN, s.display_unit) +
+      (std::isfinite(s.interval.half_width)
+           ? " ± " + load_text_in(s.interval.half_width, s.display_unit) + " (95 %, batch means)" +
+                 (s.interval.meaningful ? "" : ": the run is too short for the interval")
+           : std::string());
   gp << "plot " << quoted(data.tmp().string())
      << " index 0 using 1:2 with lines lc rgb '#a9b8c6' lw 0.8 title "
      << quoted("ice resistance, every time step (Δt = " + fmt("%g", s.time_step_s) + " s)") << " noenhanced, \\\n"
      << "  '' index 1 using 1:2 with lines lc rgb '#101010' lw 2 title "
      << quoted(s.filter + (s.moving_average_complete ? "" : " (longer than the run: cut windows)"))
      << " noenhanced, \\\n"
+     << "  '' index 2 using 1:3:4 with filledcurves fc rgb '#d1232a' fs transparent solid 0.18 noborder notitle, \\\n"
      << "  '' index 2 using 1:2 with lines lc rgb '#d1232a' lw 2.5 dt (8,4) title " << quoted(mean_title)
      << " noenhanced";
   const std::string y_mark = fmt("%.9g", y_lo_u + 0.012 * (y_hi_u - y_lo_u));
@@ -333,6 +345,13 @@ nlohmann::json plot_numbers(const SurgeLoadSummary& s, const VesselEvents& ev, c
       {"steady_start_s", s.steady_start_s},
       {"steady_samples", s.steady_samples},
       {"mean_kN", s.mean_kN},
+      {"mean_interval",
+       {{"method", "batch means (" + std::to_string(s.interval.batches) + " batches of " +
+                       fmt("%g", s.interval.batch_s) + " s), Student t"},
+        {"half_width_kN", json_number(s.interval.half_width)},
+        {"standard_error_kN", json_number(s.interval.standard_error)},
+        {"meaningful", s.interval.meaningful},
+        {"note", s.interval.note}}},
       {"moving_average_std_kN", json_number(s.moving_average_std_kN)},
       {"moving_average_max_kN", json_number(s.moving_average_max_kN)},
       {"raw_max_kN", s.raw_max_kN},

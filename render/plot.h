@@ -14,6 +14,7 @@
 #include "pipeline/options.h"
 #include "pipeline/load_series.h"
 #include "pipeline/results_io.h"
+#include "pipeline/signal.h"
 #include "pipeline/units.h"
 #include "render/render_options.h"  // auto_or_number
 
@@ -54,6 +55,7 @@ struct SurgeLoadSummary {
   double steady_start_s = 0;
   size_t steady_samples = 0;
   double mean_kN = 0;              // mean ice resistance (-Fx) over t >= steady_start_s, unfiltered
+  MeanInterval interval;           // its batch-means 95 % interval (kN; pipeline/signal.h), as summary.json's
   bool moving_average_complete = true;  // false: the run is shorter than the window (all windows cut)
   double moving_average_std_kN = 0;  // of the moving average over the steady part, full windows only (NaN if none)
   double moving_average_max_kN = 0;

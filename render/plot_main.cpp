@@ -29,7 +29,11 @@ int main(int argc, char** argv) {
     if (results.empty() || out.empty()) throw floesim::Error("--results and --out are required (see --help)");
     const auto s = floesim::render::plot_surge_load(results, config, out);
     std::cout << "wrote " << out << "/surge_ice_load.{png,svg,csv}, fracture_events.csv and plot.json: mean ice "
-              << "resistance " << floesim::load_text(1000.0 * s.mean_kN, s.display_unit) << " over t >= " << s.steady_start_s << " s (" << s.contact_model
+              << "resistance " << floesim::load_text(1000.0 * s.mean_kN, s.display_unit)
+              << (std::isfinite(s.interval.half_width)
+                      ? " ± " + floesim::load_text(1000.0 * s.interval.half_width, s.display_unit) + " (95 %)"
+                      : std::string())
+              << " over t >= " << s.steady_start_s << " s (" << s.contact_model
               << " contacts, " << s.window_s << " s moving average); " << s.fracture_events << " fracture events, "
               << s.vessel_splitting_events + s.vessel_bending_radial_events << " at the vessel\n";
     for (const std::string& stem : floesim::render::plot_structure_loads(results, config, out))

@@ -196,6 +196,7 @@ figcaption{font-size:.9em;color:#555}
 .error{border:2px solid #c00;background:#fee;padding:.5em 1em}
 pre{background:#f6f6f6;padding:.6em;overflow:auto;font-size:.85em}
 .note{color:#555;font-size:.9em}
+.warning{color:#8a4b00;font-weight:bold}
 .wide{overflow-x:auto}
 )";
 
@@ -278,6 +279,13 @@ Json read_run_summary(const fs::path& run_dir, Page& pg) {
 void mean_load_numbers(const Json& summary, const ReportOptions& o, ReportSummary& rs) {
   rs.mean_kN = find(summary, {"mean_surge_ice_resistance_N"})->get<double>() / 1000;
   rs.std_kN = number_or_nan(summary, {"std_surge_ice_load_N"}) / 1000;
+  rs.half_width_kN = NAN;
+  if (const Json* ci = find(summary, {"mean_surge_ice_load_interval"}); ci && ci->is_object()) {
+    rs.half_width_kN = number_or_nan(*ci, {"half_width_N"}) / 1000;
+    rs.interval_method = ci->value("method", "");
+    rs.interval_meaningful = ci->value("meaningful", false);
+    rs.interval_note = ci->value("note", "");
+  }
   rs.moving_average_max_kN = NAN;
   if (const Json* ma = find(summary, {"moving_average_surge_ice_load"}); ma && ma->is_array()) {
     for (const Json& m : *ma)
@@ -334,14 +342,23 @@ void mean_loads_section(std::ostream& body, const ReportSummary& rs) {
   for (const auto& c : rs.references) typical_kN = std::max(typical_kN, std::abs(c.reference_kN));
   const ForceUnit unit = force_unit_for(1000.0 * typical_kN);
   auto in_unit = [&](double x_kN) { return load_in(x_kN, unit); };
+  const bool ci = std::isfinite(rs.half_width_kN);
+  auto pm = [&](double hw_text_kN) { return ci ? " &plusmn; " + in_unit(hw_text_kN) : std::string(); };
   body << "<h2>Mean loads</h2>\n<table>\n<tr><th>quantity</th><th>" << unit.name << "</th></tr>\n"
-       << "<tr><th>mean surge ice resistance (steady part)</th><td class=\"n\" id=\"mean-kN\">" << in_unit(rs.mean_kN)
+       << "<tr><th>mean surge ice resistance (steady part" << (ci ? ", &plusmn; 95 % interval" : "")
+       << ")</th><td class=\"n\"><span id=\"mean-kN\">" << in_unit(rs.mean_kN) << "</span>"
+       << pm(rs.half_width_kN)
        << "</td></tr>\n<tr><th>standard deviation of the surge ice load</th><td class=\"n\">" << in_unit(rs.std_kN)
        << "</td></tr>\n<tr><th>largest moving average of the resistance"
        << (std::isfinite(rs.moving_average_window_s) && rs.moving_average_window_s > 0
                ? " (" + fmt("%g", rs.moving_average_window_s) + " s window)"
                : std::string())
        << "</th><td class=\"n\">" << in_unit(rs.moving_average_max_kN) << "</td></tr>\n</table>\n";
+  if (!rs.interval_method.empty())
+    body << "<p class=\"note\" id=\"interval-method\">The interval: " << html_escape(rs.interval_method) << ".</p>\n";
+  if (!rs.interval_note.empty())
+    body << "<p class=\"warning\" id=\"interval-warning\">The run is too short for its interval: "
+         << html_escape(rs.interval_note) << ".</p>\n";
   if (rs.references.empty()) {
     body << "<p class=\"note\">No reference value given (report config: <code>reference_kN</code>, "
             "<code>reference_label</code> or <code>references</code>).</p>\n";
@@ -350,8 +367,11 @@ void mean_loads_section(std::ostream& body, const ReportSummary& rs) {
          << "</th><th>simulated &minus; reference, " << unit.name << "</th><th>error, %</th></tr>\n";
     for (const auto& c : rs.references)
       body << "<tr><th>" << html_escape(c.label) << "</th><td class=\"n\">" << in_unit(c.reference_kN)
-           << "</td><td class=\"n\">" << fmt("%+.1f", 1000.0 * c.error_kN / unit.newtons) << "</td><td class=\"n\">"
-           << fmt("%+.1f", c.error_percent) << "</td></tr>\n";
+           << "</td><td class=\"n\">" << fmt("%+.1f", 1000.0 * c.error_kN / unit.newtons)
+           << (ci ? " &plusmn; " + fmt("%.1f", 1000.0 * rs.half_width_kN / unit.newtons) : std::string())
+           << "</td><td class=\"n\">" << fmt("%+.1f", c.error_percent)
+           << (ci ? " &plusmn; " + fmt("%.1f", 100 * rs.half_width_kN / c.reference_kN) : std::string())
+           << "</td></tr>\n";
     body << "</table>\n";
   }
 }

@@ -66,6 +66,11 @@ struct ReportSummary {
   uintmax_t bytes = 0;                      // size of the page
   double mean_kN = 0;                       // summary.json mean_surge_ice_resistance_N / 1000
   double std_kN = 0;                        // summary.json std_surge_ice_load_N / 1000 (NaN if absent)
+  // summary.json mean_surge_ice_load_interval: the 95 % half width of the mean (NaN if absent or none), how it was
+  // taken, whether it means anything and, if not, why.
+  double half_width_kN = 0;
+  std::string interval_method, interval_note;
+  bool interval_meaningful = false;
   double moving_average_max_kN = 0;         // the applying moving average's largest resistance (NaN if absent)
   double moving_average_window_s = 0;
   std::vector<ReferenceComparison> references;

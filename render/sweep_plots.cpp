@@ -102,8 +102,7 @@ void draw_axis_plot(const SweepPlan& plan, const GatherResult& g, size_t k, Plot
     lines[i].push_back(gp.index);
   }
   // 2. Data: per line, a block of (x, mean, low, high) sorted by x, then a block of its members (x, mean). A grid
-  // point without an interval (one ok member) has its bar collapsed onto the mean; one without ok members is left
-  // out.
+  // point of one ok member has that member's batch-means interval; one without ok members is left out.
   double to_unit = 1;
   const ForceUnit unit = plot_unit(g, &to_unit);
   std::ostringstream data, plot;
@@ -117,7 +116,7 @@ void draw_axis_plot(const SweepPlan& plan, const GatherResult& g, size_t k, Plot
               [&](auto* a, auto* b) { return x_of(a->axes[ax.key]) < x_of(b->axes[ax.key]); });
     if (block > 0) data << "\n\n";
     for (const GridPointResult* p : pts) {
-      const double hw = p->ci.n >= 2 ? p->ci.half_width : 0.0;
+      const double hw = std::isfinite(p->half_width_kN) ? p->half_width_kN : 0.0;
       data << fmt("%.10g", x_of(p->axes[ax.key])) << ' ' << fmt("%.10g", to_unit * p->ci.mean) << ' '
            << fmt("%.10g", to_unit * (p->ci.mean - hw)) << ' ' << fmt("%.10g", to_unit * (p->ci.mean + hw)) << '\n';
     }
@@ -154,8 +153,8 @@ void draw_axis_plot(const SweepPlan& plan, const GatherResult& g, size_t k, Plot
   f.draw(body.str(), data.str());
 }
 
-// Level ice: each member's mean resistance with its 95 % interval (1.96 batch-means standard errors) against its
-// mean speed, a colour per sheet thickness (the axis "simulate.level_ice.thickness_m" if the sweep has it, else
+// Level ice: each member's mean resistance with its 95 % interval (batch means, Student t with batches - 1 degrees
+// of freedom) against its mean speed, a colour per sheet thickness (the axis "simulate.level_ice.thickness_m" if the sweep has it, else
 // one colour), with Lindqvist (solid) and Riska (dashed) at the same speeds.
 void draw_level_ice_plot(const SweepPlan& plan, const GatherResult& g, PlotFiles& f) {
   const std::string hkey = "simulate.level_ice.thickness_m";
@@ -178,7 +177,7 @@ void draw_level_ice_plot(const SweepPlan& plan, const GatherResult& g, PlotFiles
               [](auto* a, auto* b) { return a->mean_speed_mps < b->mean_speed_mps; });
     if (k > 0) data << "\n\n";
     for (const MemberResult* m : members[k]) {
-      const double hw = 1.96 * m->series.batch_means_se_kN;
+      const double hw = m->series.interval.half_width;
       data << fmt("%.10g", m->mean_speed_mps) << ' ' << fmt("%.10g", to_unit * m->mean_resistance_kN) << ' '
            << fmt("%.10g", to_unit * (m->mean_resistance_kN - hw)) << ' '
            << fmt("%.10g", to_unit * (m->mean_resistance_kN + hw)) << ' ' << fmt("%.10g", to_unit * m->lindqvist_kN)

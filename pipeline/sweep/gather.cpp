@@ -48,7 +48,8 @@ ResistanceStats resistance_stats(const SteadyResistance& s, size_t batches, doub
   st.batches = batches;
   st.batch_samples = x.size() / batches;
   st.dropped_samples = x.size() - batches * st.batch_samples;
-  st.batch_means_se_kN = x.size() >= batches ? batch_means_standard_error(x, batches) : kNaN;
+  st.interval = mean_interval(x, s.time_step_s > 0 ? s.time_step_s : 1.0, batches, kConfidence);
+  st.batch_means_se_kN = st.interval.standard_error;
   // The peak of the moving average over the steady part itself: windows reaching into the start-up transient
   // would mix it in.
   st.peak_window_s = peak_window_s;
@@ -279,6 +280,15 @@ GatherResult gather_members(const SweepPlan& plan) {
         if (m.ok) means.push_back(m.mean_resistance_kN);
       }
     gp.ci = student_t_interval(means, kConfidence);
+    gp.half_width_kN = gp.ci.half_width;
+    gp.interval_method = gp.ci.n >= 2 ? "Student t over the ok members" : "none: no member ok";
+    if (gp.ci.n == 1)
+      for (const MemberResult& m : g.members)
+        if (m.grid_point == p.index && m.ok) {
+          gp.half_width_kN = m.series.interval.half_width;
+          gp.interval_method = "batch means of its one member" +
+                               (m.series.interval.meaningful ? std::string() : " (" + m.series.interval.note + ")");
+        }
     g.grid_points.push_back(std::move(gp));
   }
 
@@ -375,7 +385,8 @@ SweepTables sweep_tables(const SweepPlan& plan, const fs::path& plan_file, const
                     {"n_ok", gp.ci.n},
                     {"mean_kN", json_number(gp.ci.mean)},
                     {"std_kN", json_number(gp.ci.std)},
-                    {"ci95_half_width_kN", json_number(gp.ci.half_width)},
+                    {"ci95_half_width_kN", json_number(gp.half_width_kN)},
+                    {"interval", gp.interval_method},
                     {"t_quantile", json_number(gp.ci.t_quantile)}});
   Json axes = Json::array();
   for (const PlanAxis& a : plan.axes) axes.push_back({{"key", a.key}, {"values", a.values}});
@@ -395,7 +406,9 @@ SweepTables sweep_tables(const SweepPlan& plan, const fs::path& plan_file, const
         {"mean_speed_mps", "m/s: summary.json mean_vessel_speed_mps"},
         {"peak_0.5s_resistance_kN", "kN: largest 0.5 s centred moving average over the steady part, full windows"},
         {"wall_s", "s: sum of the stages' recorded wall times"},
-        {"ci95_half_width_kN", "kN: Student t 0.975 quantile (n_ok - 1 degrees of freedom) x std / sqrt(n_ok)"}}},
+        {"ci95_half_width_kN",
+         "kN: Student t 0.975 quantile (n_ok - 1 degrees of freedom) x std / sqrt(n_ok); for a point of one ok "
+         "member, its batch-means interval (t with batches - 1 degrees of freedom x batch_means_se_kN)"}}},
       {"members", rows},
       {"grid_points", grid},
       {"failed", failed},
@@ -419,7 +432,9 @@ std::string gather_table(const SweepPlan& plan, const GatherResult& g) {
   for (const GridPointResult& gp : g.grid_points) {
     std::vector<std::string> r = {std::to_string(gp.index)};
     for (const PlanAxis& a : plan.axes) r.push_back(value_text(gp.axes[a.key]));
-    r.push_back(ci_text(gp.ci));
+    r.push_back(gp.ci.n == 1 && std::isfinite(gp.half_width_kN)
+                    ? fmt("%.4g", gp.ci.mean) + " ± " + fmt("%.3g", gp.half_width_kN) + " (one member: batch means)"
+                    : ci_text(gp.ci));
     r.push_back(std::to_string(gp.ci.n) + "/" + std::to_string(gp.n_members));
     rows.push_back(r);
   }

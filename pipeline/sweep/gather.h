@@ -17,13 +17,10 @@
 
 namespace floesim::sweep {
 
-inline constexpr double kConfidence = 0.95;
-
-// Batches for the batch-means standard error of a member's mean. Schmeiser (1982, "Batch size effects in the
-// analysis of simulation output", Oper. Res. 30(3)) finds 10 to 30 batches a good choice: fewer leave the error
-// estimate itself too uncertain (few degrees of freedom), more make each batch too short for the batch means of a
-// correlated series to be independent.
-inline constexpr size_t kBatchMeansBatches = 20;
+// The interval's level and the batches of a member's batch-means standard error: pipeline/signal.h's, as each run's
+// summary.json has them.
+inline constexpr double kConfidence = kMeanConfidence;
+inline constexpr size_t kBatchMeansBatches = kMeanBatches;
 // Window of the peak resistance: PHYSICS.md §5's moving average for compliant contacts.
 inline constexpr double kPeakWindowS = 0.5;
 // Non-empty log lines quoted for a failed member.
@@ -51,6 +48,7 @@ struct ResistanceStats {
   size_t batch_samples = 0;          // floor(samples / batches)
   size_t dropped_samples = 0;        // the remainder, dropped at the start of the steady part
   double batch_means_se_kN = 0;      // NaN if samples < batches
+  MeanInterval interval;             // the same batches: the 95 % interval, whether it means anything
   double peak_window_s = 0;
   size_t peak_window_samples = 0;
   double peak_kN = 0;                // largest centred moving average, full windows only; NaN if none fits
@@ -86,6 +84,10 @@ struct GridPointResult {
   Json axes = Json::object();
   size_t n_members = 0;
   ConfidenceInterval ci;  // of the ok members' mean resistance (kN); ci.n = number of ok members
+  // The point's 95 % interval (kN): over its ok members (ci) when there are two or more; with one, that member's own
+  // batch-means interval (its summary.json's); NaN without.
+  double half_width_kN = 0;
+  std::string interval_method;
 };
 
 struct GatherResult {

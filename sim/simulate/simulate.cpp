@@ -236,6 +236,12 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
     const ForceUnit u = force_unit_for(load_n);
     rep << "mean surge ice load " << load_text(load_n, u) << " (resistance "
         << load_text(summary["mean_surge_ice_resistance_N"].get<double>(), u) << ")";
+    const nlohmann::json& ci = summary["mean_surge_ice_load_interval"];
+    if (ci["half_width_N"].is_number())
+      rep << " ± " << load_text(ci["half_width_N"].get<double>(), u) << " (95 %, batch means over "
+          << ci["batches"].get<size_t>() << " batches of " << std::setprecision(3) << ci["batch_s"].get<double>()
+          << " s" << std::setprecision(1) << ")";
+    if (!ci["meaningful"].get<bool>()) rep << " [" << ci["note"].get<std::string>() << "]";
   }
   rep << " from t = " << o.steady_start_s
       << " s, mean speed " << std::setprecision(3) << summary["mean_vessel_speed_mps"].get<double>() << " m/s\n";

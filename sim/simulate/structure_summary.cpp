@@ -351,6 +351,7 @@ void add_loads_json(const std::vector<double>& fh, const std::vector<double>& fy
                  {"window_s", kFilterS}};
   j["steady_part"] = {{"from_s", o.steady_start_s}, {"to_s", o.duration_s}, {"samples", fh.size()}};
   j["horizontal_load_N"] = stats_json(stats_of(fh));
+  j["horizontal_load_mean_interval"] = mean_interval_json(fh, o.time_step_s, stats_of(fh).mean, "N");
   j["horizontal_load_filtered_N"] = stats_json(stats_of(fh_f));
   j["transverse_load_N"] = stats_json(stats_of(fy));
   j["vertical_load_N"] = stats_json(stats_of(fv));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
 
@@ -289,6 +290,32 @@ nlohmann::json level_ice_summary(const SimulateOptions& o, const Model& model, c
   return j;
 }
 
+nlohmann::json mean_interval_json(const std::vector<double>& x, double dt_s, double mean, const std::string& unit) {
+  if (x.empty()) return {{"meaningful", false}, {"note", "no samples in the steady part: no interval"}};
+  const MeanInterval m = mean_interval(x, dt_s);
+  auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  char method[400];
+  std::snprintf(method, sizeof method,
+                "batch means: the steady part (%zu samples) cut into %zu consecutive batches of %zu samples (%.4g s; "
+                "the %zu left over dropped at its start), the standard error the batch means' standard deviation "
+                "over sqrt(%zu), the %.0f %% interval the mean +- Student's t (%zu degrees of freedom) times it",
+                m.samples, m.batches, m.batch_samples, m.batch_s, m.dropped_samples, m.batches, 100 * m.level,
+                m.batches - 1);
+  nlohmann::json j = {{"method", method},
+                      {"level", m.level},
+                      {"batches", m.batches},
+                      {"batch_s", m.batch_s},
+                      {"standard_error_" + unit, number(m.standard_error)},
+                      {"half_width_" + unit, number(m.half_width)},
+                      {"low_" + unit, number(mean - m.half_width)},
+                      {"high_" + unit, number(mean + m.half_width)},
+                      {"t_quantile", number(m.t_quantile)},
+                      {"batch_lag1_autocorrelation", number(m.batch_lag1)},
+                      {"meaningful", m.meaningful}};
+  if (!m.meaningful) j["note"] = m.note;
+  return j;
+}
+
 nlohmann::json summarize(const SimulateOptions& o, const Model& model, const Results& r) {
   return summarize(o, model, r, ResultsSeries(r));
 }
@@ -316,7 +343,15 @@ nlohmann::json summarize(const SimulateOptions& o, const Model& model, const Res
     for (size_t i = first; i < steps; ++i) fx.push_back(ice[6 * i]);
   }
   const double fx_rigid = steady_sum("ice_load_rigid"), fx_compliant = steady_sum("ice_load_compliant");
-  const double speed = steady_sum("vessel_velocity_mps"), thrust = steady_sum("propulsion_load");
+  std::vector<double> u;  // the surge speed over the steady part (column 0), for its interval
+  {
+    const std::vector<double> v = series.get("vessel_velocity_mps");
+    const size_t cols = static_cast<size_t>(series_field("vessel_velocity_mps").cols);
+    for (size_t i = first; i < steps; ++i) u.push_back(v[cols * i]);
+  }
+  double speed = 0;
+  for (double x : u) speed += x;
+  const double thrust = steady_sum("propulsion_load");
   const double aw = steady_sum("awake_floes"), co = steady_sum("contact_count"), vc = steady_sum("vessel_contact_count");
   const double n = static_cast<double>(fx.size());
   FLOESIM_REQUIRE(n > 0, "internal: no steady samples");
@@ -330,6 +365,8 @@ nlohmann::json summarize(const SimulateOptions& o, const Model& model, const Res
   nlohmann::json s;
   s["mean_surge_ice_load_N"] = mean;
   s["mean_surge_ice_resistance_N"] = -mean;
+  // The resistance's interval is the load's, negated: the same half width.
+  s["mean_surge_ice_load_interval"] = mean_interval_json(fx, o.time_step_s, mean, "N");
   s["std_surge_ice_load_N"] = sd;
   // The same mean split by contact law (they add up to the mean above).
   s["mean_surge_ice_load_rigid_N"] = fx_rigid / n;
@@ -405,6 +442,7 @@ nlohmann::json summarize(const SimulateOptions& o, const Model& model, const Res
   s["contact_model"] = model_kind;
   s["contact_laws"] = {{"ice_structure", o.contact.ice_structure}, {"ice_ice", o.contact.ice_ice}};
   s["mean_vessel_speed_mps"] = speed / n;
+  s["mean_vessel_speed_interval"] = mean_interval_json(u, o.time_step_s, speed / n, "mps");
   s["mean_thrust_N"] = thrust / n;
   s["mean_awake_floes"] = aw / n;
   s["mean_contacts"] = co / n;

@@ -2,6 +2,9 @@
 // of PHYSICS.md §5, how the solver did, fracture and level ice, from the results alone (and the model as built, for
 // what the inputs were).
 #pragma once
+#include <string>
+#include <vector>
+
 #include <nlohmann/json.hpp>
 
 #include "pipeline/results_io.h"
@@ -16,6 +19,12 @@ namespace floesim::sim {
 nlohmann::json summarize(const SimulateOptions& o, const Model& model, const Results& results,
                          const SeriesSource& series);
 nlohmann::json summarize(const SimulateOptions& o, const Model& model, const Results& results);
+
+// The uncertainty of a steady mean in summary.json (issue #37; pipeline/signal.h's mean_interval): the batch-means
+// standard error and the 95 % interval around `mean` (the summary's own mean of `x`), the batches, the test of
+// their independence and, when the run is too short for the interval to mean anything, why. `unit` suffixes the
+// keys (standard_error_N, low_N, ...).
+nlohmann::json mean_interval_json(const std::vector<double>& x, double dt_s, double mean, const std::string& unit);
 
 // Level ice (summary.json "level_ice"): the sheet's tiles and area at the start and the channel the vessel broke:
 // from the sheet's edge on its path to its centre of mass in the last frame (behind midship the channel is formed),

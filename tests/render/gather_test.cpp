@@ -402,7 +402,11 @@ TEST(Gather, SyntheticSweepGathersKnownNumbersAndListsFailedMembers) {
   EXPECT_EQ(g1["n_members"], 3);
   EXPECT_EQ(g1["n_ok"], 1);
   EXPECT_EQ(g1["mean_kN"].get<double>(), 250.0);
-  EXPECT_TRUE(g1["ci95_half_width_kN"].is_null()) << "one ok member: no interval";
+  // One ok member: the point's interval is that member's batch-means interval; C's series is constant, so its 20
+  // batch means are equal and the half width exactly 0. The t quantile of an ensemble needs two members.
+  EXPECT_EQ(g1["ci95_half_width_kN"].get<double>(), 0.0) << "one ok member: its own batch-means interval";
+  EXPECT_EQ(g1["interval"], "batch means of its one member");
+  EXPECT_EQ(g0["interval"], "Student t over the ok members");
   EXPECT_TRUE(g1["t_quantile"].is_null());
   EXPECT_EQ(g1["axes"][kSpeed], 2);
   ASSERT_EQ(j["failed"].size(), 2u);

@@ -214,9 +214,12 @@ TEST_F(TinyRun, ReportIsSelfContainedAndEmbedsTheArtefacts) {
   for (const auto& [name, bytes] : expected) ADD_FAILURE() << name << " is not embedded";
 
   // The reference rows from the run's own mean (read here from summary.json).
-  const double mean_kN = load_json_file(run_ / "sim/summary.json")["mean_surge_ice_resistance_N"].get<double>() / 1000;
-  char row[128];
-  std::snprintf(row, sizeof row, "%+.1f</td><td class=\"n\">%+.1f", mean_kN - 1038, 100 * (mean_kN - 1038) / 1038);
+  const Json summary = load_json_file(run_ / "sim/summary.json");
+  const double mean_kN = summary["mean_surge_ice_resistance_N"].get<double>() / 1000,
+               hw_kN = summary["mean_surge_ice_load_interval"]["half_width_N"].get<double>() / 1000;
+  char row[160];
+  std::snprintf(row, sizeof row, "%+.1f &plusmn; %.1f</td><td class=\"n\">%+.1f &plusmn; %.1f", mean_kN - 1038,
+                hw_kN, 100 * (mean_kN - 1038) / 1038, 100 * hw_kN / 1038);
   EXPECT_NE(html.find(row), std::string::npos) << row;
   EXPECT_NE(html.find("SAMS"), std::string::npos);
   // The settings, escaped: every stage's config file is on the page.
@@ -230,6 +233,9 @@ TEST_F(TinyRun, ReferenceErrorOnThePageAgainstAHandValue) {
   const fs::path run = copy_run("hand");
   Json s = load_json_file(run / "sim/summary.json");
   s["mean_surge_ice_resistance_N"] = 1100e3;
+  s["mean_surge_ice_load_interval"]["half_width_N"] = 55e3;
+  s["mean_surge_ice_load_interval"]["meaningful"] = false;
+  s["mean_surge_ice_load_interval"]["note"] = "a note for the test";
   std::ofstream(run / "sim/summary.json") << s.dump(2);
   ReportOptions o;
   o.reference_kN = 1038;
@@ -239,11 +245,16 @@ TEST_F(TinyRun, ReferenceErrorOnThePageAgainstAHandValue) {
   ASSERT_EQ(r.references.size(), 2u);
   EXPECT_NEAR(r.references[0].error_percent, 5.97303, 1e-5);
   const std::string html = read_text(root_ / "hand.html");
-  // 1100 - 1038 = +62.0 kN, +6.0 %; 1100 - 974 = +126.0 kN, +12.9 %.
-  EXPECT_NE(html.find("<th>full scale</th><td class=\"n\">1038</td><td class=\"n\">+62.0</td><td class=\"n\">+6.0"),
+  // 1100 - 1038 = +62.0 kN, +6.0 %; 1100 - 974 = +126.0 kN, +12.9 %; the 55 kN interval is 5.3 % of 1038 kN and
+  // 5.6 % of 974 kN.
+  EXPECT_NE(html.find("<th>full scale</th><td class=\"n\">1038</td><td class=\"n\">+62.0 &plusmn; 55.0</td>"
+                      "<td class=\"n\">+6.0 &plusmn; 5.3"),
             std::string::npos);
-  EXPECT_NE(html.find("<th>SAMS</th><td class=\"n\">974</td><td class=\"n\">+126.0</td><td class=\"n\">+12.9"),
+  EXPECT_NE(html.find("<th>SAMS</th><td class=\"n\">974</td><td class=\"n\">+126.0 &plusmn; 55.0</td>"
+                      "<td class=\"n\">+12.9 &plusmn; 5.6"),
             std::string::npos);
+  EXPECT_NE(html.find("1100</span> &plusmn; 55</td>"), std::string::npos) << "the mean with its interval";
+  EXPECT_NE(html.find("The run is too short for its interval: a note for the test"), std::string::npos);
 }
 
 // A structure's summary gets a section of its own, every figure named by its path; a ship's run has none.
