@@ -28,6 +28,7 @@ struct DigitiseOptions {
                                          // of their ice piece's bright level; 0 = the whole ice piece is core
   double min_contrast = 30.0;            // ice and water must differ by this many grey levels, else one class
                                          // ("local_otsu": blocks below it have no say in the local levels)
+  bool allow_one_class = false;          // an image of one class (all ice or no ice): refused unless this is set
   double crack_width_m = 0.0;            // dark lines (cracks, shadows between touching floes) up to this wide
                                          // are cut from the ice (black top-hat); 0 = off
   double crack_depth = 0.3;              // ... where they are this much darker than their surroundings, as a
@@ -70,6 +71,9 @@ struct DigitiseOptions {
             in_range(0, 1.5));
     v.field("min_contrast", min_contrast, "grey", "least ice-water contrast; below it the image is one class",
             in_range(1, 255));
+    v.field("allow_one_class", allow_one_class, "-",
+            "accept an image of one class (no water: each connected area one floe; no ice: no floes) with a warning; "
+            "false: such an image is an error");
     v.field("crack_width_m", crack_width_m, "m",
             "widest dark line between floes cut from the ice (black top-hat); 0 = off", non_negative());
     v.field("crack_depth", crack_depth, "-",

@@ -96,6 +96,8 @@ ImageHeader read_image_header(const std::filesystem::path& file) {
   std::array<unsigned char, 24> h{};
   in.read(reinterpret_cast<char*>(h.data()), h.size());
   const std::streamsize got = in.gcount();
+  FLOESIM_REQUIRE(got > 0, f, ": the image file is empty (0 bytes): an interrupted copy or download? Give a PNG, JPEG "
+                  "or TIFF image");
   // The signatures OpenCV's decoders recognise a file by (imgcodecs grfmt_png, grfmt_jpeg, grfmt_tiff).
   static const unsigned char png_sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   if (got >= 8 && std::equal(png_sig, png_sig + 8, h.begin())) return png_header(f, h.data(), got);

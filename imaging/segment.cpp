@@ -456,7 +456,8 @@ GlobalSplit global_split(const std::array<double, 256>& hist, Segmentation& seg)
 }
 
 // 2. One class: its mean brightness decides which (the middle of the 8-bit range: water photographs dark, ice
-// bright), with a warning. Sets seg.classes; for "no_ice" also the empty labels. Returns true if all ice.
+// bright), with a warning; an error unless digitise.allow_one_class (a blank or wrongly exposed image would
+// otherwise run on as one huge floe). Sets seg.classes; for "no_ice" also the empty labels. Returns true if all ice.
 bool one_class_is_ice(const std::array<double, 256>& hist, double contrast, const DigitiseOptions& o,
                       const std::string& name, Segmentation& seg) {
   double sum = 0;
@@ -466,6 +467,11 @@ bool one_class_is_ice(const std::array<double, 256>& hist, double contrast, cons
   std::snprintf(buf, sizeof buf,
                 "ice-water contrast %.1f grey levels < min_contrast %.1f, mean grey %.1f: ", contrast, o.min_contrast,
                 mean);
+  FLOESIM_REQUIRE(o.allow_one_class, name, ": ", buf, mean < 128 ? "no ice found" : "no water found",
+                  ": the image is one class (a uniform, blank or wrongly exposed image?), refused; if it is what you "
+                  "meant, set digitise.allow_one_class to true (",
+                  mean < 128 ? "no floes" : "each connected valid area one floe, concentration 1",
+                  "), or lower digitise.min_contrast for an image of faint contrast");
   if (mean < 128) {
     seg.classes = "no_ice";
     seg.warnings.push_back(name + ": " + buf + "no ice found; the result has no floes");

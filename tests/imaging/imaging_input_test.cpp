@@ -77,6 +77,33 @@ TEST_F(DigitiseBadInput, NotAnImage) {
   expect_refused(request(f), {"text.png", "cannot decode", "not a PNG, JPEG or TIFF"});
 }
 
+TEST_F(DigitiseBadInput, EmptyFileSaysItIsEmpty) {
+  const auto f = dir_.path / "empty.png";
+  std::ofstream(f).close();
+  expect_refused(request(f), {"empty.png", "is empty (0 bytes)"});
+}
+
+// A uniform grey image (issue #37: it ran on as one 40,000 m^2 floe with exit 0): one class, refused with the key
+// that accepts it; with the key, the warning and one floe of the whole image.
+TEST_F(DigitiseBadInput, AnImageWithNoWaterIsRefusedUnlessTheCaseAllowsIt) {
+  const auto f = dir_.path / "grey.png";
+  ASSERT_TRUE(cv::imwrite(f.string(), cv::Mat(200, 200, CV_8U, cv::Scalar(180))));
+  expect_refused(request(f), {"grey.png", "no water found", "digitise.allow_one_class"});
+  DigitiseRequest r = request(f);
+  r.config = {{"allow_one_class", true}};
+  const DigitiseResult res = run_digitise(r);
+  ASSERT_EQ(res.floes.floes.size(), 1u);
+  EXPECT_NEAR(signed_area(res.floes.floes[0].outline), 200.0 * 200.0, 0.02 * 200 * 200);
+  ASSERT_FALSE(res.warnings.empty());
+  EXPECT_NE(res.warnings.back().find("no water found"), std::string::npos);
+}
+
+TEST_F(DigitiseBadInput, AnImageWithNoIceIsRefusedUnlessTheCaseAllowsIt) {
+  const auto f = dir_.path / "dark.png";
+  ASSERT_TRUE(cv::imwrite(f.string(), cv::Mat(100, 100, CV_8U, cv::Scalar(40))));
+  expect_refused(request(f), {"dark.png", "no ice found", "digitise.allow_one_class"});
+}
+
 TEST_F(DigitiseBadInput, TruncatedPng) {
   std::ifstream in(good_, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
