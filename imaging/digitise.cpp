@@ -5,6 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "imaging/georeference.h"
 #include "imaging/image_io.h"
 #include "imaging/stats.h"
 #include "pipeline/atomic_file.h"
@@ -170,6 +171,7 @@ DigitiseResult run_digitise(const DigitiseRequest& req) {
   if (!req.truth_mask.empty()) inputs.push_back({"truth_mask", req.truth_mask});
   const nlohmann::json prov = make_provenance("floesim-digitise", inputs, config);
   res.floes.provenance = prov;
+  res.floes.warnings = res.warnings;
   res.stats["warnings"] = res.warnings;
   nlohmann::json stats = res.stats;
   stats["provenance"] = prov;
@@ -178,7 +180,8 @@ DigitiseResult run_digitise(const DigitiseRequest& req) {
   AtomicFile geo(req.out_dir / "floes.geojson"), labels(req.out_dir / "labels.png"),
       overlay(req.out_dir / "overlay.png"), stats_f(req.out_dir / "stats.json"), fsd_png(req.out_dir / "fsd.png"),
       fsd_csv(req.out_dir / "fsd.csv"), score_f(req.out_dir / "score.json"),
-      parts_f(req.out_dir / "convex_parts.geojson");
+      parts_f(req.out_dir / "convex_parts.geojson"), wgs84_f(req.out_dir / "floes_wgs84.geojson");
+  const bool georeferenced = !o.georeference.empty();
   write_json_tmp(geo, floes_to_geojson(res.floes));
   write_labels_png(labels.tmp(), res.seg.labels, labels.path().string());
   write_png_tmp(overlay, render_overlay(gray, res.floes, req.metres_per_pixel));
@@ -193,6 +196,8 @@ DigitiseResult run_digitise(const DigitiseRequest& req) {
     write_json_tmp(score_f, sj);
   }
   if (o.convex_parts) write_json_tmp(parts_f, convex_parts_geojson(res.floes));
+  if (georeferenced)
+    write_json_tmp(wgs84_f, floes_to_wgs84_geojson(res.floes, georeference_from(o.georeference, "digitise")));
   geo.commit();
   labels.commit();
   overlay.commit();
@@ -201,6 +206,7 @@ DigitiseResult run_digitise(const DigitiseRequest& req) {
   fsd_csv.commit();
   if (res.score) score_f.commit();
   if (o.convex_parts) parts_f.commit();
+  if (georeferenced) wgs84_f.commit();
   return res;
 }
 

@@ -5,7 +5,9 @@
 // not on one image. For close-range photographs (cm per pixel) imaging/settings/close_range.json holds a set
 // chosen by cross-validation on the 12 hand-labelled passerotti images at 0.05 m/px (README.md, issue #3).
 #pragma once
+#include <cmath>
 #include <string>
+#include <vector>
 
 #include "pipeline/options.h"
 
@@ -48,6 +50,8 @@ struct DigitiseOptions {
   double simplify_tolerance_m = 0.5;     // Douglas-Peucker tolerance of the outlines
   double thickness_m = 1.0;              // written to every floe (SAMS table: h = 1 m)
   bool convex_parts = false;             // also write convex_parts.geojson: each floe split into convex pieces
+  std::vector<double> georeference;      // [latitude_deg, longitude_deg, heading_deg] of the image centre (WGS 84)
+                                         // and its up axis (clockwise from true north): also floes_wgs84.geojson
   int size_bins_per_decade = 5;          // floe size distribution table: log-spaced bins of equivalent diameter
   double fit_min_diameter_m = 0.0;       // power-law fit uses floes with D >= this (0: chosen from the data by
                                          // the Kolmogorov-Smirnov criterion of Clauset et al. 2009)
@@ -100,6 +104,18 @@ struct DigitiseOptions {
     v.field("thickness_m", thickness_m, "m", "ice thickness written to every floe", positive());
     v.field("convex_parts", convex_parts, "-",
             "also write convex_parts.geojson (each floe as a MultiPolygon of convex pieces that tile it)");
+    v.field("georeference", georeference, "deg",
+            "[latitude, longitude, heading] of the image centre (WGS 84) and of its up axis (clockwise from true "
+            "north); also writes floes_wgs84.geojson for a GIS; [] = none",
+            Check<std::vector<double>>([](const std::vector<double>& g) {
+              if (g.empty()) return std::string();
+              if (g.size() != 3) return std::string("must be [] or [latitude_deg, longitude_deg, heading_deg]");
+              for (double x : g)
+                if (!std::isfinite(x)) return std::string("must be finite numbers");
+              if (std::abs(g[0]) > 90) return std::string("latitude must be in [-90, 90]");
+              if (std::abs(g[1]) > 180) return std::string("longitude must be in [-180, 180]");
+              return std::string();
+            }));
     v.field("size_bins_per_decade", size_bins_per_decade, "-", "size distribution bins per decade of diameter",
             int_in_range(1, 50));
     v.field("fit_min_diameter_m", fit_min_diameter_m, "m", "lower bound of the power-law fit (0: KS-minimising choice, Clauset et al. 2009)",

@@ -13,11 +13,15 @@ namespace floesim {
 nlohmann::json floes_to_geojson(const FloeField& field) {
   nlohmann::json fc;
   fc["type"] = "FeatureCollection";
+  // The legacy GeoJSON "crs" member (GDAL and so QGIS read it): a local engineering frame in metres, so that a GIS
+  // neither takes the metres for degrees nor places them on the map (floes_wgs84.geojson does that).
+  fc["crs"] = {{"type", "name"}, {"properties", {{"name", kLocalMetresCrs}}}};
   fc["floesim"] = {{"format", "floesim-floes/1"},
                    {"crs", "local metres: x to the right, y up, origin at the image's bottom-left corner"},
                    {"width_m", field.width_m},
                    {"height_m", field.height_m},
                    {"provenance", field.provenance}};
+  if (!field.warnings.empty()) fc["floesim"]["warnings"] = field.warnings;
   nlohmann::json feats = nlohmann::json::array();
   for (const Floe& f : field.floes) {
     nlohmann::json ring = nlohmann::json::array();
@@ -77,9 +81,20 @@ FloeField floes_from_geojson(const nlohmann::json& j, const std::string& file) {
   const nlohmann::json* features = member(j, "features");
   FLOESIM_REQUIRE(features && features->is_array(), file, ": has no \"features\" array");
   if (const nlohmann::json* fl = member(j, "floesim"); fl && fl->is_object()) {
+    const nlohmann::json* format = member(*fl, "format");
+    FLOESIM_REQUIRE(!is_string(format, "floesim-floes-wgs84/1"), file,
+                    ": is the floes in WGS 84 degrees (a map layer, floes_wgs84.geojson); give the floes in metres "
+                    "(floes.geojson beside it)");
     field.width_m = extent(*fl, "width_m", file);
     field.height_m = extent(*fl, "height_m", file);
     if (const nlohmann::json* p = member(*fl, "provenance")) field.provenance = *p;
+    if (const nlohmann::json* w = member(*fl, "warnings")) {
+      FLOESIM_REQUIRE(w->is_array(), file, ": floesim.warnings must be a list of strings");
+      for (const nlohmann::json& line : *w) {
+        FLOESIM_REQUIRE(line.is_string(), file, ": floesim.warnings must be a list of strings");
+        field.warnings.push_back(line.get<std::string>());
+      }
+    }
   }
   std::set<int> ids;
   int index = 0;

@@ -26,7 +26,15 @@ struct FloeField {
   std::vector<Floe> floes;
   double width_m = 0, height_m = 0;  // extent of the source image (0 if unknown)
   nlohmann::json provenance = nlohmann::json::object();
+  // What the stage that made the field warned of (digitise: an image of one class, ...): carried in the file's
+  // floesim member so that the simulation's summary and the report show it.
+  std::vector<std::string> warnings;
 };
+
+// The CRS floes.geojson declares (its legacy "crs" member, as WKT): a local frame in metres, x right, y up.
+inline constexpr const char* kLocalMetresCrs =
+    "LOCAL_CS[\"floesim image frame, metres (x right, y up, origin at the image's bottom-left corner)\","
+    "LOCAL_DATUM[\"image\",32767],UNIT[\"metre\",1],AXIS[\"x\",EAST],AXIS[\"y\",NORTH]]";
 
 nlohmann::json floes_to_geojson(const FloeField& field);
 // Strict: errors name the file and the feature. Rings may come in either orientation (stored CCW).

@@ -16,57 +16,57 @@ namespace floesim {
 
 const std::vector<FieldSpec>& series_fields() {
   static const std::vector<FieldSpec> k = {
-      {"time_s", 1, "s", "simulation time at the end of the step"},
-      {"vessel_position_m", 3, "m", "vessel centre of mass, world frame"},
-      {"vessel_quaternion_wxyz", 4, "-", "vessel attitude, body to world"},
-      {"vessel_velocity_mps", 3, "m/s", "vessel velocity, body axes (surge, sway, heave)"},
-      {"vessel_angular_velocity_radps", 3, "rad/s", "vessel angular velocity, body axes (roll, pitch, yaw rate)"},
-      {"ice_load", 6, "N, N m", "total ice contact load on the vessel, body axes (Fx Fy Fz Mx My Mz)"},
-      {"ice_load_rigid", 6, "N, N m", "part of ice_load from rigid contacts"},
-      {"ice_load_compliant", 6, "N, N m", "part of ice_load from compliant (crushing) contacts"},
-      {"hydro_load", 6, "N, N m", "hydrostatic + hydrodynamic load on the vessel (buoyancy, drag, resistance), body axes"},
-      {"wind_load", 6, "N, N m", "wind load on the vessel, body axes"},
-      {"propulsion_load", 6, "N, N m", "propulsion load on the vessel, body axes"},
-      {"contact_count", 1, "-", "contacts in the step (all bodies)"},
-      {"vessel_contact_count", 1, "-", "contacts on the vessel"},
-      {"solver_iterations", 1, "-", "contact solver sweeps in the step"},
-      {"solver_residual", 1, "m/s", "largest velocity change of the last sweep"},
-      {"awake_floes", 1, "-", "floes integrated this step (others sleep)"},
-      {"fracture_events", 1, "-", "fracture events in the step (floes broken, /fracture holds each event)", 2},
-      {"floe_bodies", 1, "-", "floe bodies in the world at the end of the step (pieces included)", 2},
-      {"solver_subspace_solves", 1, "-", "subspace minimisations (exact sparse solves of the settled rows) in the solve",
+      {"time_s", 1, "time_s", "s", "simulation time at the end of the step"},
+      {"vessel_position_m", 3, "x y z", "m", "vessel centre of mass, world frame"},
+      {"vessel_quaternion_wxyz", 4, "w x y z", "-", "vessel attitude, body to world"},
+      {"vessel_velocity_mps", 3, "surge sway heave", "m/s", "vessel velocity, body axes (surge, sway, heave)"},
+      {"vessel_angular_velocity_radps", 3, "roll_rate pitch_rate yaw_rate", "rad/s", "vessel angular velocity, body axes (roll, pitch, yaw rate)"},
+      {"ice_load", 6, "Fx Fy Fz Mx My Mz", "N, N m", "total ice contact load on the vessel, body axes (Fx Fy Fz Mx My Mz)"},
+      {"ice_load_rigid", 6, "Fx Fy Fz Mx My Mz", "N, N m", "part of ice_load from rigid contacts"},
+      {"ice_load_compliant", 6, "Fx Fy Fz Mx My Mz", "N, N m", "part of ice_load from compliant (crushing) contacts"},
+      {"hydro_load", 6, "Fx Fy Fz Mx My Mz", "N, N m", "hydrostatic + hydrodynamic load on the vessel (buoyancy, drag, resistance), body axes"},
+      {"wind_load", 6, "Fx Fy Fz Mx My Mz", "N, N m", "wind load on the vessel, body axes"},
+      {"propulsion_load", 6, "Fx Fy Fz Mx My Mz", "N, N m", "propulsion load on the vessel, body axes"},
+      {"contact_count", 1, "contact_count", "-", "contacts in the step (all bodies)"},
+      {"vessel_contact_count", 1, "vessel_contact_count", "-", "contacts on the vessel"},
+      {"solver_iterations", 1, "solver_iterations", "-", "contact solver sweeps in the step"},
+      {"solver_residual", 1, "solver_residual", "m/s", "largest velocity change of the last sweep"},
+      {"awake_floes", 1, "awake_floes", "-", "floes integrated this step (others sleep)"},
+      {"fracture_events", 1, "fracture_events", "-", "fracture events in the step (floes broken, /fracture holds each event)", 2},
+      {"floe_bodies", 1, "floe_bodies", "-", "floe bodies in the world at the end of the step (pieces included)", 2},
+      {"solver_subspace_solves", 1, "solver_subspace_solves", "-", "subspace minimisations (exact sparse solves of the settled rows) in the solve",
        3},
-      {"solver_capped", 1, "-", "1 if the solve stopped at the sweep cap with the tolerance unmet, else 0", 3},
-      {"solver_complementarity", 1, "m/s",
+      {"solver_capped", 1, "solver_capped", "-", "1 if the solve stopped at the sweep cap with the tolerance unmet, else 0", 3},
+      {"solver_complementarity", 1, "solver_complementarity", "m/s",
        "largest contact-law violation left by the solve (how far one more exact row update would move a velocity)", 3},
-      {"relax_iterations", 1, "-", "sweeps of the relax pass (no push-out bias), whose impulses are the recorded loads",
+      {"relax_iterations", 1, "relax_iterations", "-", "sweeps of the relax pass (no push-out bias), whose impulses are the recorded loads",
        3},
-      {"relax_residual", 1, "m/s", "largest velocity change of the relax pass's last sweep", 3},
-      {"relax_capped", 1, "-", "1 if the relax pass stopped at its sweep cap with the tolerance unmet, else 0", 3},
-      {"relax_complementarity", 1, "m/s", "largest contact-law violation left by the relax pass", 3},
-      {"solver_surge_load_error", 1, "N",
+      {"relax_residual", 1, "relax_residual", "m/s", "largest velocity change of the relax pass's last sweep", 3},
+      {"relax_capped", 1, "relax_capped", "-", "1 if the relax pass stopped at its sweep cap with the tolerance unmet, else 0", 3},
+      {"relax_complementarity", 1, "relax_complementarity", "m/s", "largest contact-law violation left by the relax pass", 3},
+      {"solver_surge_load_error", 1, "solver_surge_load_error", "N",
        "surge ice load minus the same from a second solve of the step (simulate.solver.reference; NaN if off)", 3},
-      {"ice_load_level_ice", 6, "N, N m",
+      {"ice_load_level_ice", 6, "Fx Fy Fz Mx My Mz", "N, N m",
        "part of ice_load from contacts with level ice tiles (breaking the sheet's edge; the rest is the floes and "
        "broken pieces being cleared, turned and submerged), body axes",
        6},
-      {"ice_kinetic_energy", 1, "J",
+      {"ice_kinetic_energy", 1, "ice_kinetic_energy", "J",
        "kinetic energy of the floes and pieces (translation and rotation) at the end of the step: a long run's ice "
        "must not gain energy",
        7},
-      {"ice_load_ridge_rubble", 6, "N, N m",
+      {"ice_load_ridge_rubble", 6, "Fx Fy Fz Mx My Mz", "N, N m",
        "part of ice_load from the rubble of ridges' keels and sails (simulate.ridges), body axes", 10},
-      {"ice_load_ridge_layer", 6, "N, N m",
+      {"ice_load_ridge_layer", 6, "Fx Fy Fz Mx My Mz", "N, N m",
        "part of ice_load from ridges' consolidated layers and the pieces broken from them, body axes", 10},
-      {"station_offset", 3, "m, m, rad",
+      {"station_offset", 3, "x y heading", "m, m, rad",
        "a moored or DP structure (simulate.vessel.station_keeping): its reference point's offset from its station, "
        "earth frame (x, y), and its heading's change; 0 for a ship or a fixed structure",
        8},
-      {"station_keeping_demanded", 3, "N, N, N m",
+      {"station_keeping_demanded", 3, "Fx Fy Mz", "N, N, N m",
        "a moored or DP structure's station-keeping force (x, y, yaw moment) as asked: the DP controller's command "
        "before the thrust limits (body axes), or the mooring lines' pull (the station's axes); 0 otherwise",
        8},
-      {"station_keeping_delivered", 3, "N, N, N m",
+      {"station_keeping_delivered", 3, "Fx Fy Mz", "N, N, N m",
        "the same as given: the DP thrusters' after their limits, or the mooring lines' pull",
        8},
   };
@@ -93,25 +93,159 @@ const char* fracture_mode_name(int32_t mode) {
 
 const std::vector<StructureField>& structure_fields() {
   static const std::vector<StructureField> fields = {
-      {"position_m", "m", "[3] its centre of mass, earth frame"},
-      {"quaternion_wxyz", "-", "[4] body-to-earth rotation"},
-      {"velocity_mps", "m/s", "[3] its centre of mass's velocity over the earth"},
-      {"ice_force_n", "N", "[3] the ice's force on it (every contact)"},
-      {"ice_moment_nm", "N m", "[3] the ice's moment about its reference point (its axis at the water line)"},
-      {"level_ice_force_n", "N", "[3] the part of ice_force_n from level ice tiles (breaking the sheet's edge)"},
-      {"ridge_rubble_force_n", "N", "[3] the part of ice_force_n from ridges' rubble (keels and sails; layout /10)"},
-      {"ridge_layer_force_n", "N",
+      {"position_m", "x y z", "m", "[3] its centre of mass, earth frame"},
+      {"quaternion_wxyz", "w x y z", "-", "[4] body-to-earth rotation"},
+      {"velocity_mps", "x y z", "m/s", "[3] its centre of mass's velocity over the earth"},
+      {"ice_force_n", "x y z", "N", "[3] the ice's force on it (every contact)"},
+      {"ice_moment_nm", "x y z", "N m", "[3] the ice's moment about its reference point (its axis at the water line)"},
+      {"level_ice_force_n", "x y z", "N", "[3] the part of ice_force_n from level ice tiles (breaking the sheet's edge)"},
+      {"ridge_rubble_force_n", "x y z", "N", "[3] the part of ice_force_n from ridges' rubble (keels and sails; layout /10)"},
+      {"ridge_layer_force_n", "x y z", "N",
        "[3] the part of ice_force_n from ridges' consolidated layers and their pieces (layout /10)"},
-      {"water_force_n", "N", "[3] buoyancy, damping and the water's resistance (0 for a fixed structure)"},
-      {"station_keeping_force_n", "N", "[3] its mooring lines' or thrusters' force (0 for a fixed structure)"},
-      {"offset", "m, m, rad", "[3] its reference point's offset x, y from the station, its heading's change"},
-      {"station_keeping_demanded", "N, N, N m",
+      {"water_force_n", "x y z", "N", "[3] buoyancy, damping and the water's resistance (0 for a fixed structure)"},
+      {"station_keeping_force_n", "x y z", "N", "[3] its mooring lines' or thrusters' force (0 for a fixed structure)"},
+      {"offset", "x y heading", "m, m, rad", "[3] its reference point's offset x, y from the station, its heading's change"},
+      {"station_keeping_demanded", "Fx Fy Mz", "N, N, N m",
        "[3] dp: the controller's demand (surge, sway, yaw; body axes) before its limits; moored: as delivered"},
-      {"station_keeping_delivered", "N, N, N m",
+      {"station_keeping_delivered", "Fx Fy Mz", "N, N, N m",
        "[3] dp: the thrusters' force within their limits; moored: the spread's pull in the station's axes"},
-      {"line_tension_n", "N", "[lines] moored: each line's fairlead tension, in the order of its lines"},
-      {"part_force_n", "N", "[3 x parts] the ice's force on each of its convex parts (part k: columns 3k..3k+2)"}};
+      {"line_tension_n", "line#", "N", "[lines] moored: each line's fairlead tension, in the order of its lines"},
+      {"part_force_n", "part#.x part#.y part#.z", "N", "[3 x parts] the ice's force on each of its convex parts (part k: columns 3k..3k+2)"}};
   return fields;
+}
+
+namespace {
+
+// "N, N m" over 6 columns is 3 + 3; "m, m, rad" one each; one unit for all.
+std::vector<std::string> split(const std::string& text, const std::string& sep) {
+  std::vector<std::string> out;
+  size_t at = 0;
+  for (size_t k; (k = text.find(sep, at)) != std::string::npos; at = k + sep.size()) out.push_back(text.substr(at, k - at));
+  out.push_back(text.substr(at));
+  return out;
+}
+
+std::vector<DatasetSpec> make_results_datasets() {
+  std::vector<DatasetSpec> d;
+  auto add = [&](std::string path, std::string type, std::string shape, std::string columns, std::string unit,
+                 std::string doc) { d.push_back({path, type, shape, columns, unit, doc}); };
+  for (const FieldSpec& f : series_fields())
+    add(std::string("/series/") + f.name, "float64", f.cols == 1 ? "steps" : "steps x " + std::to_string(f.cols),
+        f.columns, f.unit, f.doc);
+  add("/frames/time_s", "float64", "F", "time_s", "s", "times of the stored body states (the output interval)");
+  add("/frames/offset", "int64", "F+1", "row", "-", "rows of frame k are offset[k] .. offset[k+1]-1 of /states/*");
+  add("/states/body_id", "int32", "R", "body_id", "-",
+      "0 = vessel, k >= 1 = floe id k; frame k stores the vessel and every body that is new or whose pose or "
+      "in_contact changed since its last stored row (a body absent from a frame is unchanged, not gone)");
+  add("/states/position_m", "float64", "R x 3", "x y z", "m", "centre of mass, world frame (z up from the water)");
+  add("/states/quaternion_wxyz", "float64", "R x 4", "w x y z", "-", "body-to-world rotation");
+  add("/states/in_contact", "int8", "R", "in_contact", "-",
+      "1: a floe pressed against the vessel in the step that ends at this frame (a normal impulse), else 0");
+  add("/geometry/floe_id", "int32", "n", "floe_id", "-", "every floe that ever existed, pieces included");
+  add("/geometry/floe_thickness_m", "float64", "n", "thickness", "m", "its thickness");
+  add("/geometry/floe_level_ice", "int8", "n", "level_ice", "-",
+      "1: a tile of a level ice sheet (held by the sheet until it breaks), 0: a floe or a piece");
+  add("/geometry/floe_vertex_offset", "int64", "n+1", "row", "-",
+      "outline of floe k: rows offset[k] .. offset[k+1]-1 of floe_vertices_m");
+  add("/geometry/floe_vertices_m", "float64", "V x 2", "x y", "m",
+      "CCW outline in the floe's body frame (origin = centre of mass; the slab spans z = -h/2 .. h/2)");
+  add("/geometry/floe_parent_id", "int32", "n", "parent_id", "-", "-1 for a floe of the input field, else the id it broke from");
+  add("/geometry/floe_generation", "int32", "n", "generation", "-", "0 for input floes, the parent's + 1 for a piece");
+  add("/geometry/floe_origin_mode", "int32", "n", "origin_mode", "-",
+      "how it was made: 0 input, else the fracture mode of its event");
+  add("/geometry/floe_created_s", "float64", "n", "created", "s", "time it appeared (0 for input floes)");
+  add("/geometry/floe_ended_s", "float64", "n", "ended", "s", "time it broke up (replaced by its pieces); +inf if it lasted");
+  add("/geometry/hull_vertices_m", "float64", "Vh x 3", "x y z", "m", "hull mesh, vessel body frame (origin = centre of mass)");
+  add("/geometry/hull_triangles", "int32", "T x 3", "a b c", "-", "the mesh's triangles (rows of hull_vertices_m)");
+  add("/fracture/time_s", "float64", "E", "time_s", "s", "one row per fracture event (PHYSICS.md §2), in time order");
+  add("/fracture/parent_id", "int32", "E", "parent_id", "-", "the floe that broke (it ends at this time)");
+  add("/fracture/mode", "int32", "E", "mode", "-",
+      "1 bending, 2 radial, 3 splitting, 4 crushing (a fixed structure's crushed ice cleared from a level-ice tile)");
+  add("/fracture/at_structure", "int32", "E", "at_structure", "-", "1: at a contact with the vessel, 0: floe-floe");
+  add("/fracture/force_n", "float64", "E x 3", "x y z", "N", "contact force on the floe at failure, world frame");
+  add("/fracture/threshold_n", "float64", "E", "threshold", "N",
+      "the failure load it reached (vertical for bending/radial, horizontal for splitting)");
+  add("/fracture/point_m", "float64", "E x 3", "x y z", "m", "contact point, world frame");
+  add("/fracture/width_m", "float64", "E", "width", "m", "contact width used (never below the thickness)");
+  add("/fracture/theta_rad", "float64", "E", "theta", "rad", "wedge angle (bending/radial), 0 for splitting");
+  add("/fracture/brash_mass_kg", "float64", "E", "brash_mass", "kg",
+      "mass of pieces below the minimum size, removed; for a crushing event the crushed ice cleared");
+  add("/fracture/child_offset", "int64", "E+1", "row", "-", "pieces of event k: child_id[offset[k] .. offset[k+1]-1]");
+  add("/fracture/child_id", "int32", "C", "floe_id", "-", "floe ids of the pieces that became bodies");
+  for (const StructureField& f : structure_fields()) {
+    const std::string doc = f.doc;  // "[3] ..." gives the shape
+    const size_t close = doc.find("] ");
+    add(std::string("/structures/NAME/") + f.name, "float64", "steps x " + doc.substr(1, close - 1), f.columns,
+        f.unit, doc.substr(close + 2) + " (earth axes)");
+  }
+  add("/structures/NAME/hull_vertices_m", "float64", "V x 3", "x y z", "m", "its mesh, body frame (origin = centre of mass)");
+  add("/structures/NAME/hull_triangles", "int32", "T x 3", "a b c", "-", "the mesh's triangles");
+  return d;
+}
+
+}  // namespace
+
+const std::vector<DatasetSpec>& results_datasets() {
+  static const std::vector<DatasetSpec> d = make_results_datasets();
+  return d;
+}
+
+const DatasetSpec& results_dataset(const std::string& path) {
+  std::string key = path;
+  if (key.rfind("/structures/", 0) == 0) {  // /structures/<name>/FIELD
+    const size_t field = key.rfind('/');
+    key = "/structures/NAME" + key.substr(field);
+  }
+  for (const DatasetSpec& d : results_datasets())
+    if (d.path == key) return d;
+  throw Error("internal: the results layout has no dataset " + path);
+}
+
+std::vector<std::string> column_names(const DatasetSpec& d, size_t cols) {
+  const std::vector<std::string> names = split(d.columns, " ");
+  if (d.columns.find('#') == std::string::npos) {
+    FLOESIM_REQUIRE(names.size() == cols, "internal: ", d.path, " has ", names.size(), " column names for ", cols,
+                    " columns");
+    return names;
+  }
+  FLOESIM_REQUIRE(cols % names.size() == 0, "internal: ", d.path, ": ", cols, " columns are not groups of ",
+                  names.size());
+  std::vector<std::string> out;
+  for (size_t g = 1; g <= cols / names.size(); ++g)
+    for (const std::string& n : names) out.push_back(n.substr(0, n.find('#')) + std::to_string(g) + n.substr(n.find('#') + 1));
+  return out;
+}
+
+std::vector<std::string> column_units(const DatasetSpec& d, size_t cols) {
+  const std::vector<std::string> units = split(d.unit, ", ");
+  if (units.size() == 1) return std::vector<std::string>(cols, units[0]);
+  if (units.size() == cols) return units;
+  FLOESIM_REQUIRE(units.size() == 2 && cols % 2 == 0, "internal: ", d.path, ": units '", d.unit, "' for ", cols,
+                  " columns");
+  std::vector<std::string> out(cols / 2, units[0]);
+  out.resize(cols, units[1]);
+  return out;
+}
+
+std::string results_layout_markdown() {
+  std::string md =
+      "# The results file, `results.h5`\n\n"
+      "Generated from the field table of `pipeline/results_io.cpp` (`results_layout_markdown`; the test\n"
+      "`ResultsLayout.TheGuideIsTheCodesTable` says when this file is stale and how to rewrite it). Every dataset\n"
+      "carries the attributes `unit`, `columns` and `column_units` (one string per column) and `doc`. Shapes: `steps`\n"
+      "rows of the series, `F` frames, `R` stored states, `n` floes, `V` outline vertices, `E` fracture events,\n"
+      "`C` pieces. The root attribute `floesim` is JSON text: the layout, time step, duration, output interval, the\n"
+      "structures with their columns, and the provenance.\n\n"
+      "| dataset | type | shape | columns | unit | what |\n|---|---|---|---|---|---|\n";
+  for (const DatasetSpec& d : results_datasets()) {
+    std::string cols = d.columns;
+    for (char& c : cols)
+      if (c == ' ') c = ',';
+    std::string doc = d.doc;
+    for (size_t k; (k = doc.find('|')) != std::string::npos;) doc.replace(k, 1, "/");
+    md += "| `" + d.path + "` | " + d.type + " | " + d.shape + " | " + cols + " | " + d.unit + " | " + doc + " |\n";
+  }
+  return md;
 }
 
 size_t Results::steps() const {
@@ -168,6 +302,33 @@ std::string h5_write_reason() {
   return errno != 0 ? write_failure_reason(errno) : std::string("the disk is full, or the folder is not writable?");
 }
 
+// A string attribute: one fixed-length string, or an array of them (null-padded to the longest), which h5py reads
+// as bytes. Fixed length keeps the file's bytes the same from run to run.
+void write_string_attribute(hid_t obj, const char* key, const std::vector<std::string>& values, bool scalar,
+                            const std::string& file, const std::string& name) {
+  size_t longest = 1;
+  for (const std::string& v : values) longest = std::max(longest, v.size());
+  std::string packed(longest * values.size(), '\0');
+  for (size_t k = 0; k < values.size(); ++k) std::copy(values[k].begin(), values[k].end(), packed.begin() + k * longest);
+  H5Id st(H5Tcopy(H5T_C_S1), H5Tclose);
+  H5Tset_size(st, longest);
+  H5Tset_strpad(st, H5T_STR_NULLPAD);
+  const hsize_t n = values.size();
+  H5Id sp(scalar ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &n, nullptr), H5Sclose);
+  H5Id at(H5Acreate2(obj, key, st, sp, H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  FLOESIM_REQUIRE(at.id >= 0 && H5Awrite(at, st, packed.data()) >= 0, file, ": cannot write the attribute ", key,
+                  " of ", name, ": ", h5_write_reason());
+}
+
+// A dataset's unit, column names, column units and meaning, from the layout's table (results_datasets).
+void annotate(hid_t ds, const std::string& name, size_t cols, const std::string& file) {
+  const DatasetSpec& d = results_dataset(name);
+  write_string_attribute(ds, "unit", {d.unit}, true, file, name);
+  write_string_attribute(ds, "columns", column_names(d, cols), false, file, name);
+  write_string_attribute(ds, "column_units", column_units(d, cols), false, file, name);
+  write_string_attribute(ds, "doc", {d.doc}, true, file, name);
+}
+
 template <class T>
 void write_ds(hid_t loc, const std::string& name, const std::vector<T>& data, size_t cols, const std::string& file) {
   FLOESIM_REQUIRE(cols > 0 && data.size() % cols == 0, file, ": internal: dataset ", name, " has ", data.size(),
@@ -185,6 +346,7 @@ void write_ds(hid_t loc, const std::string& name, const std::vector<T>& data, si
   }
   H5Id ds(H5Dcreate2(loc, name.c_str(), h5type<T>(), space, H5P_DEFAULT, plist, H5P_DEFAULT), H5Dclose);
   FLOESIM_REQUIRE(ds.id >= 0, file, ": cannot create dataset ", name, ": ", h5_write_reason());
+  annotate(ds, name, cols, file);
   if (!data.empty())
     FLOESIM_REQUIRE(H5Dwrite(ds, h5type<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) >= 0, file,
                     ": cannot write dataset ", name, ": ", h5_write_reason());
@@ -228,7 +390,7 @@ std::vector<T> read_ds(hid_t file_id, const std::string& name, size_t cols, cons
 // plot and render: /1 had no fracture (no /fracture, no lineage), /2 no solver series beyond sweeps and residual,
 // /3 no /states/in_contact, /4 no /geometry/floe_level_ice, /5 no ice_load_level_ice series, /6 every alive body
 // in every frame (which FrameReplay reads like the changed bodies of /7) and no ice_kinetic_energy series.
-constexpr int kLayoutVersion = 10;
+constexpr int kLayoutVersion = 11;
 constexpr const char* kLayoutPrefix = "floesim-results/";
 std::string layout_name(int version) { return kLayoutPrefix + std::to_string(version); }
 

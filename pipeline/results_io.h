@@ -1,57 +1,26 @@
-// The simulation results artefact (HDF5), one documented layout. The table of per-step series below drives the
-// writer, the reader and the README's table; add a field here and it flows everywhere.
+// The simulation results artefact (HDF5), one documented layout. Its datasets, with shape, type, columns, units and
+// meaning, are the table results_datasets() below (pipeline/results-layout.md is generated from it, and every
+// dataset carries those as attributes); the per-step series come from series_fields(). In short:
 //
-//   /series/<name>         [steps x cols] float64   one row per time step (see series_fields())
-//   /frames/time_s         [F]            float64   times of the stored body states (output interval)
-//   /frames/offset         [F+1]          int64     rows of frame k are offset[k] .. offset[k+1]-1 of /states/*
-//   /states/body_id        [R]            int32     0 = vessel, k >= 1 = floe id k (bodies may appear later)
-//                          Frame k stores the vessel and every body that is new or whose pose or in_contact changed
-//                          since its last stored row: a body absent from a frame is unchanged, not gone. A body is
-//                          gone from the frames at and after its /geometry/floe_ended_s. FrameReplay below gives the
-//                          state of every body at a frame (a sleeping field costs nothing per frame, so a long
-//                          transit's file grows with the ice that moves, not with the field).
-//   /states/position_m     [R x 3]        float64   centre of mass, world frame (x right, y up, z up from water)
-//   /states/quaternion_wxyz[R x 4]        float64   body-to-world rotation
-//   /states/in_contact     [R]            int8      1: a floe pressed against the vessel in the step that ends at
-//                                                   this frame (a vessel contact carried a normal impulse), else 0
-//   /geometry/floe_id            [n]      int32
-//   /geometry/floe_thickness_m   [n]      float64
-//   /geometry/floe_level_ice     [n]      int8      1: a tile of a level ice sheet (fixed, held by the sheet; what
-//                                                   a wedge leaves of a tile is one too), 0: a floe or a piece
-//   /geometry/floe_vertex_offset [n+1]    int64     outline of floe k: rows offset[k] .. offset[k+1]-1
-//   /geometry/floe_vertices_m    [V x 2]  float64   CCW outline in the floe's body frame (origin = centre of mass;
-//                                                   the slab spans z = -h/2 .. h/2 in that frame)
-//   /geometry/floe_parent_id     [n]      int32     -1 for a floe of the input field, else the id it broke from
-//   /geometry/floe_generation    [n]      int32     0 for input floes, the parent's + 1 for a piece
-//   /geometry/floe_origin_mode   [n]      int32     how it was made: 0 input, else the FractureMode of its event
-//   /geometry/floe_created_s     [n]      float64   time it appeared (0 for input floes)
-//   /geometry/floe_ended_s       [n]      float64   time it broke up (replaced by its pieces); +inf if it lasted
-//   /geometry/hull_vertices_m    [Vh x 3] float64   hull mesh in the vessel body frame (origin = centre of mass)
-//   /geometry/hull_triangles     [T x 3]  int32
-//   /fracture/time_s             [E]      float64   one row per fracture event (PHYSICS.md §2), in time order
-//   /fracture/parent_id          [E]      int32     the floe that broke (it ends at this time)
-//   /fracture/mode               [E]      int32     FractureMode: 1 bending, 2 radial, 3 splitting, 4 crushing
-//                                                   (a fixed structure's crushed ice cleared from a level-ice tile)
-//   /fracture/at_structure       [E]      int32     1: at a contact with the vessel, 0: floe-floe contact
-//   /fracture/force_n            [E x 3]  float64   contact force on the floe at failure, world frame
-//   /fracture/threshold_n        [E]      float64   the failure load it reached (vertical for bending/radial,
-//                                                   horizontal for splitting)
-//   /fracture/point_m            [E x 3]  float64   contact point, world frame
-//   /fracture/width_m            [E]      float64   contact width used (never below the thickness)
-//   /fracture/theta_rad          [E]      float64   wedge angle (bending/radial), 0 for splitting
-//   /fracture/brash_mass_kg      [E]      float64   mass of pieces below the minimum size, removed (counted here);
-//                                                   for a crushing event the crushed ice cleared
-//   /fracture/child_offset       [E+1]    int64     pieces of event k: child_id[offset[k] .. offset[k+1]-1]
-//   /fracture/child_id           [C]      int32     floe ids of the pieces that became bodies
-//   /structures/NAME/FIELD       [steps x c] float64   the structures: the vessel's hull body when it is one (NAME
-//                                                   "vessel") and those beside it (simulate.structures), one
-//                                                   group each, one row per step; the root attribute's "structures"
-//                                                   lists them: name, kind, reference point and each field's columns
-//                                                   (structure_fields below). Earth axes; NAME/hull_vertices_m
-//                                                   [V x 3] and NAME/hull_triangles [T x 3] its mesh in its body
-//                                                   frame (origin = centre of mass).
-//   Layout "floesim-results/10" (this one) added the series ice_load_ridge_rubble and ice_load_ridge_layer (NaN when
-//   reading an earlier file) and the structures' fields ridge_rubble_force_n and ridge_layer_force_n. "/9" added
+//   /series/<name>      one row per time step (series_fields())
+//   /frames, /states    body states at the output interval. Frame k stores the vessel and every body that is new or
+//                       whose pose or in_contact changed since its last stored row: a body absent from a frame is
+//                       unchanged, not gone. A body is gone from the frames at and after its /geometry/floe_ended_s.
+//                       FrameReplay below gives the state of every body at a frame (a sleeping field costs nothing
+//                       per frame, so a long transit's file grows with the ice that moves, not with the field).
+//   /geometry           every floe that ever existed (outline in its body frame, thickness, level ice, lineage),
+//                       and the hull mesh in the vessel's body frame
+//   /fracture           one row per fracture event (PHYSICS.md §2), in time order, with its pieces
+//   /structures/NAME    the structures: the vessel's hull body when it is one (NAME "vessel") and those beside it
+//                       (simulate.structures), one group each, one row per step, earth axes, and each one's mesh;
+//                       the root attribute's "structures" lists them: name, kind, reference point and each field's
+//                       columns (structure_fields below).
+//   attribute "floesim" on the root: JSON text with layout version, time_step_s, duration_s,
+//   output_interval_s and the provenance.
+//
+//   Layout "floesim-results/11" (this one) added the dataset attributes unit, columns, column_units and doc (the data
+//   are those of /10). "/10" added the series ice_load_ridge_rubble and ice_load_ridge_layer (NaN when reading an
+//   earlier file) and the structures' fields ridge_rubble_force_n and ridge_layer_force_n. "/9" added
 //   /structures (none when reading an earlier file). "/8" added the
 //   fracture mode 4, crushing, and the series station_offset, station_keeping_demanded and
 //   station_keeping_delivered (NaN when reading an earlier file). "/7" stores only the
@@ -59,12 +28,10 @@
 //   layouts stored every alive body in every frame, which FrameReplay reads the same way. "/6" added the series
 //   ice_load_level_ice (NaN when reading an earlier file); "/5" added /geometry/floe_level_ice (all 0 when reading an
 //   earlier file); "/4" added /states/in_contact; "/3" added the solver series (relax sweeps and residual, subspace
-//   solves, capped steps, contact-law violations); "/2" added /fracture and the lineage datasets. "/1" to "/7" files
+//   solves, capped steps, contact-law violations); "/2" added /fracture and the lineage datasets. "/1" to "/10" files
 //   are still read: a series a file lacks is filled as FieldSpec::since says (input floes only, no events; solver
 //   figures NaN: not recorded), /states/in_contact as all 0 (not recorded: no floe is shown in contact) and
 //   /geometry/floe_level_ice as all 0.
-//   attribute "floesim" on the root: JSON text with layout version, time_step_s, duration_s,
-//   output_interval_s and the provenance.
 #pragma once
 #include <cstdint>
 #include <filesystem>
@@ -94,6 +61,7 @@ const char* fracture_mode_name(int32_t mode);  // "input", "bending", "radial", 
 struct FieldSpec {
   const char* name;
   int cols;
+  const char* columns;  // the column names, space-separated (one per column)
   const char* unit;
   const char* doc;
   int since = 1;  // the layout version (floesim-results/N) that added it
@@ -163,10 +131,33 @@ struct Results {
 // has lines or parts, see the doc), unit, doc. All earth axes; moments about its reference point.
 struct StructureField {
   const char* name;
+  const char* columns;  // space-separated; "#" is the 1-based line or part of a repeated group
   const char* unit;
   const char* doc;
 };
 const std::vector<StructureField>& structure_fields();
+
+// Every dataset of the layout, in the order of the file: the one table from which the writer takes each dataset's
+// attributes (unit, columns, column_units, doc; layout /11) and pipeline/results-layout.md is generated
+// (results_layout_markdown; a test keeps the file current). The series come from series_fields(), a structure's
+// fields from structure_fields() (path /structures/NAME/FIELD).
+struct DatasetSpec {
+  std::string path;     // e.g. "/series/ice_load", "/structures/NAME/ice_force_n"
+  std::string type;     // "float64", "int64", "int32", "int8"
+  std::string shape;    // e.g. "steps x 6", "R", "V x 2"
+  std::string columns;  // space-separated column names; "#" in a name is the 1-based index of a repeated group
+  std::string unit;     // "-" for a count, a flag or an index; per column as "N, N m" (3 + 3) or "m, m, rad"
+  std::string doc;
+};
+const std::vector<DatasetSpec>& results_datasets();
+// The spec of a dataset by its path (a structure's by /structures/<any name>/FIELD); Error if the layout has none.
+const DatasetSpec& results_dataset(const std::string& path);
+// A dataset's column names and each column's unit, for `cols` columns (a repeated group, as a mooring's lines or
+// a structure's parts, expanded to fill them). Error if they cannot fill `cols`.
+std::vector<std::string> column_names(const DatasetSpec& d, size_t cols);
+std::vector<std::string> column_units(const DatasetSpec& d, size_t cols);
+// The table as Markdown: pipeline/results-layout.md.
+std::string results_layout_markdown();
 
 // The lineage and the fracture events checked for consistency (lengths, offsets, modes, time order, ids known to
 // /geometry), as write_results and read_results do; for code that builds Results in memory. Returns the first

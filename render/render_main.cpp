@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
       std::cout << "wrote frame " << still << " to " << out << "\n";
       return;
     }
-    const auto st = floesim::render::render_video(results, config, out);
+    const auto st = floesim::render::render_video(results, config, out, &std::cout);
     std::cout << "wrote " << out << ": " << st.frames << " frames; " << st.render_ms_per_frame
               << " ms/frame rendering + " << st.encode_ms_per_frame << " ms/frame encoding; "
               << st.floes_drawn_per_frame << " floes drawn, " << st.floes_culled_per_frame

@@ -334,6 +334,22 @@ void case_section(std::ostream& body, const std::string& run_name, const fs::pat
        << scalar_text(summary.value("mean_vessel_speed_mps", Json())) << " m/s</td></tr>\n</table>\n";
 }
 
+// 3. Section "Warnings": what the stages warned of (summary.json's warnings: the floes' maker's and simulate's), on
+// the first screen, so that a result built on a degenerate input is not read as a sound one.
+void warnings_section(std::ostream& body, const Json& summary) {
+  const Json w = summary.value("warnings", Json::array());
+  body << "<h2>Warnings</h2>\n";
+  if (!w.is_array() || w.empty()) {
+    body << "<p class=\"note\" id=\"no-warnings\">No stage warned.</p>\n";
+    return;
+  }
+  body << "<ul id=\"warnings\">\n";
+  for (const Json& line : w)
+    body << "<li class=\"warning\">" << html_escape(line.is_string() ? line.get<std::string>() : line.dump())
+         << "</li>\n";
+  body << "</ul>\n";
+}
+
 // 3. Section "Mean loads", in the unit that suits their size and the references' (N for a tank model, kN for a
 // ship), and the table of references.
 void mean_loads_section(std::ostream& body, const ReportSummary& rs) {
@@ -554,6 +570,18 @@ void structure_section(std::ostream& body, const fs::path& run_dir, const Json& 
     }
 }
 
+// ", plays 5x real time (25 frames per second, one per 0.2 s simulated)" from the video's sidecar; "" without one.
+std::string playback_note(const fs::path& sidecar) {
+  if (!fs::is_regular_file(sidecar)) return "";
+  const Json side = Json::parse(read_bytes(sidecar), nullptr, false);
+  if (side.is_discarded() || !side.is_object() || !side.contains("playback_speed") ||
+      !side["playback_speed"].is_number() || !side.contains("fps") || !side["fps"].is_number())
+    return "";
+  const double speed = side["playback_speed"].get<double>(), fps = side["fps"].get<double>();
+  return fmt("; it plays %.3g", speed) + "&times; real time (" + fmt("%g", fps) + " frames per second, one per " +
+         fmt("%.3g", speed / fps) + " s simulated)";
+}
+
 // 3. Section "Video": embedded up to max_video_mb, else named beside the page; its size and embedding into rs.
 void video_section(std::ostream& body, const fs::path& run_dir, const ReportOptions& o, Page& pg, ReportSummary& rs) {
   body << "<h2>Video</h2>\n";
@@ -565,12 +593,13 @@ void video_section(std::ostream& body, const fs::path& run_dir, const ReportOpti
       pg.inputs.push_back({"video", video});
       body << "<video controls preload=\"auto\" src=\"data:video/mp4;base64,"
            << base64_encode(read_bytes(video)) << "\"></video>\n<p class=\"note\">video/transit.mp4, " << size
-           << ", embedded.</p>\n";
+           << ", embedded" << playback_note(run_dir / "video/transit.json") << ".</p>\n";
       rs.video_embedded = true;
     } else {
       body << "<p class=\"missing\" id=\"video-not-embedded\">The video video/transit.mp4 (" << size
            << ") is larger than max_video_mb = " << fmt("%g", o.max_video_mb)
-           << " MB and is not embedded: open it beside this page.</p>\n";
+           << " MB and is not embedded: open it beside this page" << playback_note(run_dir / "video/transit.json")
+           << ".</p>\n";
     }
   } else {
     pg.missing.push_back("video/transit.mp4 (video)");
@@ -618,6 +647,7 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
   const fs::path case_json = case_file(run_dir).lexically_normal();
   const std::string title = report_title(o, run_name, case_json);
   case_section(body, run_name, case_json, summary);
+  warnings_section(body, summary);
   mean_loads_section(body, rs);
   load_plot_section(body, run_dir, pg);
   identified_section(body, run_dir, pg, rs);

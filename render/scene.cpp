@@ -182,6 +182,7 @@ struct SceneRenderer::Impl {
   };
   std::vector<StructureMesh> structures;
   double steps_per_frame = 0;
+  std::string playback_label;  // ", plays 5x real time" (empty if the frame interval is unknown)
   float sky[3], water[3], edge[3], contact[3];
   std::vector<SubView> views;
   std::unique_ptr<LoadStripChart> strip;  // null without strip_chart
@@ -334,6 +335,8 @@ struct SceneRenderer::Impl {
     }
     const double dt = r.attributes.value("time_step_s", 0.0), every = r.attributes.value("output_interval_s", 0.0);
     steps_per_frame = dt > 0 ? every / dt : 0;
+    const double speed = playback_speed(r, o.fps);
+    if (std::isfinite(speed)) playback_label = ", plays " + fmt("%.3g", speed) + "x real time";
   }
 
   // A mesh's triangles into the vertex buffer: [first, first + count).
@@ -692,7 +695,8 @@ struct SceneRenderer::Impl {
     const int font = cv::FONT_HERSHEY_SIMPLEX;
     const int thick = std::max(1, int(std::lround(1.6 * s)));
     std::vector<std::string> lines = {"t = " + fmt("%.2f s", r.frame_time_s[k]),
-                                      "frame " + std::to_string(k + 1) + " / " + std::to_string(r.frames())};
+                                      "frame " + std::to_string(k + 1) + " / " + std::to_string(r.frames()) +
+                                          playback_label};
     const double v = speed(k);
     if (std::isfinite(v)) lines.push_back("speed " + fmt("%.2f m/s", v) + " (" + fmt("%.1f kn", v * 3600 / 1852) + ")");
     // Only for runs in which ice broke: without fracture a constant 0 says nothing.
@@ -843,6 +847,12 @@ void floe_top_colour(const RenderOptions& o, int32_t origin_mode, int32_t genera
   }
   const float dim = 1.0f - 0.15f * float(std::clamp(generation, 1, 4) - 1);
   for (int i = 0; i < 3; ++i) rgb[i] *= dim;
+}
+
+double playback_speed(const Results& r, double fps) {
+  double every = r.attributes.value("output_interval_s", 0.0);
+  if (!(every > 0) && r.frames() >= 2) every = r.frame_time_s[1] - r.frame_time_s[0];
+  return every > 0 && fps > 0 ? every * fps : std::nan("");
 }
 
 cv::Point2d top_view_pixel(const Results& r, const RenderOptions& o, size_t frame, double x_m, double y_m) {

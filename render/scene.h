@@ -55,6 +55,10 @@ std::vector<bool> hull_internal_faces(const std::vector<double>& v, const std::v
 // the floe it broke from and the viewer sees at a glance what broke and how.
 void floe_top_colour(const RenderOptions& o, int32_t origin_mode, int32_t generation, float rgb[3]);
 
+// How much faster than real time the video plays: simulated seconds per second of video, fps times the results'
+// frame interval (the output_interval_s attribute, else the first two frames' spacing); NaN if neither is known.
+double playback_speed(const Results& r, double fps);
+
 // The pixel at which the top view shows world point (x, y) in results frame `frame` (for tests and overlays):
 // the view is centred on the vessel, north up, top_width_m across.
 cv::Point2d top_view_pixel(const Results& r, const RenderOptions& o, size_t frame, double x_m, double y_m);

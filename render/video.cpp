@@ -1,6 +1,7 @@
 #include "render/video.h"
 
 #include <chrono>
+#include <cmath>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
@@ -8,6 +9,7 @@
 #include "pipeline/atomic_file.h"
 #include "pipeline/error.h"
 #include "pipeline/interrupt.h"
+#include "pipeline/progress.h"
 #include "pipeline/provenance.h"
 #include "render/scene.h"
 
@@ -20,7 +22,7 @@ RenderOptions read_render_options(const fs::path& config) {
 }
 
 RenderStats render_video(const Results& r, const RenderOptions& o, const fs::path& out_mp4,
-                         const nlohmann::json& provenance, const std::string& source) {
+                         const nlohmann::json& provenance, const std::string& source, std::ostream* progress) {
   using clock = std::chrono::steady_clock;
   FLOESIM_REQUIRE(out_mp4.extension() == ".mp4", out_mp4.string(),
                   ": the video must be an .mp4 file (H.264 in MP4 plays everywhere)");
@@ -42,6 +44,8 @@ RenderStats render_video(const Results& r, const RenderOptions& o, const fs::pat
   cv::Mat frame;
   // SIGINT/SIGTERM stop the loop between two frames; the temporary video is then removed (pipeline/interrupt.h).
   InterruptPolling polling;
+  const auto start = clock::now();
+  ProgressLine line(progress, static_cast<long>(n));
   for (size_t k = 0; k < n; ++k) {
     check_interrupt();
     const auto t0 = clock::now();
@@ -53,6 +57,10 @@ RenderStats render_video(const Results& r, const RenderOptions& o, const fs::pat
     encode_s += std::chrono::duration<double>(t2 - t1).count();
     st.floes_drawn_per_frame += static_cast<double>(scene.last_stats().floes_drawn);
     st.floes_culled_per_frame += static_cast<double>(scene.last_stats().floes_culled);
+    const long done = static_cast<long>(k + 1);
+    if (line.due(done))
+      line.print(done, std::chrono::duration<double>(clock::now() - start).count(),
+                 "frame " + std::to_string(done) + " / " + std::to_string(n));
   }
   const auto t3 = clock::now();
   writer.release();  // flushes the encoder's delayed frames and writes the MP4 index
@@ -86,6 +94,9 @@ RenderStats render_video(const Results& r, const RenderOptions& o, const fs::pat
       {"height_px", o.height_px},
       {"fps", o.fps},
       {"duration_s", static_cast<double>(n) / o.fps},
+      // Simulated seconds per second of video (fps x the frame interval): "plays 5x real time".
+      {"playback_speed", std::isfinite(playback_speed(r, o.fps)) ? nlohmann::json(playback_speed(r, o.fps))
+                                                                  : nlohmann::json()},
       {"simulated_time_s", {r.frame_time_s.front(), r.frame_time_s[n - 1]}},
       {"view", o.view},
       {"split_views", o.view == "split" ? nlohmann::json(o.split_views) : nlohmann::json()},
@@ -105,11 +116,12 @@ RenderStats render_video(const Results& r, const RenderOptions& o, const fs::pat
 // PHYSICS.md §5); the others stay on disk.
 const std::set<std::string> kRenderSeries = {"time_s", "ice_load", "ice_load_rigid", "ice_load_compliant"};
 
-RenderStats render_video(const fs::path& results, const fs::path& config, const fs::path& out_mp4) {
+RenderStats render_video(const fs::path& results, const fs::path& config, const fs::path& out_mp4,
+                         std::ostream* progress) {
   const RenderOptions o = read_render_options(config);
   const Results r = read_results(results, true, kRenderSeries);
   const auto prov = make_provenance("floesim-render", {{"results", results}, {"config", config}}, options_to_json(o));
-  return render_video(r, o, out_mp4, prov, results.string());
+  return render_video(r, o, out_mp4, prov, results.string(), progress);
 }
 
 void render_still(const fs::path& results, const fs::path& config, size_t frame, const fs::path& out_image) {

@@ -2,6 +2,7 @@
 // JSON sidecar (provenance, frame count). floesim-render is a thin main over render_video().
 #pragma once
 #include <filesystem>
+#include <iosfwd>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -25,12 +26,14 @@ struct RenderStats {
 };
 
 // Renders frames [0, min(frames, max_frames)) of `r` to `out_mp4` (must end in .mp4) and writes the sidecar
-// <out without extension>.json holding `provenance` and the frame count. Both appear only when complete.
+// <out without extension>.json holding `provenance`, the frame count and the playback speed. Both appear only when
+// complete. `progress` (may be null) gets a line with the time left every 10 % of the frames (pipeline/progress.h).
 RenderStats render_video(const Results& r, const RenderOptions& o, const std::filesystem::path& out_mp4,
-                         const nlohmann::json& provenance, const std::string& source);
+                         const nlohmann::json& provenance, const std::string& source,
+                         std::ostream* progress = nullptr);
 // The stage: reads the config first (cheap errors first), then the results.
 RenderStats render_video(const std::filesystem::path& results, const std::filesystem::path& config,
-                         const std::filesystem::path& out_mp4);
+                         const std::filesystem::path& out_mp4, std::ostream* progress = nullptr);
 
 // One frame as an image (PNG/JPEG by extension) for reports and for checking a look without encoding a video.
 void render_still(const std::filesystem::path& results, const std::filesystem::path& config, size_t frame,

@@ -20,6 +20,9 @@ struct SimulateOptions : EngineSettings {
   // to a fraction of a second (the world's state plus the results recorded since the last one, written once), while
   // 10 s of a large field take minutes of wall time; a stopped run then loses at most that much.
   double checkpoint_interval_s = 10.0;
+  // Also write OUT/paraview (results.pvd and a .vtp per frame: pipeline/vtk_series.h). Off by default: every frame
+  // holds the whole field, ~20 bytes per floe vertex, which for a long run is far more than results.h5.
+  bool paraview = false;
   HullLoadOptions hull;
 
   template <class V>
@@ -36,6 +39,8 @@ struct SimulateOptions : EngineSettings {
             "simulated time between checkpoints in OUT/checkpoint (a whole number of time steps; 0 = none); "
             "--resume continues from the last one with byte-identical results",
             non_negative());
+    v.field("paraview", paraview, "-",
+            "also write OUT/paraview/results.pvd, a VTK series of the floes and hull per frame for ParaView");
     v.section("ice", ice, "ice material");
     v.section("water", water, "water, gravity and current");
     v.section("vessel", vessel, "vessel start, mass, resistance, propulsion, steering");

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -12,8 +13,10 @@
 #include "pipeline/error.h"
 #include "pipeline/floes_io.h"
 #include "pipeline/interrupt.h"
+#include "pipeline/progress.h"
 #include "pipeline/provenance.h"
 #include "pipeline/units.h"
+#include "pipeline/vtk_series.h"
 #include "sim/engine/ridge_build.h"
 #include "sim/engine/world.h"
 #include "sim/simulate/checkpoint.h"
@@ -91,9 +94,10 @@ Results simulate(const SimulateOptions& o, Model model, RunStats& stats, std::os
   auto wall_now = [&] { return sums.wall_s + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
 
   // 2. The steps: step, record, checkpoint every checkpoint_interval_s (not after the last step: the results
-  // follow), a progress line every 10 %.
+  // follow), a progress line with the time left every 10 % (pipeline/progress.h).
   {
     InterruptPolling polling;
+    ProgressLine line(progress, steps);
     for (long k = first; k <= steps; ++k) {
       stop_if_interrupted(*world, cp.get(), checkpoint_every, r, sums, wall_now());
       world->step();
@@ -107,11 +111,12 @@ Results simulate(const SimulateOptions& o, Model model, RunStats& stats, std::os
         ++stats.checkpoints;
         sums.wall_s = before;
       }
-      if (progress && (k * 10) % steps < 10 && k != steps) {
+      if (line.due(k)) {
         const StepReport& rep = world->report();
-        *progress << "  t = " << std::fixed << std::setprecision(1) << world->state().time_s << " s  ("
-                  << (k * 100) / steps << " %, " << std::setprecision(1) << wall_now() << " s wall, awake floes "
-                  << rep.awake_floes << ", contacts " << rep.contacts << ")" << std::defaultfloat << std::endl;
+        char head[48];
+        std::snprintf(head, sizeof head, "t = %.1f s", world->state().time_s);
+        line.print(k, wall_now(), head,
+                   ", awake floes " + std::to_string(rep.awake_floes) + ", contacts " + std::to_string(rep.contacts));
       }
     }
   }
@@ -199,11 +204,18 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   nlohmann::json summary = summarize(o, world->model(), results, series);
   if (!world->model().settings.ridges.empty())
     summary["ridges"] = ridge_summary(o, world->model(), settled, series, world->state());
+  // Every warning of the stages before (the floes' maker) and of this one, for the report.
+  nlohmann::json warnings = nlohmann::json::array();
+  for (const std::string& w : field.warnings) warnings.push_back("floes (" + floes_file.filename().string() + "): " + w);
+  summary["warnings"] = warnings;
   summary["settings"] = options_to_json(o);
   summary["provenance"] = prov;
 
   // 3. Artefacts, atomically; then the checkpoint has served.
   write_results(out_dir / "results.h5", results, series);
+  if (o.paraview)  // from the file: it holds the series of a long run that left them on disk
+    write_vtk_series(read_results(out_dir / "results.h5", true, {"ice_load"}), out_dir / "paraview",
+                     (out_dir / "results.h5").string());
   write_text_atomic(out_dir / "summary.json", summary.dump(2) + "\n");
   remove_checkpoint(checkpoints.dir);
 

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include "pipeline/options.h"
+#include "pipeline/results_io.h"
 #include "pipeline/stage_main.h"
 #include "sim/simulate/simulate.h"
 
@@ -12,7 +13,7 @@ int main(int argc, char** argv) {
                "drag, ITTC-57 resistance, propulsion) and writes DIR/results.h5 and DIR/summary.json.",
                "floesim-simulate"};
   std::string floes, hull, config, out;
-  bool help_config = false, check_config = false, resume = false;
+  bool help_config = false, check_config = false, resume = false, results_layout = false;
   app.add_option("--floes", floes, "floe field GeoJSON (floesim-digitise output)");
   app.add_option("--hull", hull, "hull mesh (OBJ of convex parts, e.g. floesim-hull output)");
   app.add_option("--config", config, "JSON object of simulate options (see --help-config)");
@@ -22,7 +23,13 @@ int main(int argc, char** argv) {
                "and settings (else an error says what differs); without one, start from t = 0");
   app.add_flag("--check-config", check_config, "read and check --config (strictly, as a run would), write nothing");
   app.add_flag("--help-config", help_config, "print the simulate options as a Markdown table and exit");
+  app.add_flag("--results-layout", results_layout,
+               "print the layout of results.h5 as a Markdown table (pipeline/results-layout.md) and exit");
   return floesim::run_stage(app, argc, argv, [&] {
+    if (results_layout) {
+      std::cout << floesim::results_layout_markdown();
+      return;
+    }
     if (help_config) {
       const floesim::sim::SimulateOptions defaults;  // named: GCC 12 misreads a temporary's strings as uninitialised
       std::cout << floesim::options_doc(defaults);

@@ -41,7 +41,23 @@ TEST(FloesIo, RoundTripKeepsGeometryAndIds) {
   EXPECT_DOUBLE_EQ(g.floes[0].area_m2, 8.0);
   EXPECT_DOUBLE_EQ(g.floes[0].thickness_m, 0.7);
   EXPECT_EQ(g.width_m, 100);
+  EXPECT_TRUE(g.warnings.empty());
   fs::remove(p);
+}
+
+// The file declares its CRS (a local frame in metres, so that a GIS does not read degrees) and carries its maker's
+// warnings to the simulation, which puts them into summary.json.
+TEST(FloesIo, TheCrsIsDeclaredAndWarningsRoundTrip) {
+  FloeField f;
+  f.floes.push_back({1, {{0, 0}, {4, 0}, {4, 2}, {0, 2}}, 8.0, 1.0});
+  f.warnings = {"image.png: no water found"};
+  const nlohmann::json j = floes_to_geojson(f);
+  EXPECT_EQ(j["crs"]["type"], "name");
+  EXPECT_EQ(j["crs"]["properties"]["name"].get<std::string>().rfind("LOCAL_CS[", 0), 0u);
+  EXPECT_EQ(floes_from_geojson(j, "f.geojson").warnings, f.warnings);
+  nlohmann::json bad = j;
+  bad["floesim"]["warnings"] = "one";
+  EXPECT_NE(error_of(bad).find("floesim.warnings"), std::string::npos);
 }
 
 TEST(FloesIo, ClockwiseRingsAreStoredCounterClockwise) {

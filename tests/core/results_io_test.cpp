@@ -6,6 +6,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <map>
 
 #include "pipeline/error.h"
 #include "pipeline/provenance.h"
@@ -218,7 +219,7 @@ TEST(ResultsIo, FractureEventsAndLineageRoundTrip) {
   const Results r = fractured_results();
   write_results(p, r);
   const Results b = read_results(p);
-  EXPECT_EQ(b.attributes["layout"], "floesim-results/10");
+  EXPECT_EQ(b.attributes["layout"], "floesim-results/11");
   EXPECT_EQ(b.floe_id, r.floe_id);
   EXPECT_EQ(b.floe_vertices_m, r.floe_vertices_m);
   EXPECT_EQ(b.floe_parent_id, r.floe_parent_id);
@@ -407,12 +408,12 @@ TEST(ResultsIo, LayoutOneFilesFromBeforeFractureReadWithDefaults) {
   // Rewritten, it becomes a file of the current layout with the same content.
   const fs::path q = fs::temp_directory_path() / "floesim_results_layout1_rewritten.h5";
   write_results(q, r);
-  EXPECT_EQ(read_results(q).attributes["layout"], "floesim-results/10");
+  EXPECT_EQ(read_results(q).attributes["layout"], "floesim-results/11");
   fs::remove(q);
 
   // A layout from the future is refused, naming it.
   write_results(p, small_results(2));
-  replace_attributes(p, {{"layout", "floesim-results/11"}});
+  replace_attributes(p, {{"layout", "floesim-results/12"}});
   const std::string e = error_of([&] { read_results(p); });
   EXPECT_NE(e.find("floesim-results/11"), std::string::npos) << e;
   fs::remove(p);
@@ -494,4 +495,102 @@ TEST(ResultsIo, DamagedShapesAttributesAndOffsetsAreClearErrors) {
   replace_dataset<double>(p, "/states/quaternion_wxyz", {1, 0, 0, 0}, 4);
   expect_error("/states arrays have different lengths");
   fs::remove(p);
+}
+
+namespace {
+
+// A string attribute of an HDF5 object as its strings (one for a scalar), read with the C API alone.
+std::vector<std::string> string_attribute(hid_t obj, const char* key) {
+  if (H5Aexists(obj, key) <= 0) return {};
+  const hid_t at = H5Aopen(obj, key, H5P_DEFAULT), type = H5Aget_type(at), space = H5Aget_space(at);
+  const size_t size = H5Tget_size(type), n = static_cast<size_t>(H5Sget_simple_extent_npoints(space));
+  std::string buf(size * n, '\0');
+  const hid_t mem = H5Tcopy(H5T_C_S1);
+  H5Tset_size(mem, size);
+  H5Tset_strpad(mem, H5T_STR_NULLPAD);
+  H5Aread(at, mem, buf.data());
+  std::vector<std::string> out;
+  for (size_t k = 0; k < n; ++k) {
+    std::string v = buf.substr(k * size, size);
+    out.push_back(v.substr(0, v.find('\0')));
+  }
+  H5Tclose(mem), H5Sclose(space), H5Tclose(type), H5Aclose(at);
+  return out;
+}
+
+struct DatasetSeen {
+  std::string path;
+  size_t cols;
+  std::vector<std::string> unit, columns, column_units, doc;
+};
+
+herr_t visit_dataset(hid_t obj, const char* name, const H5O_info_t* info, void* data) {
+  if (info->type != H5O_TYPE_DATASET) return 0;
+  const hid_t ds = H5Dopen2(obj, name, H5P_DEFAULT), space = H5Dget_space(ds);
+  hsize_t dims[2] = {0, 1};
+  H5Sget_simple_extent_dims(space, dims, nullptr);
+  const size_t cols = H5Sget_simple_extent_ndims(space) == 2 ? dims[1] : 1;
+  static_cast<std::vector<DatasetSeen>*>(data)->push_back(
+      {std::string("/") + name, cols, string_attribute(ds, "unit"), string_attribute(ds, "columns"),
+       string_attribute(ds, "column_units"), string_attribute(ds, "doc")});
+  H5Sclose(space), H5Dclose(ds);
+  return 0;
+}
+
+}  // namespace
+
+// Layout /11: every dataset the file holds, whatever writes it, names its columns and units, one per column of its
+// own shape; the loads' six columns are three forces in N and three moments in N m.
+TEST(ResultsLayout, EveryDatasetCarriesItsUnitAndColumnNames) {
+  Results r = small_results(3);
+  r.attributes["structures"] = {{{"name", "buoy"}, {"columns", {{"line_tension_n", 2}, {"part_force_n", 6}}}}};
+  r.structure_series["buoy/line_tension_n"] = std::vector<double>(3 * 2, 1.0);
+  r.structure_series["buoy/part_force_n"] = std::vector<double>(3 * 6, 2.0);
+  r.structure_hull_vertices_m["buoy"] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  r.structure_hull_triangles["buoy"] = {0, 1, 2};
+  const fs::path p = fs::temp_directory_path() / "floesim_results_attributes.h5";
+  write_results(p, r);
+  std::vector<DatasetSeen> seen;
+  const hid_t f = H5Fopen(p.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  H5Ovisit2(f, H5_INDEX_NAME, H5_ITER_NATIVE, visit_dataset, &seen, H5O_INFO_BASIC);
+  H5Fclose(f);
+  fs::remove(p);
+  ASSERT_GT(seen.size(), series_fields().size() + 30);
+  std::map<std::string, DatasetSeen> by_path;
+  for (const DatasetSeen& d : seen) {
+    by_path[d.path] = d;
+    EXPECT_EQ(d.unit.size(), 1u) << d.path;
+    EXPECT_EQ(d.doc.size(), 1u) << d.path;
+    EXPECT_FALSE(d.doc.empty() || d.doc[0].empty()) << d.path;
+    EXPECT_EQ(d.columns.size(), d.cols) << d.path << ": one name per column";
+    EXPECT_EQ(d.column_units.size(), d.cols) << d.path << ": one unit per column";
+    for (const std::string& c : d.columns) EXPECT_FALSE(c.empty() || c.find(' ') != std::string::npos) << d.path;
+  }
+  EXPECT_EQ(by_path["/series/ice_load"].columns, (std::vector<std::string>{"Fx", "Fy", "Fz", "Mx", "My", "Mz"}));
+  EXPECT_EQ(by_path["/series/ice_load"].column_units, (std::vector<std::string>{"N", "N", "N", "N m", "N m", "N m"}));
+  EXPECT_EQ(by_path["/series/station_offset"].column_units, (std::vector<std::string>{"m", "m", "rad"}));
+  EXPECT_EQ(by_path["/states/quaternion_wxyz"].columns, (std::vector<std::string>{"w", "x", "y", "z"}));
+  EXPECT_EQ(by_path["/frames/time_s"].unit, std::vector<std::string>{"s"});
+  EXPECT_EQ(by_path["/structures/buoy/line_tension_n"].columns, (std::vector<std::string>{"line1", "line2"}));
+  EXPECT_EQ(by_path["/structures/buoy/part_force_n"].columns,
+            (std::vector<std::string>{"part1.x", "part1.y", "part1.z", "part2.x", "part2.y", "part2.z"}));
+  // Every dataset of the file is in the layout's table, and every one of the table in the file.
+  for (const DatasetSpec& d : results_datasets()) {
+    std::string path = d.path;
+    if (path.rfind("/structures/NAME/", 0) == 0) {
+      if (path.find("line_tension") == std::string::npos && path.find("part_force") == std::string::npos &&
+          path.find("hull_") == std::string::npos)
+        continue;  // this structure records only those two fields
+      path.replace(12, 4, "buoy");
+    }
+    EXPECT_TRUE(by_path.count(path)) << path << " is in the table but not in the file";
+  }
+}
+
+// pipeline/results-layout.md is the code's table: regenerate it when the layout changes.
+TEST(ResultsLayout, TheGuideIsTheCodesTable) {
+  const fs::path guide = fs::path(FLOESIM_SOURCE_DIR) / "pipeline" / "results-layout.md";
+  EXPECT_EQ(floesim::tests::read_text(guide), results_layout_markdown())
+      << guide << " is stale: rewrite it with `build/bin/floesim-simulate --results-layout > pipeline/results-layout.md`";
 }

@@ -335,12 +335,15 @@ TEST(DigitiseSynthetic, OpenWaterAndAllIceGiveCorrectResultsWithAWarning) {
   cv::Mat water(200, 300, CV_8U), ice(200, 300, CV_8U);
   cv::randu(water, 35, 55);
   cv::randu(ice, 205, 225);
-  const DigitiseResult w = digitise(water, 1.0, DigitiseOptions{}, "water.png");
+  // An image of one class is refused unless it is meant (imaging_input_test checks the refusal).
+  DigitiseOptions one_class;
+  one_class.allow_one_class = true;
+  const DigitiseResult w = digitise(water, 1.0, one_class, "water.png");
   EXPECT_EQ(w.floes.floes.size(), 0u);
   EXPECT_EQ(w.stats["ice_concentration"].get<double>(), 0.0);
   ASSERT_EQ(w.warnings.size(), 1u);
   EXPECT_NE(w.warnings[0].find("no ice"), std::string::npos) << w.warnings[0];
-  const DigitiseResult i = digitise(ice, 1.0, DigitiseOptions{}, "ice.png");
+  const DigitiseResult i = digitise(ice, 1.0, one_class, "ice.png");
   ASSERT_EQ(i.floes.floes.size(), 1u);
   EXPECT_NEAR(i.stats["ice_concentration"].get<double>(), 1.0, 1e-12);
   // The outline may deviate from the pixel area by the simplification tolerance along its perimeter.

@@ -321,3 +321,29 @@ TEST_F(TinyRun, NoSummaryIsAnErrorAndWritesNothing) {
     EXPECT_EQ(e.path().filename().string().find("report"), std::string::npos) << e.path();
   }
 }
+
+// Every stage's warnings on the first screen (issue #37, part 3): the tiny run has none and says so; a warning of
+// the floes' maker carried into summary.json is listed, escaped. The video's sidecar and note say how fast it plays:
+// the case's output interval times the frames per second.
+TEST_F(TinyRun, WarningsAndThePlaybackSpeedAreOnThePage) {
+  ASSERT_EQ(ran_.code, 0) << ran_.text;
+  const Json summary = load_json_file(run_ / "sim/summary.json");
+  ASSERT_TRUE(summary.contains("warnings")) << "summary.json lists the warnings, also when there are none";
+  EXPECT_TRUE(summary["warnings"].empty());
+  write_report(run_, ReportOptions{}, root_ / "nowarn.html", Json::object());
+  const std::string clean = read_text(root_ / "nowarn.html");
+  EXPECT_NE(clean.find("No stage warned."), std::string::npos);
+  const Json side = load_json_file(run_ / "video/transit.json");
+  const double every = load_json_file(run_ / "config/simulate.json").value("output_interval_s", 0.2);
+  EXPECT_DOUBLE_EQ(side["playback_speed"].get<double>(), every * side["fps"].get<double>());
+  EXPECT_NE(clean.find("real time ("), std::string::npos);
+  const fs::path run = copy_run("warned");
+  Json s = summary;
+  s["warnings"] = {"floes (floes.geojson): image.png: no water found <one class>"};
+  std::ofstream(run / "sim/summary.json") << s.dump(2);
+  write_report(run, ReportOptions{}, root_ / "warned.html", Json::object());
+  const std::string html = read_text(root_ / "warned.html");
+  EXPECT_NE(html.find("<li class=\"warning\">floes (floes.geojson): image.png: no water found &lt;one class&gt;</li>"),
+            std::string::npos);
+  EXPECT_LT(html.find("<h2>Warnings</h2>"), html.find("<h2>Video</h2>")) << "before the details";
+}

@@ -1,0 +1,48 @@
+#include "imaging/georeference.h"
+
+#include <cmath>
+
+#include <GeographicLib/AzimuthalEquidistant.hpp>
+#include <GeographicLib/Geodesic.hpp>
+
+#include "pipeline/error.h"
+
+namespace floesim::imaging {
+
+GeoReference georeference_from(const std::vector<double>& v, const std::string& where) {
+  FLOESIM_REQUIRE(v.size() == 3, where, ": georeference must be [latitude_deg, longitude_deg, heading_deg] (the image "
+                  "centre's WGS 84 position and its up axis clockwise from true north), got ", v.size(), " numbers");
+  for (double x : v) FLOESIM_REQUIRE(std::isfinite(x), where, ": georeference must be finite numbers");
+  FLOESIM_REQUIRE(std::abs(v[0]) <= 90, where, ": georeference latitude ", v[0], " is not in [-90, 90]");
+  FLOESIM_REQUIRE(std::abs(v[1]) <= 180, where, ": georeference longitude ", v[1], " is not in [-180, 180]");
+  return {v[0], v[1], v[2]};
+}
+
+std::array<double, 2> image_to_wgs84(const GeoReference& g, double width_m, double height_m, double x_m, double y_m) {
+  // Offsets from the centre along the image's right and up axes, turned into east and north by the heading.
+  const double dx = x_m - width_m / 2, dy = y_m - height_m / 2;
+  const double h = g.heading_deg * M_PI / 180, east = dx * std::cos(h) + dy * std::sin(h),
+               north = -dx * std::sin(h) + dy * std::cos(h);
+  static const GeographicLib::AzimuthalEquidistant map(GeographicLib::Geodesic::WGS84());
+  double lat = 0, lon = 0, azimuth = 0, scale = 0;
+  map.Reverse(g.latitude_deg, g.longitude_deg, east, north, lat, lon, azimuth, scale);
+  return {lon, lat};
+}
+
+nlohmann::json floes_to_wgs84_geojson(const FloeField& field, const GeoReference& g) {
+  nlohmann::json fc = floes_to_geojson(field);
+  fc["crs"] = {{"type", "name"}, {"properties", {{"name", "urn:ogc:def:crs:OGC:1.3:CRS84"}}}};
+  fc["floesim"]["format"] = "floesim-floes-wgs84/1";
+  fc["floesim"]["crs"] = "WGS 84 longitude, latitude (degrees); from the image frame of floes.geojson";
+  fc["floesim"]["georeference"] = {{"latitude_deg", g.latitude_deg},
+                                   {"longitude_deg", g.longitude_deg},
+                                   {"heading_deg", g.heading_deg}};
+  for (nlohmann::json& feature : fc["features"])
+    for (nlohmann::json& vertex : feature["geometry"]["coordinates"][0]) {
+      const auto ll = image_to_wgs84(g, field.width_m, field.height_m, vertex[0].get<double>(), vertex[1].get<double>());
+      vertex = {ll[0], ll[1]};
+    }
+  return fc;
+}
+
+}  // namespace floesim::imaging

@@ -1,0 +1,36 @@
+// Where a digitised image lies on the Earth: its centre's latitude and longitude (WGS 84) and the heading of its
+// up axis (degrees clockwise from true north), given in the case (digitise.georeference). The floes of
+// floes.geojson are in the image's own metres (x right, y up, origin at the bottom-left corner: the frame the
+// simulation works in); with a georeference they are also written in WGS 84 longitude and latitude
+// (floes_wgs84.geojson, RFC 7946) so that a GIS (QGIS) places them on a map.
+#pragma once
+#include <array>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "pipeline/floes_io.h"
+
+namespace floesim::imaging {
+
+struct GeoReference {
+  double latitude_deg = 0;   // the image centre
+  double longitude_deg = 0;
+  double heading_deg = 0;    // the image's up axis, clockwise from true north
+};
+
+// The option's value [latitude_deg, longitude_deg, heading_deg] (empty: none) as a GeoReference; Error naming the
+// key if it is not three finite numbers with the latitude in [-90, 90] and the longitude in [-180, 180].
+GeoReference georeference_from(const std::vector<double>& values, const std::string& where);
+
+// [longitude, latitude] in degrees of the image point (x, y) metres (image frame) of an image width_m x height_m.
+// The image is taken as an azimuthal equidistant map about its centre on the WGS 84 ellipsoid (GeographicLib): a
+// photograph of a few kilometres differs from any other map projection there by far less than a pixel.
+std::array<double, 2> image_to_wgs84(const GeoReference& g, double width_m, double height_m, double x_m, double y_m);
+
+// The floes as a GeoJSON FeatureCollection in WGS 84 (longitude, latitude; CRS84), with the same ids and
+// properties; its floesim member names the format floesim-floes-wgs84/1 (a map layer: the simulation reads the
+// metres of floes.geojson, and refuses this one).
+nlohmann::json floes_to_wgs84_geojson(const FloeField& field, const GeoReference& g);
+
+}  // namespace floesim::imaging
