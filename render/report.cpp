@@ -307,31 +307,94 @@ std::string report_title(const ReportOptions& o, const std::string& run_name, co
   return title;
 }
 
-// 3. Section "Case": the run folder, the case file and its description, the steady part, contact model, floes and
-// speed.
-void case_section(std::ostream& body, const std::string& run_name, const fs::path& case_json, const Json& summary) {
-  body << "<h2>Case</h2>\n<table>\n<tr><th>run folder</th><td>" << html_escape(run_name) << "</td></tr>\n";
-  if (const fs::path& cf = case_json; !cf.empty()) {
-    body << "<tr><th>case file</th><td>" << html_escape(cf.string()) << "</td></tr>\n";
-    if (fs::is_regular_file(cf)) {
-      try {
-        const Json c = load_json_file(cf);
-        if (c.contains("description") && c["description"].is_string())
-          body << "<tr><th>description</th><td>" << html_escape(c["description"].get<std::string>())
-               << "</td></tr>\n";
-      } catch (const Error&) {
-        // The case file changed since the run and no longer reads: the settings below are what ran.
-      }
+// A JSON file of the run, or null if it is absent or does not read (the section then says less, not wrong).
+Json optional_json(Page& pg, const std::string& rel, const std::string& role) {
+  if (!fs::is_regular_file(pg.run / rel)) return Json();
+  try {
+    return pg.json(rel, role);
+  } catch (const Error&) {
+    return Json();
+  }
+}
+
+// "116 m", "2.00 m/s": a number with its unit, NaN as a dash.
+std::string quantity(double x, const char* format, const char* unit) {
+  return std::isfinite(x) ? html_escape(fmt(format, x)) + "&nbsp;" + unit : "&ndash;";
+}
+
+// How the vessel was driven, from the simulation's settings.
+std::string propulsion_text(const Json& settings) {
+  const Json* p = find(settings, {"vessel", "propulsion"});
+  if (!p || !p->is_object()) return "&ndash;";
+  const std::string mode = p->value("mode", "");
+  if (mode == "speed")
+    return "held at " + quantity(number_or_nan(*p, {"speed_mps"}), "%.2f", "m/s") + " (thrust by a PI controller, at most " +
+           quantity(number_or_nan(*p, {"max_thrust_n"}) / 1e3, "%.0f", "kN") + ")";
+  if (mode == "constant_thrust") return "constant thrust " + quantity(number_or_nan(*p, {"thrust_n"}) / 1e3, "%.0f", "kN");
+  if (mode == "bollard_pull") return "bollard pull, " + quantity(number_or_nan(*p, {"thrust_n"}) / 1e3, "%.0f", "kN");
+  if (mode == "thrust_series") return "thrust series from " + html_escape(p->value("thrust_file", std::string("?")));
+  return html_escape(mode);
+}
+
+// 3. Section "What was run" (the first screen): the case, the hull and its main particulars, the ice, how the
+// vessel was driven and the speed it made, the simulated time and the steady part, each with a label a reader knows
+// and its unit.
+void case_section(std::ostream& body, const std::string& run_name, const fs::path& case_json, const Json& summary,
+                  Page& pg) {
+  std::vector<std::pair<std::string, std::string>> rows;
+  if (const fs::path& cf = case_json; !cf.empty() && fs::is_regular_file(cf)) {
+    try {
+      const Json c = load_json_file(cf);
+      if (c.contains("description") && c["description"].is_string())
+        rows.push_back({"Case", html_escape(c["description"].get<std::string>())});
+    } catch (const Error&) {
+      // The case file changed since the run and no longer reads: the settings below are what ran.
     }
   }
-  if (const Json* sp = find(summary, {"steady_part"}))
-    body << "<tr><th>steady part</th><td>" << scalar_text((*sp).value("from_s", Json())) << " s to "
-         << scalar_text((*sp).value("to_s", Json())) << " s (" << scalar_text((*sp).value("samples", Json()))
-         << " samples)</td></tr>\n";
-  body << "<tr><th>contact model</th><td>" << scalar_text(summary.value("contact_model", Json()))
-       << "</td></tr>\n<tr><th>floes</th><td>" << scalar_text(summary.value("floes", Json()))
-       << "</td></tr>\n<tr><th>mean vessel speed</th><td>"
-       << scalar_text(summary.value("mean_vessel_speed_mps", Json())) << " m/s</td></tr>\n</table>\n";
+  const Json settings = summary.value("settings", Json::object());
+  const Json hull = optional_json(pg, "hull/hull.json", "hull particulars");
+  if (const Json* pt = find(hull, {"particulars"})) {
+    std::string h = "length " + quantity(number_or_nan(*pt, {"length_m"}), "%.1f", "m") + " at the waterline, beam " +
+                    quantity(number_or_nan(*pt, {"beam_m"}), "%.1f", "m") + ", draught " +
+                    quantity(number_or_nan(*pt, {"draught_m"}), "%.1f", "m");
+    const double disp = number_or_nan(hull, {"hydrostatics", "displacement_t"});
+    if (std::isfinite(disp)) h += ", displacement " + quantity(disp, "%.0f", "t");
+    h += "; stem angle " + quantity(number_or_nan(*pt, {"stem_angle_deg"}), "%.0f", "&deg;");
+    rows.push_back({"Hull", h});
+  }
+  {
+    const Json stats = optional_json(pg, "floes/stats.json", "floe statistics");
+    std::string ice = scalar_text(summary.value("floes", Json())) + " floes";
+    const double conc = number_or_nan(stats, {"ice_concentration"});
+    if (std::isfinite(conc)) ice += ", concentration " + quantity(100 * conc, "%.0f", "%");
+    const double h = number_or_nan(stats, {"provenance", "config", "options", "thickness_m"});
+    if (std::isfinite(h)) ice += ", thickness " + quantity(h, "%.2f", "m");
+    ice += "; flexural strength " +
+           quantity(number_or_nan(settings, {"fracture", "flexural_strength_pa"}) / 1e3, "%.0f", "kPa") +
+           ", crushing strength " + quantity(number_or_nan(settings, {"ice", "crushing_strength_pa"}) / 1e6, "%.2g", "MPa");
+    rows.push_back({"Ice", ice});
+  }
+  rows.push_back({"Propulsion", propulsion_text(settings)});
+  {
+    std::string v = quantity(number_or_nan(summary, {"mean_vessel_speed_mps"}), "%.2f", "m/s");
+    const double hw = number_or_nan(summary, {"mean_vessel_speed_interval", "half_width_mps"});
+    if (std::isfinite(hw)) v += " &plusmn; " + quantity(hw, "%.2f", "m/s") + " (95 %)";
+    rows.push_back({"Mean speed in the steady part", v});
+  }
+  {
+    std::string t = quantity(number_or_nan(settings, {"duration_s"}), "%g", "s") + " simulated, time step " +
+                    quantity(number_or_nan(settings, {"time_step_s"}), "%g", "s");
+    if (const Json* sp = find(summary, {"steady_part"}))
+      t += "; steady part " + quantity(number_or_nan(*sp, {"from_s"}), "%g", "s") + " to " +
+           quantity(number_or_nan(*sp, {"to_s"}), "%g", "s");
+    rows.push_back({"Duration", t});
+  }
+  rows.push_back({"Contact model", scalar_text(summary.value("contact_model", Json()))});
+  rows.push_back({"Run folder", html_escape(run_name)});
+  if (!case_json.empty()) rows.push_back({"Case file", html_escape(case_json.string())});
+  body << "<h2>What was run</h2>\n<table id=\"what-was-run\">\n";
+  for (const auto& [label, value] : rows) body << "<tr><th>" << label << "</th><td>" << value << "</td></tr>\n";
+  body << "</table>\n";
 }
 
 // 3. Section "Warnings": what the stages warned of (summary.json's warnings: the floes' maker's and simulate's), on
@@ -646,7 +709,7 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
   const std::string run_name = fs::absolute(run_dir).lexically_normal().string();
   const fs::path case_json = case_file(run_dir).lexically_normal();
   const std::string title = report_title(o, run_name, case_json);
-  case_section(body, run_name, case_json, summary);
+  case_section(body, run_name, case_json, summary, pg);
   warnings_section(body, summary);
   mean_loads_section(body, rs);
   load_plot_section(body, run_dir, pg);

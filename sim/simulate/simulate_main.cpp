@@ -1,10 +1,12 @@
 // floesim-simulate: a vessel transit through a floe field -> DIR/results.h5 and DIR/summary.json.
+#include <filesystem>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
 
 #include "pipeline/options.h"
 #include "pipeline/results_io.h"
+#include "pipeline/vtk_series.h"
 #include "pipeline/stage_main.h"
 #include "sim/simulate/simulate.h"
 
@@ -12,7 +14,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Simulates a vessel transit through a floe field (rigid non-smooth contacts, buoyancy by clipping, "
                "drag, ITTC-57 resistance, propulsion) and writes DIR/results.h5 and DIR/summary.json.",
                "floesim-simulate"};
-  std::string floes, hull, config, out;
+  std::string floes, hull, config, out, paraview_from;
   bool help_config = false, check_config = false, resume = false, results_layout = false;
   app.add_option("--floes", floes, "floe field GeoJSON (floesim-digitise output)");
   app.add_option("--hull", hull, "hull mesh (OBJ of convex parts, e.g. floesim-hull output)");
@@ -25,7 +27,18 @@ int main(int argc, char** argv) {
   app.add_flag("--help-config", help_config, "print the simulate options as a Markdown table and exit");
   app.add_flag("--results-layout", results_layout,
                "print the layout of results.h5 as a Markdown table (pipeline/results-layout.md) and exit");
+  app.add_option("--paraview-from", paraview_from,
+                 "write the ParaView series (DIR/paraview/results.pvd, as simulate.paraview does) of this existing "
+                 "results.h5 into --out DIR, and exit");
   return floesim::run_stage(app, argc, argv, [&] {
+    if (!paraview_from.empty()) {
+      if (out.empty()) throw floesim::Error("--paraview-from needs --out DIR");
+      const size_t bytes = floesim::write_vtk_series(floesim::read_results(paraview_from, true, {"ice_load"}),
+                                                     std::filesystem::path(out) / "paraview", paraview_from);
+      std::cout << "wrote " << (std::filesystem::path(out) / "paraview" / "results.pvd").string() << " ("
+                << bytes / 1e6 << " MB)\n";
+      return;
+    }
     if (results_layout) {
       std::cout << floesim::results_layout_markdown();
       return;

@@ -347,3 +347,31 @@ TEST_F(TinyRun, WarningsAndThePlaybackSpeedAreOnThePage) {
             std::string::npos);
   EXPECT_LT(html.find("<h2>Warnings</h2>"), html.find("<h2>Video</h2>")) << "before the details";
 }
+
+// The first screen says what was run in words a reader knows (issue #37, part 2): no raw key (a dot or an
+// underscore) in a label, the hull's waterline length and the floes' concentration as their artefacts give them,
+// how the vessel was driven.
+TEST_F(TinyRun, TheFirstScreenSaysWhatWasRunInHumanLabels) {
+  ASSERT_EQ(ran_.code, 0) << ran_.text;
+  write_report(run_, ReportOptions{}, root_ / "first.html", Json::object());
+  const std::string html = read_text(root_ / "first.html");
+  const size_t a = html.find("<table id=\"what-was-run\">"), b = html.find("</table>", a);
+  ASSERT_NE(a, std::string::npos);
+  EXPECT_LT(a, html.find("<h2>Mean loads")) << "before the answer";
+  const std::string table = html.substr(a, b - a);
+  std::vector<std::string> labels;
+  for (size_t p = table.find("<th>"); p != std::string::npos; p = table.find("<th>", p + 1))
+    labels.push_back(table.substr(p + 4, table.find("</th>", p) - p - 4));
+  for (const std::string& l : labels)
+    EXPECT_EQ(l.find_first_of("._"), std::string::npos) << "a raw key as a label: " << l;
+  for (const char* want : {"Hull", "Ice", "Propulsion", "Duration"})
+    EXPECT_NE(std::find(labels.begin(), labels.end(), want), labels.end()) << want;
+  const Json hull = load_json_file(run_ / "hull/hull.json");
+  char length[64];
+  std::snprintf(length, sizeof length, "length %.1f&nbsp;m at the waterline", hull["particulars"]["length_m"].get<double>());
+  EXPECT_NE(table.find(length), std::string::npos) << table;
+  const Json stats = load_json_file(run_ / "floes/stats.json");
+  char conc[64];
+  std::snprintf(conc, sizeof conc, "concentration %.0f&nbsp;%%", 100 * stats["ice_concentration"].get<double>());
+  EXPECT_NE(table.find(conc), std::string::npos) << table;
+}
