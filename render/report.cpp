@@ -1,6 +1,7 @@
 #include "render/report.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -84,28 +85,85 @@ std::string load_in(double x_kN, const ForceUnit& u) {
   return load_number(1000.0 * x_kN / u.newtons);
 }
 
-// A JSON scalar as table text: numbers to 4 significant digits (integers whole), strings escaped.
+// A number for reading: 4 significant digits; from 10,000 on whole, in groups of three (13 229 000, not
+// 1.323e+07); below 0.001 in powers of ten.
+std::string readable_number(double x) {
+  if (!std::isfinite(x)) return std::isnan(x) ? "&ndash;" : (x > 0 ? "&infin;" : "&minus;&infin;");
+  if (std::abs(x) < 1e4 || std::abs(x) >= 1e15) {
+    std::string t = fmt("%.4g", x);
+    const size_t e = t.find('e');
+    if (e == std::string::npos) return t;
+    return t.substr(0, e) + "&times;10<sup>" + std::to_string(std::stoi(t.substr(e + 1))) + "</sup>";
+  }
+  const double digits = std::pow(10.0, std::floor(std::log10(std::abs(x))) - 3);
+  const std::string whole = fmt("%.0f", std::abs(std::round(x / digits) * digits));
+  std::string grouped;
+  for (size_t k = 0; k < whole.size(); ++k) {
+    if (k > 0 && (whole.size() - k) % 3 == 0) grouped += "&thinsp;";
+    grouped += whole[k];
+  }
+  return (x < 0 ? "&minus;" : "") + grouped;
+}
+
+// A JSON scalar as table text: numbers for reading (integers whole), strings escaped.
 std::string scalar_text(const Json& v) {
-  if (v.is_number_integer() || v.is_number_unsigned()) return v.dump();
-  if (v.is_number()) return html_escape(fmt("%.4g", v.get<double>()));
+  if (v.is_number_integer() || v.is_number_unsigned()) return readable_number(v.get<double>());
+  if (v.is_number()) return readable_number(v.get<double>());
   if (v.is_string()) return html_escape(v.get<std::string>());
+  if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
   if (v.is_null()) return "&ndash;";
   return html_escape(v.dump());
 }
 
-// Rows "key | value" for the scalars of a JSON object (nested objects and arrays are left to the settings).
+// A key as a reader's label: "hydrostatics.lcb_m" -> "hydrostatics: lcb (m)", "mean_peak_N" -> "mean peak (N)",
+// "lines[3].fairlead_tension_N.max" -> "lines 3: fairlead tension (N): max". The unit suffixes of the project's
+// keys become units; the rest of the underscores spaces.
+std::string human_label(const std::string& key) {
+  static const std::vector<std::pair<std::string, std::string>> units = {
+      {"_kg_m3", "kg/m&sup3;"}, {"_m2", "m&sup2;"}, {"_m3", "m&sup3;"}, {"_mps", "m/s"}, {"_radps", "rad/s"},
+      {"_deg", "&deg;"}, {"_rad", "rad"}, {"_kN", "kN"}, {"_N", "N"}, {"_Nm", "N m"}, {"_nm", "N m"}, {"_n", "N"},
+      {"_pa", "Pa"}, {"_Pa", "Pa"}, {"_kg", "kg"}, {"_t", "t"}, {"_s", "s"}, {"_m", "m"}, {"_J", "J"}};
+  std::vector<std::string> parts;
+  std::string part;
+  for (char c : key) {
+    if (c == '.' || c == '[') {
+      parts.push_back(part);
+      part.clear();
+    } else if (c != ']') {
+      part += c;
+    }
+  }
+  parts.push_back(part);
+  std::string label;
+  for (std::string p : parts) {
+    if (p.empty()) continue;
+    std::string unit;
+    for (const auto& [suffix, u] : units)
+      if (p.size() > suffix.size() && p.compare(p.size() - suffix.size(), suffix.size(), suffix) == 0) {
+        unit = u;
+        p.resize(p.size() - suffix.size());
+        break;
+      }
+    std::replace(p.begin(), p.end(), '_', ' ');
+    if (!label.empty()) label += std::isdigit(static_cast<unsigned char>(p[0])) ? " " : ": ";
+    label += html_escape(p) + (unit.empty() ? "" : " (" + unit + ")");
+  }
+  return label;
+}
+
+// Rows "label | value" for the scalars of a JSON object (nested objects and arrays are left to the settings).
 std::string scalar_rows(const Json& obj, const std::string& prefix = "") {
   std::string rows;
   if (!obj.is_object()) return rows;
   for (auto it = obj.begin(); it != obj.end(); ++it) {
     if (it.value().is_object() || it.value().is_array()) continue;
-    rows += "<tr><th>" + html_escape(prefix + it.key()) + "</th><td>" + scalar_text(it.value()) + "</td></tr>\n";
+    rows += "<tr><th>" + human_label(prefix + it.key()) + "</th><td>" + scalar_text(it.value()) + "</td></tr>\n";
   }
   return rows;
 }
 
-// Rows for every scalar of a JSON object and of the objects and arrays inside it, named by their path
-// ("cycles.mean_peak_N", "lines[3].fairlead_tension_N.max").
+// Rows for every scalar of a JSON object and of the objects and arrays inside it, labelled by their path
+// ("cycles: mean peak (N)", "lines 3: fairlead tension (N): max").
 std::string nested_rows(const Json& obj, const std::string& prefix = "") {
   std::string rows = scalar_rows(obj, prefix);
   for (auto it = obj.begin(); it != obj.end(); ++it) {
@@ -115,7 +173,7 @@ std::string nested_rows(const Json& obj, const std::string& prefix = "") {
         const Json& e = it.value()[i];
         const std::string name = prefix + it.key() + "[" + std::to_string(i) + "]";
         if (e.is_object()) rows += nested_rows(e, name + ".");
-        else rows += "<tr><th>" + html_escape(name) + "</th><td>" + scalar_text(e) + "</td></tr>\n";
+        else rows += "<tr><th>" + human_label(name) + "</th><td>" + scalar_text(e) + "</td></tr>\n";
       }
   }
   return rows;
@@ -579,12 +637,24 @@ void hull_section(std::ostream& body, const fs::path& run_dir, const Json& summa
   if (const Json* v = find(summary, {"vessel"})) body << scalar_rows(*v);
   if (fs::is_regular_file(run_dir / "hull/hull.json")) {
     const Json h = pg.json("hull/hull.json", "hull sidecar");
-    if (const Json* hy = find(h, {"hydrostatics"})) body << scalar_rows(*hy, "hydrostatics.");
+    // What the simulation's vessel summary already gave (the waterline beam, length, draught, ...) is shown once.
+    if (const Json* hy = find(h, {"hydrostatics"})) {
+      Json rest = *hy;
+      if (const Json* v = find(summary, {"vessel"}))
+        for (auto it = v->begin(); it != v->end(); ++it) rest.erase(it.key());
+      if (rest.contains("volume_m3") && find(summary, {"vessel", "displacement_m3"})) rest.erase("volume_m3");
+      body << scalar_rows(rest, "hydrostatics.");
+    }
     // A user's mesh: how it was placed and where it floats (floesim-hull's report).
     if (const Json* pl = find(h, {"placement"})) body << scalar_rows(*pl, "placement.");
     if (const Json* wl = find(h, {"waterline"})) body << scalar_rows(*wl, "waterline.");
     // The angles and lengths the level-ice resistance formulas take (floesim-resistance).
-    if (const Json* pa = find(h, {"particulars"})) body << scalar_rows(*pa, "particulars.");
+    // The particulars' length, beam and draught are the hydrostatics' (waterline) ones: shown once.
+    if (const Json* pa = find(h, {"particulars"})) {
+      Json rest = *pa;
+      for (const char* k : {"length_m", "beam_m", "draught_m"}) rest.erase(k);
+      body << scalar_rows(rest, "particulars.");
+    }
     body << scalar_rows(h);
   } else if (fs::exists(run_dir / "config/hull.json")) {
     pg.missing.push_back("hull/hull.json (hull particulars)");
