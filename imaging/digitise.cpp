@@ -197,7 +197,7 @@ DigitiseResult run_digitise(const DigitiseRequest& req) {
   }
   if (o.convex_parts) write_json_tmp(parts_f, convex_parts_geojson(res.floes));
   if (georeferenced)
-    write_json_tmp(wgs84_f, floes_to_wgs84_geojson(res.floes, georeference_from(o.georeference, "digitise")));
+    write_json_tmp(wgs84_f, floes_to_wgs84_geojson(res.floes, georeference_from(o.georeference)));
   geo.commit();
   labels.commit();
   overlay.commit();

@@ -5,10 +5,10 @@
 // not on one image. For close-range photographs (cm per pixel) imaging/settings/close_range.json holds a set
 // chosen by cross-validation on the 12 hand-labelled passerotti images at 0.05 m/px (README.md, issue #3).
 #pragma once
-#include <cmath>
 #include <string>
 #include <vector>
 
+#include "imaging/georeference.h"
 #include "pipeline/options.h"
 
 namespace floesim::imaging {
@@ -108,13 +108,7 @@ struct DigitiseOptions {
             "[latitude, longitude, heading] of the image centre (WGS 84) and of its up axis (clockwise from true "
             "north); also writes floes_wgs84.geojson for a GIS; [] = none",
             Check<std::vector<double>>([](const std::vector<double>& g) {
-              if (g.empty()) return std::string();
-              if (g.size() != 3) return std::string("must be [] or [latitude_deg, longitude_deg, heading_deg]");
-              for (double x : g)
-                if (!std::isfinite(x)) return std::string("must be finite numbers");
-              if (std::abs(g[0]) > 90) return std::string("latitude must be in [-90, 90]");
-              if (std::abs(g[1]) > 180) return std::string("longitude must be in [-180, 180]");
-              return std::string();
+              return g.empty() ? std::string() : georeference_problem(g);
             }));
     v.field("size_bins_per_decade", size_bins_per_decade, "-", "size distribution bins per decade of diameter",
             int_in_range(1, 50));

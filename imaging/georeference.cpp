@@ -9,12 +9,18 @@
 
 namespace floesim::imaging {
 
-GeoReference georeference_from(const std::vector<double>& v, const std::string& where) {
-  FLOESIM_REQUIRE(v.size() == 3, where, ": georeference must be [latitude_deg, longitude_deg, heading_deg] (the image "
-                  "centre's WGS 84 position and its up axis clockwise from true north), got ", v.size(), " numbers");
-  for (double x : v) FLOESIM_REQUIRE(std::isfinite(x), where, ": georeference must be finite numbers");
-  FLOESIM_REQUIRE(std::abs(v[0]) <= 90, where, ": georeference latitude ", v[0], " is not in [-90, 90]");
-  FLOESIM_REQUIRE(std::abs(v[1]) <= 180, where, ": georeference longitude ", v[1], " is not in [-180, 180]");
+std::string georeference_problem(const std::vector<double>& g) {
+  if (g.size() != 3) return "must be [latitude_deg, longitude_deg, heading_deg]";
+  for (double x : g)
+    if (!std::isfinite(x)) return "must be finite numbers";
+  if (std::abs(g[0]) > 90) return "latitude must be in [-90, 90]";
+  if (std::abs(g[1]) > 180) return "longitude must be in [-180, 180]";
+  return "";
+}
+
+GeoReference georeference_from(const std::vector<double>& v) {
+  const std::string problem = georeference_problem(v);
+  FLOESIM_REQUIRE(problem.empty(), "internal: digitise.georeference ", problem);
   return {v[0], v[1], v[2]};
 }
 

@@ -19,9 +19,11 @@ struct GeoReference {
   double heading_deg = 0;    // the image's up axis, clockwise from true north
 };
 
-// The option's value [latitude_deg, longitude_deg, heading_deg] (empty: none) as a GeoReference; Error naming the
-// key if it is not three finite numbers with the latitude in [-90, 90] and the longitude in [-180, 180].
-GeoReference georeference_from(const std::vector<double>& values, const std::string& where);
+// What is wrong with the option's value [latitude_deg, longitude_deg, heading_deg], "" if nothing (digitise's
+// option check: three finite numbers, the latitude in [-90, 90], the longitude in [-180, 180]).
+std::string georeference_problem(const std::vector<double>& values);
+// A checked option value as a GeoReference.
+GeoReference georeference_from(const std::vector<double>& values);
 
 // [longitude, latitude] in degrees of the image point (x, y) metres (image frame) of an image width_m x height_m.
 // The image is taken as an azimuthal equidistant map about its centre on the WGS 84 ellipsoid (GeographicLib): a

@@ -55,13 +55,14 @@ std::string frame_file(const Results& r, const FrameReplay& replay, size_t k) {
     const double* p = &r.state_position_m[3 * static_cast<size_t>(row)];
     return std::make_pair(Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized(), Eigen::Vector3d(p[0], p[1], p[2]));
   };
+  // A cell's data; its points follow, then end_cell() (VTK's offsets are each cell's end in the connectivity).
   auto cell = [&](int64_t row, int32_t k_kind) {
-    offsets.push_back(static_cast<int32_t>(connectivity.size()));
     body_id.push_back(r.state_body_id[static_cast<size_t>(row)]);
     kind.push_back(k_kind);
     in_contact.push_back(r.state_in_contact[static_cast<size_t>(row)]);
     for (int c = 0; c < 3; ++c) centre.push_back(r.state_position_m[3 * static_cast<size_t>(row) + c]);
   };
+  auto end_cell = [&] { offsets.push_back(static_cast<int32_t>(connectivity.size())); };
   auto point = [&](const Eigen::Vector3d& x) {
     connectivity.push_back(static_cast<int32_t>(points.size() / 3));
     for (int c = 0; c < 3; ++c) points.push_back(static_cast<float>(x[c]));
@@ -77,7 +78,7 @@ std::string frame_file(const Results& r, const FrameReplay& replay, size_t k) {
           const double* v = &r.hull_vertices_m[3 * static_cast<size_t>(r.hull_triangles[t + c])];
           point(q * Eigen::Vector3d(v[0], v[1], v[2]) + p);
         }
-        offsets.back() = static_cast<int32_t>(connectivity.size());  // VTK's offsets are each cell's end
+        end_cell();
       }
       continue;
     }
@@ -87,7 +88,7 @@ std::string frame_file(const Results& r, const FrameReplay& replay, size_t k) {
     const double top = r.floe_thickness_m[gi] / 2;
     for (int64_t v = r.floe_vertex_offset[gi]; v < r.floe_vertex_offset[gi + 1]; ++v)
       point(q * Eigen::Vector3d(r.floe_vertices_m[2 * v], r.floe_vertices_m[2 * v + 1], top) + p);
-    offsets.back() = static_cast<int32_t>(connectivity.size());
+    end_cell();
   }
   const double t = r.frame_time_s[k];
   const std::vector<double> time_value{t};

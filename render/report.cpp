@@ -85,6 +85,16 @@ std::string load_in(double x_kN, const ForceUnit& u) {
   return load_number(1000.0 * x_kN / u.newtons);
 }
 
+// "13229000" as "13 229 000" (thin spaces between groups of three).
+std::string grouped_digits(const std::string& whole) {
+  std::string grouped;
+  for (size_t k = 0; k < whole.size(); ++k) {
+    if (k > 0 && (whole.size() - k) % 3 == 0) grouped += "&thinsp;";
+    grouped += whole[k];
+  }
+  return grouped;
+}
+
 // A number for reading: 4 significant digits; from 10,000 on whole, in groups of three (13 229 000, not
 // 1.323e+07); below 0.001 in powers of ten.
 std::string readable_number(double x) {
@@ -96,18 +106,16 @@ std::string readable_number(double x) {
     return t.substr(0, e) + "&times;10<sup>" + std::to_string(std::stoi(t.substr(e + 1))) + "</sup>";
   }
   const double digits = std::pow(10.0, std::floor(std::log10(std::abs(x))) - 3);
-  const std::string whole = fmt("%.0f", std::abs(std::round(x / digits) * digits));
-  std::string grouped;
-  for (size_t k = 0; k < whole.size(); ++k) {
-    if (k > 0 && (whole.size() - k) % 3 == 0) grouped += "&thinsp;";
-    grouped += whole[k];
-  }
-  return (x < 0 ? "&minus;" : "") + grouped;
+  return (x < 0 ? "&minus;" : "") + grouped_digits(fmt("%.0f", std::abs(std::round(x / digits) * digits)));
 }
 
-// A JSON scalar as table text: numbers for reading (integers whole), strings escaped.
+// A JSON scalar as table text: integers whole, other numbers for reading, strings escaped.
 std::string scalar_text(const Json& v) {
-  if (v.is_number_integer() || v.is_number_unsigned()) return readable_number(v.get<double>());
+  if (v.is_number_unsigned()) return grouped_digits(std::to_string(v.get<uint64_t>()));
+  if (v.is_number_integer()) {
+    const int64_t i = v.get<int64_t>();
+    return (i < 0 ? "&minus;" : "") + grouped_digits(std::to_string(i < 0 ? -static_cast<uint64_t>(i) : i));
+  }
   if (v.is_number()) return readable_number(v.get<double>());
   if (v.is_string()) return html_escape(v.get<std::string>());
   if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
@@ -704,13 +712,10 @@ void structure_section(std::ostream& body, const fs::path& run_dir, const Json& 
 }
 
 // ", plays 5x real time (25 frames per second, one per 0.2 s simulated)" from the video's sidecar; "" without one.
-std::string playback_note(const fs::path& sidecar) {
-  if (!fs::is_regular_file(sidecar)) return "";
-  const Json side = Json::parse(read_bytes(sidecar), nullptr, false);
-  if (side.is_discarded() || !side.is_object() || !side.contains("playback_speed") ||
-      !side["playback_speed"].is_number() || !side.contains("fps") || !side["fps"].is_number())
-    return "";
-  const double speed = side["playback_speed"].get<double>(), fps = side["fps"].get<double>();
+std::string playback_note(Page& pg) {
+  const Json side = optional_json(pg, "video/transit.json", "video sidecar");
+  const double speed = number_or_nan(side, {"playback_speed"}), fps = number_or_nan(side, {"fps"});
+  if (!std::isfinite(speed) || !std::isfinite(fps)) return "";
   return fmt("; it plays %.3g", speed) + "&times; real time (" + fmt("%g", fps) + " frames per second, one per " +
          fmt("%.3g", speed / fps) + " s simulated)";
 }
@@ -726,13 +731,12 @@ void video_section(std::ostream& body, const fs::path& run_dir, const ReportOpti
       pg.inputs.push_back({"video", video});
       body << "<video controls preload=\"auto\" src=\"data:video/mp4;base64,"
            << base64_encode(read_bytes(video)) << "\"></video>\n<p class=\"note\">video/transit.mp4, " << size
-           << ", embedded" << playback_note(run_dir / "video/transit.json") << ".</p>\n";
+           << ", embedded" << playback_note(pg) << ".</p>\n";
       rs.video_embedded = true;
     } else {
       body << "<p class=\"missing\" id=\"video-not-embedded\">The video video/transit.mp4 (" << size
            << ") is larger than max_video_mb = " << fmt("%g", o.max_video_mb)
-           << " MB and is not embedded: open it beside this page" << playback_note(run_dir / "video/transit.json")
-           << ".</p>\n";
+           << " MB and is not embedded: open it beside this page" << playback_note(pg) << ".</p>\n";
     }
   } else {
     pg.missing.push_back("video/transit.mp4 (video)");

@@ -85,6 +85,7 @@ RenderStats render_video(const Results& r, const RenderOptions& o, const fs::pat
   st.floes_drawn_per_frame /= static_cast<double>(n);
   st.floes_culled_per_frame /= static_cast<double>(n);
 
+  const double playback = playback_speed(r, o.fps);
   nlohmann::json side = {
       {"video", out_mp4.filename().string()},
       {"codec", "H.264 (avc1), MP4"},
@@ -95,8 +96,7 @@ RenderStats render_video(const Results& r, const RenderOptions& o, const fs::pat
       {"fps", o.fps},
       {"duration_s", static_cast<double>(n) / o.fps},
       // Simulated seconds per second of video (fps x the frame interval): "plays 5x real time".
-      {"playback_speed", std::isfinite(playback_speed(r, o.fps)) ? nlohmann::json(playback_speed(r, o.fps))
-                                                                  : nlohmann::json()},
+      {"playback_speed", std::isfinite(playback) ? nlohmann::json(playback) : nlohmann::json()},
       {"simulated_time_s", {r.frame_time_s.front(), r.frame_time_s[n - 1]}},
       {"view", o.view},
       {"split_views", o.view == "split" ? nlohmann::json(o.split_views) : nlohmann::json()},

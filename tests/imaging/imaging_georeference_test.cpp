@@ -54,17 +54,23 @@ TEST(Georeference, TheHeadingTurnsTheImageClockwiseFromNorth) {
   EXPECT_LT(right_turned[1], 78.2);
 }
 
-TEST(Georeference, DigitiseWritesTheFloesInWgs84AndEveryFileDeclaresItsCrs) {
-  cv::Mat img(120, 160, CV_8U);
-  cv::randu(img, 30, 60);
-  cv::rectangle(img, cv::Rect(20, 20, 50, 40), cv::Scalar(220), cv::FILLED);
-  test::ScratchDir d;
+// A request to digitise `img` (written into `d`) at 1 m/px with digitise.georeference = `georeference`.
+DigitiseRequest georeferenced_request(const test::ScratchDir& d, const cv::Mat& img, const Json& georeference) {
   cv::imwrite((d.path / "image.png").string(), img);
   DigitiseRequest req;
   req.image = d.path / "image.png";
   req.metres_per_pixel = 1.0;
   req.out_dir = d.path / "out";
-  req.config = {{"georeference", {78.2, 15.6, 30.0}}};
+  req.config = {{"georeference", georeference}};
+  return req;
+}
+
+TEST(Georeference, DigitiseWritesTheFloesInWgs84AndEveryFileDeclaresItsCrs) {
+  cv::Mat img(120, 160, CV_8U);
+  cv::randu(img, 30, 60);
+  cv::rectangle(img, cv::Rect(20, 20, 50, 40), cv::Scalar(220), cv::FILLED);
+  test::ScratchDir d;
+  const DigitiseRequest req = georeferenced_request(d, img, {78.2, 15.6, 30.0});
   const DigitiseResult res = run_digitise(req);
   ASSERT_EQ(res.floes.floes.size(), 1u);
   const Json local = load_json_file(req.out_dir / "floes.geojson");
@@ -91,12 +97,7 @@ TEST(Georeference, ALatitudeOffTheEarthIsRefusedNamingTheKey) {
   cv::Mat img(60, 60, CV_8U, cv::Scalar(40));
   cv::rectangle(img, cv::Rect(20, 20, 20, 20), cv::Scalar(220), cv::FILLED);
   test::ScratchDir d;
-  cv::imwrite((d.path / "image.png").string(), img);
-  DigitiseRequest req;
-  req.image = d.path / "image.png";
-  req.metres_per_pixel = 1.0;
-  req.out_dir = d.path / "out";
-  req.config = {{"georeference", {95.0, 15.6, 0.0}}};
+  const DigitiseRequest req = georeferenced_request(d, img, {95.0, 15.6, 0.0});
   try {
     run_digitise(req);
     ADD_FAILURE() << "expected an error";

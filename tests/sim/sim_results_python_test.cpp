@@ -3,6 +3,8 @@
 // CSV export of the series, value for value (issue #37, part 4).
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <sstream>
 
@@ -30,7 +32,8 @@ std::string reader() { return (fs::path(FLOESIM_SOURCE_DIR) / "pipeline/python/f
 class PythonReader : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = new fs::path(testing::temp_dir("python_reader"));
+    // A folder per process: ctest runs the suite's tests as parallel processes, each making its own run.
+    dir_ = new fs::path(testing::temp_dir("python_reader_" + std::to_string(::getpid())));
     RunStats stats;
     const Results r = simulate(testing::small_breaking_run_options(), testing::small_breaking_run(), stats);
     write_results(*dir_ / "results.h5", r);
