@@ -9,15 +9,6 @@
 
 namespace floesim::imaging {
 
-std::string georeference_problem(const std::vector<double>& g) {
-  if (g.size() != 3) return "must be [latitude_deg, longitude_deg, heading_deg]";
-  for (double x : g)
-    if (!std::isfinite(x)) return "must be finite numbers";
-  if (std::abs(g[0]) > 90) return "latitude must be in [-90, 90]";
-  if (std::abs(g[1]) > 180) return "longitude must be in [-180, 180]";
-  return "";
-}
-
 GeoReference georeference_from(const std::vector<double>& v) {
   const std::string problem = georeference_problem(v);
   FLOESIM_REQUIRE(problem.empty(), "internal: digitise.georeference ", problem);

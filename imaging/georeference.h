@@ -5,6 +5,8 @@
 // (floes_wgs84.geojson, RFC 7946) so that a GIS (QGIS) places them on a map.
 #pragma once
 #include <array>
+#include <cmath>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -20,8 +22,16 @@ struct GeoReference {
 };
 
 // What is wrong with the option's value [latitude_deg, longitude_deg, heading_deg], "" if nothing (digitise's
-// option check: three finite numbers, the latitude in [-90, 90], the longitude in [-180, 180]).
-std::string georeference_problem(const std::vector<double>& values);
+// option check: three finite numbers, the latitude in [-90, 90], the longitude in [-180, 180]). Inline: the
+// options header, which harnesses use without the imaging library, calls it.
+inline std::string georeference_problem(const std::vector<double>& g) {
+  if (g.size() != 3) return "must be [latitude_deg, longitude_deg, heading_deg]";
+  for (double x : g)
+    if (!std::isfinite(x)) return "must be finite numbers";
+  if (std::abs(g[0]) > 90) return "latitude must be in [-90, 90]";
+  if (std::abs(g[1]) > 180) return "longitude must be in [-180, 180]";
+  return "";
+}
 // A checked option value as a GeoReference.
 GeoReference georeference_from(const std::vector<double>& values);
 
