@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -180,8 +181,16 @@ DigitiseResult run_digitise(const DigitiseRequest& req) {
   AtomicFile geo(req.out_dir / "floes.geojson"), labels(req.out_dir / "labels.png"),
       overlay(req.out_dir / "overlay.png"), stats_f(req.out_dir / "stats.json"), fsd_png(req.out_dir / "fsd.png"),
       fsd_csv(req.out_dir / "fsd.csv"), score_f(req.out_dir / "score.json"),
-      parts_f(req.out_dir / "convex_parts.geojson"), wgs84_f(req.out_dir / "floes_wgs84.geojson");
+      parts_f(req.out_dir / "convex_parts.geojson"), wgs84_f(req.out_dir / "floes_wgs84.geojson"),
+      labels_pgw(req.out_dir / "labels.pgw"), labels_prj(req.out_dir / "labels.prj"),
+      overlay_pgw(req.out_dir / "overlay.pgw"), overlay_prj(req.out_dir / "overlay.prj");
   const bool georeferenced = !o.georeference.empty();
+  const std::optional<GeoReference> where =
+      georeferenced ? std::optional<GeoReference>(georeference_from(o.georeference)) : std::nullopt;
+  const WorldFile world = raster_world_file(res.floes.width_m, res.floes.height_m, req.metres_per_pixel,
+                                            where ? &*where : nullptr);
+  for (const AtomicFile* f : {&labels_pgw, &overlay_pgw}) write_file_checked(f->tmp(), world.pgw, f->path());
+  for (const AtomicFile* f : {&labels_prj, &overlay_prj}) write_file_checked(f->tmp(), world.prj, f->path());
   write_json_tmp(geo, floes_to_geojson(res.floes));
   write_labels_png(labels.tmp(), res.seg.labels, labels.path().string());
   write_png_tmp(overlay, render_overlay(gray, res.floes, req.metres_per_pixel));
@@ -196,11 +205,11 @@ DigitiseResult run_digitise(const DigitiseRequest& req) {
     write_json_tmp(score_f, sj);
   }
   if (o.convex_parts) write_json_tmp(parts_f, convex_parts_geojson(res.floes));
-  if (georeferenced)
-    write_json_tmp(wgs84_f, floes_to_wgs84_geojson(res.floes, georeference_from(o.georeference)));
+  if (georeferenced) write_json_tmp(wgs84_f, floes_to_wgs84_geojson(res.floes, *where));
   geo.commit();
   labels.commit();
   overlay.commit();
+  for (AtomicFile* f : {&labels_pgw, &labels_prj, &overlay_pgw, &overlay_prj}) f->commit();
   stats_f.commit();
   fsd_png.commit();
   fsd_csv.commit();

@@ -5,6 +5,8 @@
 //                  thickness_m; the field extent and provenance (program, version, input hashes, resolved config)
 //   labels.png     16-bit labels on the input's pixel grid: 0 = no floe, k = feature id k
 //   overlay.png    the photograph in colour with each floe's outline and id
+//   labels.pgw, labels.prj, overlay.pgw, overlay.prj  world files and CRS placing the two rasters for a GIS: in
+//                  the image's metres, or with a georeference on the map (georeference.h raster_world_file)
 //   stats.json     count, concentration, size distribution table, power-law fits, diagnostics, warnings,
 //                  provenance
 //   fsd.png        the size distribution (number density against equivalent diameter, log-log) with the

@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "imaging/digitise.h"
+#include "pipeline/options_describe.h"
 #include "pipeline/stage_main.h"
 
 int main(int argc, char** argv) {
@@ -29,6 +30,7 @@ int main(int argc, char** argv) {
         throw CLI::Success();
       },
       "print the options table and exit");
+  add_describe_config(app, [] { return options_description(imaging::DigitiseOptions{}); });
   return run_stage(app, argc, argv, [&] {
     if (check_config) {
       FLOESIM_REQUIRE(!config.empty(), "--check-config needs --config FILE");

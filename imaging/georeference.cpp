@@ -1,6 +1,7 @@
 #include "imaging/georeference.h"
 
 #include <cmath>
+#include <cstdio>
 
 #include <GeographicLib/AzimuthalEquidistant.hpp>
 #include <GeographicLib/Geodesic.hpp>
@@ -40,6 +41,36 @@ nlohmann::json floes_to_wgs84_geojson(const FloeField& field, const GeoReference
       vertex = {ll[0], ll[1]};
     }
   return fc;
+}
+
+WorldFile raster_world_file(double width_m, double height_m, double mpp, const GeoReference* g) {
+  // The top-left pixel's centre in the image frame (x right, y up from the bottom-left corner).
+  const double x0 = 0.5 * mpp, y0 = height_m - 0.5 * mpp;
+  double a = mpp, d = 0, b = 0, e = -mpp, c = x0, f = y0;
+  WorldFile w;
+  if (!g) {
+    w.prj = kLocalMetresCrs;
+  } else {
+    // East and north of the image point (x, y): its offsets from the centre turned by the heading (image_to_wgs84).
+    const double h = g->heading_deg * M_PI / 180, ch = std::cos(h), sh = std::sin(h);
+    const double dx = x0 - width_m / 2, dy = y0 - height_m / 2;
+    a = mpp * ch, d = -mpp * sh, b = -mpp * sh, e = -mpp * ch;
+    c = dx * ch + dy * sh, f = -dx * sh + dy * ch;
+    char prj[768];
+    std::snprintf(prj, sizeof prj,
+                  "PROJCS[\"floesim image: azimuthal equidistant about its centre\",GEOGCS[\"GCS_WGS_1984\","
+                  "DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",6378137.0,298.257223563]],PRIMEM[\"Greenwich\",0.0],"
+                  "UNIT[\"Degree\",0.0174532925199433]],PROJECTION[\"Azimuthal_Equidistant\"],"
+                  "PARAMETER[\"False_Easting\",0.0],PARAMETER[\"False_Northing\",0.0],"
+                  "PARAMETER[\"Central_Meridian\",%.12g],PARAMETER[\"Latitude_Of_Origin\",%.12g],UNIT[\"Meter\",1.0]]",
+                  g->longitude_deg, g->latitude_deg);
+    w.prj = prj;
+  }
+  char pgw[256];
+  std::snprintf(pgw, sizeof pgw, "%.15g\n%.15g\n%.15g\n%.15g\n%.15g\n%.15g\n", a, d, b, e, c, f);
+  w.pgw = pgw;
+  w.prj += "\n";
+  return w;
 }
 
 }  // namespace floesim::imaging

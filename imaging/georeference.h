@@ -45,4 +45,15 @@ std::array<double, 2> image_to_wgs84(const GeoReference& g, double width_m, doub
 // metres of floes.geojson, and refuses this one).
 nlohmann::json floes_to_wgs84_geojson(const FloeField& field, const GeoReference& g);
 
+// What places a raster on the image's pixel grid (labels.png, overlay.png) where its floes are, for a GIS: an ESRI
+// world file (`pgw`: six lines A, D, B, E, C, F; a pixel (column, row) lies at x = A col + B row + C,
+// y = D col + E row + F, C and F at the centre of the top-left pixel) and its CRS as ESRI WKT (`prj`). With a
+// georeference: the azimuthal equidistant map about the image centre on WGS 84 (east and north in metres, the image
+// turned by its heading) that floes_wgs84.geojson is drawn from, so that QGIS lays the raster under those floes;
+// without one: the image's own metres, under floes.geojson.
+struct WorldFile {
+  std::string pgw, prj;
+};
+WorldFile raster_world_file(double width_m, double height_m, double metres_per_pixel, const GeoReference* g);
+
 }  // namespace floesim::imaging

@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "imaging/synth.h"
+#include "pipeline/options_describe.h"
 #include "pipeline/stage_main.h"
 
 int main(int argc, char** argv) {
@@ -20,6 +21,7 @@ int main(int argc, char** argv) {
         throw CLI::Success();
       },
       "print the options table and exit");
+  add_describe_config(app, [] { return options_description(imaging::SynthOptions{}); });
   return run_stage(app, argc, argv, [&] {
     const auto opts =
         config.empty() ? imaging::SynthOptions{} : read_options<imaging::SynthOptions>(load_json_file(config), config);

@@ -8,6 +8,16 @@
 
 namespace floesim {
 
+void add_describe_config(CLI::App& app, std::function<nlohmann::json()> describe) {
+  app.add_flag_callback(
+      "--describe-config",
+      [describe = std::move(describe)] {
+        std::cout << describe().dump(2) << "\n";
+        throw CLI::Success();
+      },
+      "print every option's key path with its unit and meaning as JSON (for programs) and exit");
+}
+
 int run_stage(CLI::App& app, int argc, char** argv, const std::function<void()>& body) {
   app.set_version_flag("--version", std::string(app.get_name()) + " (floesim) " + version());
   // SIGINT, SIGTERM, SIGHUP: stop without leaving a half-written file (pipeline/interrupt.h).

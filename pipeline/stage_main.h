@@ -5,10 +5,15 @@
 #include <string>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 namespace floesim {
 
 // Adds --version to `app`, runs `parse` and then `body`; returns the process exit code.
 int run_stage(CLI::App& app, int argc, char** argv, const std::function<void()>& body);
+
+// Adds --describe-config: prints `describe()` (options_description of the stage's options: each key's unit and
+// meaning) as JSON and exits. The sweep runner labels its axes with it.
+void add_describe_config(CLI::App& app, std::function<nlohmann::json()> describe);
 
 }  // namespace floesim

@@ -2,6 +2,7 @@
 // (plot.json).
 #include <iostream>
 
+#include "pipeline/options_describe.h"
 #include "pipeline/stage_main.h"
 #include "render/plot.h"
 
@@ -21,6 +22,7 @@ int main(int argc, char** argv) {
     std::cout << floesim::options_doc(floesim::render::PlotOptions{});
     throw CLI::Success();
   }, "print the plot options (key, default, unit, meaning) and exit");
+  floesim::add_describe_config(app, [] { return floesim::options_description(floesim::render::PlotOptions{}); });
   return floesim::run_stage(app, argc, argv, [&] {
     if (check_config) {
       floesim::render::read_plot_options(config);

@@ -1,6 +1,7 @@
 // floesim-render: results HDF5 -> H.264 MP4 of the transit (off-screen OSMesa), plus a JSON sidecar.
 #include <iostream>
 
+#include "pipeline/options_describe.h"
 #include "pipeline/stage_main.h"
 #include "render/video.h"
 
@@ -19,6 +20,7 @@ int main(int argc, char** argv) {
     std::cout << floesim::options_doc(floesim::render::RenderOptions{});
     throw CLI::Success();
   }, "print the render options (key, default, unit, meaning) and exit");
+  floesim::add_describe_config(app, [] { return floesim::options_description(floesim::render::RenderOptions{}); });
   return floesim::run_stage(app, argc, argv, [&] {
     if (check_config) {
       floesim::render::read_render_options(config);

@@ -133,8 +133,12 @@ std::string human_label(const std::string& key) {
       {"_pa", "Pa"}, {"_Pa", "Pa"}, {"_kg", "kg"}, {"_t", "t"}, {"_s", "s"}, {"_m", "m"}, {"_J", "J"}};
   std::vector<std::string> parts;
   std::string part;
-  for (char c : key) {
-    if (c == '.' || c == '[') {
+  for (size_t i = 0; i < key.size(); ++i) {
+    const char c = key[i];
+    const bool decimal_point = c == '.' && i > 0 && i + 1 < key.size() &&
+                               std::isdigit(static_cast<unsigned char>(key[i - 1])) &&
+                               std::isdigit(static_cast<unsigned char>(key[i + 1]));  // "peak_0.5s_..."
+    if ((c == '.' && !decimal_point) || c == '[') {
       parts.push_back(part);
       part.clear();
     } else if (c != ']') {
@@ -841,19 +845,25 @@ SweepReportSummary write_sweep_report(const fs::path& sweep_dir, const ReportOpt
     if (const std::string d = case_description(fs::path(base) / "case.json"); !d.empty())
       body << "<tr><th>base case description</th><td>" << html_escape(d) << "</td></tr>\n";
   }
-  std::vector<std::string> axis_keys;
+  // Each axis by the name its option's description gives it (the key, for a sweep gathered before labels), the
+  // key and the option's meaning in a tooltip.
+  std::vector<std::string> axis_keys, axis_labels;
   if (sw.contains("axes") && sw["axes"].is_array())
     for (const Json& a : sw["axes"]) {
       axis_keys.push_back(a.value("key", ""));
-      body << "<tr><th>axis " << html_escape(axis_keys.back()) << "</th><td>"
-           << html_escape(a.value("values", Json::array()).dump()) << "</td></tr>\n";
+      axis_labels.push_back(a.value("label", axis_keys.back()));
+      std::string values;
+      for (const Json& v : a.value("values", Json::array())) values += (values.empty() ? "" : ", ") + scalar_text(v);
+      body << "<tr><th title=\"" << html_escape(axis_keys.back() + ": " + a.value("doc", "")) << "\">"
+           << html_escape(axis_labels.back()) << "</th><td>varied over " << values << "</td></tr>\n";
     }
   if (sw.contains("ensemble")) body << "<tr><th>ensemble</th><td>" << html_escape(sw["ensemble"].dump()) << "</td></tr>\n";
   body << "</table>\n";
 
   // The ensemble means, one row per grid point, each against the references.
   body << "<h2>Mean surge ice resistance per grid point</h2>\n<table id=\"grid-points\">\n<tr>";
-  for (const std::string& k : axis_keys) body << "<th>" << html_escape(k) << "</th>";
+  for (size_t a = 0; a < axis_keys.size(); ++a)
+    body << "<th title=\"" << html_escape(axis_keys[a]) << "\">" << html_escape(axis_labels[a]) << "</th>";
   // One unit for the table, from the largest mean (N for a tank model, kN for a ship).
   double typical_kN = 0;
   if (sw.contains("grid_points") && sw["grid_points"].is_array())
@@ -910,7 +920,12 @@ SweepReportSummary write_sweep_report(const fs::path& sweep_dir, const ReportOpt
   if (sw.contains("columns") && sw["columns"].is_array())
     for (const Json& c : sw["columns"])
       if (c.is_string() && c.get<std::string>() != "error") columns.push_back(c.get<std::string>());
-  for (const std::string& c : columns) body << "<th>" << html_escape(c) << "</th>";
+  // Headed by the axes' labels and the other columns' words, each with its key in a tooltip.
+  for (const std::string& c : columns) {
+    const auto axis = std::find(axis_keys.begin(), axis_keys.end(), c);
+    const std::string label = axis != axis_keys.end() ? html_escape(axis_labels[axis - axis_keys.begin()]) : human_label(c);
+    body << "<th title=\"" << html_escape(c) << "\">" << label << "</th>";
+  }
   body << "</tr>\n";
   std::ostringstream failures;
   if (sw.contains("members") && sw["members"].is_array())

@@ -3,6 +3,7 @@
 // the settings.
 #include <iostream>
 
+#include "pipeline/options_describe.h"
 #include "pipeline/stage_main.h"
 #include "render/report.h"
 
@@ -20,6 +21,7 @@ int main(int argc, char** argv) {
     std::cout << floesim::options_doc(floesim::render::ReportOptions{});
     throw CLI::Success();
   }, "print the report options (key, default, unit, meaning) and exit");
+  floesim::add_describe_config(app, [] { return floesim::options_description(floesim::render::ReportOptions{}); });
   return floesim::run_stage(app, argc, argv, [&] {
     if (check_config) {
       if (config.empty()) throw floesim::Error("--check-config needs --config FILE");

@@ -95,7 +95,7 @@ void draw_axis_plot(const SweepPlan& plan, const GatherResult& g, size_t k, Plot
     std::string label;
     for (size_t a = 0; a < plan.axes.size(); ++a)
       if (a != k)
-        label += (label.empty() ? "" : ", ") + plan.axes[a].key + " = " + value_text(gp.axes[plan.axes[a].key]);
+        label += (label.empty() ? "" : ", ") + axis_title(plan.axes[a]) + " = " + value_text(gp.axes[plan.axes[a].key]);
     if (label.empty()) label = "ensemble mean";
     const size_t i = std::find(labels.begin(), labels.end(), label) - labels.begin();
     if (i == labels.size()) labels.push_back(label), lines.emplace_back();
@@ -143,8 +143,9 @@ void draw_axis_plot(const SweepPlan& plan, const GatherResult& g, size_t k, Plot
   for (const Json& v : ax.values)
     tics += (tics.empty() ? "" : ", ") + gnuplot_quoted(value_text(v)) + " " + fmt("%.10g", x_of(v));
   std::ostringstream body;
-  body << "set title " << gnuplot_quoted(plan.name + ": ice resistance against " + ax.key) << " noenhanced font ',14'\n"
-       << "set xlabel " << gnuplot_quoted(ax.key) << " noenhanced\n"
+  body << "set title " << gnuplot_quoted(plan.name + ": ice resistance against " + axis_title(ax))
+       << " noenhanced font ',14'\n"
+       << "set xlabel " << gnuplot_quoted(axis_title(ax)) << " noenhanced\n"
        << "set ylabel 'Mean ice resistance (" << unit.name << "): ensemble mean and 95 % confidence interval'\n"
        << "set xtics (" << tics << ") noenhanced\n"
        << "set xrange [" << fmt("%.10g", lo - pad) << ":" << fmt("%.10g", hi + pad) << "]\n"

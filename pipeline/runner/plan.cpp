@@ -416,7 +416,8 @@ class CasePlanner {
     Json d = c_.contains("digitise") ? c_["digitise"] : Json::object();
     FLOESIM_REQUIRE(d.is_object(), cf_, ": digitise must be an object");
     PlannedStage* st = add("digitise", "digitise", "floe segmentation and polygons", d, {image_png},
-                           {"floes.geojson", "labels.png", "overlay.png", "stats.json", "fsd.png", "fsd.csv"},
+                           {"floes.geojson", "labels.png", "overlay.png", "stats.json", "fsd.png", "fsd.csv",
+                            "overlay.pgw", "overlay.prj", "labels.pgw", "labels.prj"},
                            "floesim-digitise");
     st->args = {image_png.string(), "--metres-per-pixel", number(mpp), "--config", st->config.string(), "--out",
                 st->dir.string()};

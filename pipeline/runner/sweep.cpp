@@ -109,6 +109,41 @@ void check_stage_settings(const Sweep& s, const std::vector<Member>& members, co
                   " stage setting(s) refused, nothing was run:\n  ", join(problems, "\n  "));
 }
 
+// Each axis's label, unit and meaning from its option's own description: the stage whose settings section is the
+// longest prefix of the axis key describes its options (`--describe-config`), asked once per executable. A key in no
+// stage's settings (the case's own, such as image.metres_per_pixel) is named by its words.
+void describe_axes(std::vector<sweep::PlanAxis>& axes, const std::vector<PlannedStage>& stages) {
+  std::map<fs::path, Json> described;
+  for (sweep::PlanAxis& a : axes) {
+    const PlannedStage* owner = nullptr;
+    for (const PlannedStage& st : stages)
+      if (!st.section.empty() && a.key.rfind(st.section + ".", 0) == 0 &&
+          (!owner || st.section.size() > owner->section.size()))
+        owner = &st;
+    if (!owner) {
+      a.label = sweep::axis_label(a.key, "", "");
+      continue;
+    }
+    auto it = described.find(owner->exe);
+    if (it == described.end()) {
+      const Output r = run_capture({owner->exe.string(), "--describe-config"});
+      Json d;
+      try {
+        d = Json::parse(r.text);
+      } catch (const std::exception&) {
+      }
+      FLOESIM_REQUIRE(r.code == 0 && d.is_object(), owner->exe.string(),
+                      " --describe-config did not describe its options (exit ", r.code, "): ", r.text.substr(0, 300));
+      it = described.emplace(owner->exe, std::move(d)).first;
+    }
+    const std::string field = a.key.substr(owner->section.size() + 1);
+    const Json& d = it->second.value(sweep::list_item_path(field), Json::object());
+    a.unit = d.value("unit", "");
+    a.doc = d.value("doc", "");
+    a.label = sweep::axis_label(field, a.unit, a.doc);
+  }
+}
+
 // Writes what the run needs: stage settings, member folders (case.json and links to their stages' folders, named
 // as in a run folder) and plan.json for floesim-gather.
 void write_sweep_files(const Sweep& s, const std::vector<Member>& members, const SweepStages& p, const fs::path& run) {
@@ -121,7 +156,8 @@ void write_sweep_files(const Sweep& s, const std::vector<Member>& members, const
   plan.sweep_file = fs::absolute(s.file).string();
   plan.base_case = fs::absolute(s.base_dir).lexically_normal().string();
   plan.combine = s.zip ? "zip" : "grid";
-  for (const SweepAxis& a : s.axes) plan.axes.push_back({a.key, a.paths, a.values});
+  for (const SweepAxis& a : s.axes) plan.axes.push_back({a.key, a.paths, a.values, "", "", ""});
+  describe_axes(plan.axes, p.stages);
   Json vary = Json::array();
   if (s.vary_field_seed) vary.push_back("field_seed");
   if (s.vary_start) vary.push_back("start");

@@ -389,7 +389,8 @@ SweepTables sweep_tables(const SweepPlan& plan, const fs::path& plan_file, const
                     {"interval", gp.interval_method},
                     {"t_quantile", json_number(gp.ci.t_quantile)}});
   Json axes = Json::array();
-  for (const PlanAxis& a : plan.axes) axes.push_back({{"key", a.key}, {"values", a.values}});
+  for (const PlanAxis& a : plan.axes)
+    axes.push_back({{"key", a.key}, {"label", axis_title(a)}, {"unit", a.unit}, {"doc", a.doc}, {"values", a.values}});
 
   const Json out = {
       {"format", "floesim-sweep-results/1"},

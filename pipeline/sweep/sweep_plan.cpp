@@ -1,6 +1,7 @@
 #include "pipeline/sweep/sweep_plan.h"
 
 #include <algorithm>
+#include <cctype>
 #include <set>
 #include <sstream>
 
@@ -97,9 +98,77 @@ class PlanChecker {
 
 std::string value_text(const Json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
 
+namespace {
+
+bool all_digits(const std::string& s) {
+  return !s.empty() && std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c) != 0; });
+}
+
+// A key's words: "level_ice" -> "level ice"; a unit suffix dropped ("thickness_m" -> "thickness").
+std::string words(std::string key) {
+  for (const char* suffix : {"_mps", "_m2", "_m", "_s", "_deg", "_pa", "_n", "_kg", "_kn", "_hz", "_rpm", "_w"})
+    if (const std::string x = suffix; key.size() > x.size() && key.compare(key.size() - x.size(), x.size(), x) == 0) {
+      key.resize(key.size() - x.size());
+      break;
+    }
+  std::replace(key.begin(), key.end(), '_', ' ');
+  return key;
+}
+
+}  // namespace
+
+std::string list_item_path(const std::string& field) {
+  std::string out, segment;
+  auto flush = [&] {
+    const bool index = all_digits(segment);
+    out += index ? "[]" : (out.empty() ? "" : ".") + segment;
+    segment.clear();
+  };
+  for (char ch : field) {
+    if (ch == '.') flush();
+    else segment += ch;
+  }
+  flush();
+  return out;
+}
+
+std::string axis_label(const std::string& field, const std::string& unit, const std::string& doc) {
+  // The sections it is in: "vessel.propulsion" -> "vessel propulsion"; a list item "ridges.0" -> "ridge 1".
+  std::vector<std::string> parts;
+  for (size_t start = 0;;) {
+    const size_t dot = field.find('.', start);
+    parts.push_back(field.substr(start, dot == std::string::npos ? std::string::npos : dot - start));
+    if (dot == std::string::npos) break;
+    start = dot + 1;
+  }
+  std::string context;
+  for (size_t i = 0; i + 1 < parts.size(); ++i) {
+    const std::string& p = parts[i];
+    if (all_digits(p) && p.size() < 10) {
+      if (!context.empty() && context.back() == 's') context.pop_back();  // "ridges 1" reads "ridge 1"
+      context += " " + std::to_string(std::stoul(p) + 1);
+    } else {
+      context += (context.empty() ? "" : " ") + words(p);
+    }
+  }
+  std::string head = doc;
+  size_t cut = std::string::npos;
+  for (const char* sep : {": ", " (", "; ", ", "}) cut = std::min(cut, head.find(sep));
+  if (cut != std::string::npos) head.resize(cut);
+  if (head.empty()) head = words(parts.back());
+  std::string label = context.empty() ? head : context + ": " + head;
+  if (!unit.empty() && unit != "-") label += " (" + unit + ")";
+  return label;
+}
+
 Json sweep_plan_json(const SweepPlan& p) {
   Json axes = Json::array(), grid = Json::array(), members = Json::array();
-  for (const PlanAxis& a : p.axes) axes.push_back({{"key", a.key}, {"paths", a.paths}, {"values", a.values}});
+  for (const PlanAxis& a : p.axes) {
+    Json axis = {{"key", a.key}, {"paths", a.paths}, {"values", a.values}};
+    for (const auto& [name, text] : {std::pair{"label", &a.label}, {"unit", &a.unit}, {"doc", &a.doc}})
+      if (!text->empty()) axis[name] = *text;
+    axes.push_back(std::move(axis));
+  }
   for (const PlanGridPoint& g : p.grid_points) grid.push_back({{"index", g.index}, {"axes", g.axes}});
   for (const PlanMember& m : p.members) {
     Json stages = Json::array();
@@ -162,6 +231,9 @@ SweepPlan read_sweep_plan(const fs::path& file) {
       PlanAxis a;
       if (!c.text((*axes)[i], w, "key", a.key, true)) continue;
       if (!axis_keys.insert(a.key).second) c.problem(PlanChecker::path(w, "key"), "\"" + a.key + "\" repeats an axis");
+      c.text((*axes)[i], w, "label", a.label, false);
+      c.text((*axes)[i], w, "unit", a.unit, false);
+      c.text((*axes)[i], w, "doc", a.doc, false);
       const Json* v = c.find((*axes)[i], w, "values", true, "");
       if (v && (!v->is_array() || v->empty())) c.problem(PlanChecker::path(w, "values"), "must be a non-empty array");
       for (size_t k = 0; v && v->is_array() && k < v->size(); ++k) {

@@ -16,7 +16,23 @@ struct PlanAxis {
   std::string key;                 // a case key path, e.g. "simulate.vessel.propulsion.speed_mps"
   std::vector<std::string> paths;  // every case key path the axis sets (the key and those it drives together)
   std::vector<Json> values;        // numbers, strings or booleans, in sweep order
+  // A reader's name for it, from the option's own description (axis_label): "level ice: thickness of the sheet (m)";
+  // its unit ("-": none) and the option's meaning as the stage documents it. Empty in a plan that does not give them.
+  std::string label, unit, doc;
 };
+
+// The name a reader sees for an axis: label if the plan gives one, else the key.
+inline const std::string& axis_title(const PlanAxis& a) { return a.label.empty() ? a.key : a.label; }
+
+// A reader's name for the option at `field` (its key path inside its stage's settings: "level_ice.thickness_m",
+// "ridges.0.keel_depth_m") from its unit and meaning: the meaning's head (up to its first ": ", " (", "; " or ", ")
+// after the sections it is in, with the unit: "level ice: thickness of the sheet (m)", "ridge 1: keel draft (m)".
+// Without a meaning, the field's own name in words ("initial speed (m/s)").
+std::string axis_label(const std::string& field, const std::string& unit, const std::string& doc);
+
+// A key path with list indices as the options' description names a list item's fields: "ridges.0.keel_depth_m" ->
+// "ridges[].keel_depth_m".
+std::string list_item_path(const std::string& field);
 
 struct PlanStage {
   std::string name;                             // "synth", "digitise", ... (the member's stages are in run order)

@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include "pipeline/options.h"
+#include "pipeline/options_describe.h"
 #include "pipeline/stage_main.h"
 #include "sim/analysis/shipdata.h"
 
@@ -21,6 +22,10 @@ int main(int argc, char** argv) {
   app.add_option("--out", out, "the CSV to write (FILE.csv; FILE.json and FILE.provenance.json beside it)");
   app.add_flag("--check-config", check_config, "read and check --config (strictly, as a run would), write nothing");
   app.add_flag("--help-config", help_config, "print the shipdata options as a Markdown table and exit");
+  floesim::add_describe_config(app, [] {
+    const floesim::sim::ShipDataOptions defaults;
+    return floesim::options_description(defaults);
+  });
   return floesim::run_stage(app, argc, argv, [&] {
     if (help_config) {
       const floesim::sim::ShipDataOptions defaults;

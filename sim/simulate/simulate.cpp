@@ -64,6 +64,19 @@ void fill_run_stats(const World& w, const RecorderSums& sums, long steps, double
   stats.mean_crushing_pairs = sums.crushing / steps;
 }
 
+// What a reader of the run's loads must know of it: a mean whose interval the run is too short for, floes the run
+// left out.
+std::vector<std::string> run_warnings(const nlohmann::json& summary, const Model& model) {
+  std::vector<std::string> out;
+  const nlohmann::json& ci = summary["mean_surge_ice_load_interval"];
+  if (!ci.value("meaningful", true))
+    out.push_back("the mean surge ice load's 95 % interval cannot be trusted: " + ci.value("note", std::string()));
+  if (const size_t n = model.removed_floe_ids.size(); n > 0)
+    out.push_back(std::to_string(n) + (n == 1 ? " floe was" : " floes were") +
+                  " left out of the run: they overlapped the vessel's initial footprint");
+  return out;
+}
+
 }  // namespace
 
 Results simulate(const SimulateOptions& o, Model model, RunStats& stats, std::ostream* progress,
@@ -207,6 +220,7 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   // Every warning of the stages before (the floes' maker) and of this one, for the report.
   nlohmann::json warnings = nlohmann::json::array();
   for (const std::string& w : field.warnings) warnings.push_back("floes (" + floes_file.filename().string() + "): " + w);
+  for (const std::string& w : run_warnings(summary, world->model())) warnings.push_back("simulate: " + w);
   summary["warnings"] = warnings;
   summary["settings"] = options_to_json(o);
   summary["provenance"] = prov;

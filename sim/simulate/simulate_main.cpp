@@ -7,6 +7,7 @@
 #include "pipeline/options.h"
 #include "pipeline/results_io.h"
 #include "pipeline/vtk_series.h"
+#include "pipeline/options_describe.h"
 #include "pipeline/stage_main.h"
 #include "sim/simulate/simulate.h"
 
@@ -30,6 +31,10 @@ int main(int argc, char** argv) {
   app.add_option("--paraview-from", paraview_from,
                  "write the ParaView series (DIR/paraview/results.pvd, as simulate.paraview does) of this existing "
                  "results.h5 into --out DIR, and exit");
+  floesim::add_describe_config(app, [] {
+    const floesim::sim::SimulateOptions defaults;  // named, as for --help-config
+    return floesim::options_description(defaults);
+  });
   return floesim::run_stage(app, argc, argv, [&] {
     if (!paraview_from.empty()) {
       if (out.empty()) throw floesim::Error("--paraview-from needs --out DIR");

@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "pipeline/options.h"
+#include "pipeline/options_describe.h"
 #include "pipeline/stage_main.h"
 #include "sim/vessel/hull.h"
 
@@ -37,6 +38,16 @@ int main(int argc, char** argv) {
   app.add_option("--out", out, "output OBJ file; the sidecar is written beside it with extension .json");
   app.add_flag("--check-config", check_config, "read and check --config (strictly, as a run would), write nothing");
   app.add_flag("--help-config", help_config, "print the hull options as Markdown tables and exit");
+  // One description for the three kinds of hull config: the generator's keys (a case's hull.generate), the
+  // structure's ("structure.*") and the user mesh's (a case's hull section); where a key is in two, the first's.
+  floesim::add_describe_config(app, [] {
+    floesim::Json all = floesim::options_description(floesim::sim::HullGeneratorOptions{});
+    for (const floesim::Json& more : {floesim::options_description(StructureHullConfig{}),
+                                      floesim::options_description(floesim::sim::HullImportOptions{})})
+      for (auto it = more.begin(); it != more.end(); ++it)
+        if (!all.contains(it.key())) all[it.key()] = it.value();
+    return all;
+  });
   return floesim::run_stage(app, argc, argv, [&] {
     namespace sim = floesim::sim;
     if (help_config) {

@@ -7,6 +7,7 @@
 #include "pipeline/error.h"
 #include "pipeline/runner/plan.h"
 #include "pipeline/runner/sweep.h"
+#include "pipeline/sweep/sweep_plan.h"
 
 using namespace floesim;
 namespace fs = std::filesystem;
@@ -96,4 +97,22 @@ TEST(Plan, SweepKeyPathsReachListElementsByIndex) {
   }
   EXPECT_NE(error.find("simulate.ridges is a list of 2"), std::string::npos) << error;
   EXPECT_NE(error.find("sweep.json"), std::string::npos) << error;
+}
+
+// A sweep axis is named for a reader from its option's unit and meaning (the stage's --describe-config), after the
+// sections it is in; a list index is the item's number from 1.
+TEST(SweepAxis, ALabelIsTheOptionsMeaningWithItsSectionsAndUnit) {
+  EXPECT_EQ(sweep::axis_label("level_ice.thickness_m", "m", "thickness of the sheet (when thickness_profile is empty)"),
+            "level ice: thickness of the sheet (m)");
+  EXPECT_EQ(sweep::axis_label("ridges.0.keel_depth_m", "m", "keel draft: its deepest point below the waterline"),
+            "ridge 1: keel draft (m)");
+  EXPECT_EQ(sweep::axis_label("vessel.propulsion.speed_mps", "m/s", "speed: prescribed forward speed through the water"),
+            "vessel propulsion: speed (m/s)");
+  EXPECT_EQ(sweep::axis_label("concentration", "-", "target floe area / image area"), "target floe area / image area");
+  // Without a description (a key of the case itself): the key's words.
+  EXPECT_EQ(sweep::axis_label("image.metres_per_pixel", "", ""), "image: metres per pixel");
+  EXPECT_EQ(sweep::axis_label("duration_s", "s", ""), "duration (s)");
+  EXPECT_EQ(sweep::list_item_path("ridges.0.keel_depth_m"), "ridges[].keel_depth_m");
+  EXPECT_EQ(sweep::list_item_path("vessel.propellers.12.diameter_m"), "vessel.propellers[].diameter_m");
+  EXPECT_EQ(sweep::list_item_path("level_ice.thickness_m"), "level_ice.thickness_m");
 }

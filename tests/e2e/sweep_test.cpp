@@ -133,6 +133,11 @@ TEST_F(TinySweep, SharedStagesRunOnceAndEveryMemberIsGathered) {
   EXPECT_NEAR(std::stod(rows[3].at("simulate.vessel.y_m")), 82.001, 1e-12);
   EXPECT_TRUE(fs::exists(run_ / "sweep.json"));
   EXPECT_TRUE(fs::exists(run_ / "members" / "g001-e01" / "sim" / "summary.json"));  // a member is a run folder
+  // The axis by its option's own description (floesim-simulate --help-config: vessel.initial_speed_mps, m/s,
+  // "initial forward speed"), in sweep.json and on the report, not by its key.
+  const nlohmann::json sw = nlohmann::json::parse(read_text(run_ / "sweep.json"));
+  EXPECT_EQ(sw["axes"][0]["label"], "vessel: initial forward speed (m/s)");
+  EXPECT_EQ(sw["axes"][0]["unit"], "m/s");
   // The sweep's report: every grid point and member on one page, the gathered plot embedded, nothing missing.
   const std::string html = read_text(run_ / "report.html");
   EXPECT_NE(html.find("id=\"grid-points\""), std::string::npos);
@@ -141,6 +146,8 @@ TEST_F(TinySweep, SharedStagesRunOnceAndEveryMemberIsGathered) {
   EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
   EXPECT_EQ(html.find("id=\"missing\""), std::string::npos);
   EXPECT_EQ(html.find("id=\"failed-members\""), std::string::npos);
+  EXPECT_NE(html.find(">vessel: initial forward speed (m/s)</th>"), std::string::npos);
+  EXPECT_EQ(html.find(">simulate.vessel.initial_speed_mps<"), std::string::npos);  // no key as a visible cell
 }
 
 // The member's case.json run alone with floesim run gives the summary the sweep gathered, number for number.

@@ -171,7 +171,8 @@ TEST(DigitiseSynthetic, ArtefactsAgreeWithEachOther) {
   std::set<std::string> files;
   for (const auto& n : test::list_dir(out)) files.insert(n);
   EXPECT_EQ(files, (std::set<std::string>{"floes.geojson", "labels.png", "overlay.png", "stats.json", "fsd.png",
-                                          "fsd.csv", "score.json"}));
+                                          "fsd.csv", "score.json", "labels.pgw", "labels.prj", "overlay.pgw",
+                                          "overlay.prj"}));
 
   // floes.geojson reads back through the strict reader (simple, CCW, unique ids >= 1).
   const FloeField floes = read_floes(out / "floes.geojson");

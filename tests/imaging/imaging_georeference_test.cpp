@@ -2,7 +2,12 @@
 // longitude against a published geodesic, the heading's turn, and digitise's floes_wgs84.geojson and CRS members.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -91,6 +96,59 @@ TEST(Georeference, DigitiseWritesTheFloesInWgs84AndEveryFileDeclaresItsCrs) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("floes.geojson"), std::string::npos) << e.what();
   }
+}
+
+std::string text_of(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// A raster's world file (A, D, B, E, C, F): where the image point at pixel (column, row) lies.
+std::array<double, 2> world_point(const std::filesystem::path& pgw, double col, double row) {
+  std::ifstream in(pgw);
+  double a = 0, d = 0, b = 0, e = 0, c = 0, f = 0;
+  EXPECT_TRUE(static_cast<bool>(in >> a >> d >> b >> e >> c >> f)) << pgw;
+  return {a * col + b * row + c, d * col + e * row + f};
+}
+
+// The rasters' world files place their corners by hand geometry. A 160 x 120 px image at 1 m/px: without a
+// georeference its bottom-left corner (pixel -0.5, 119.5) is at the image frame's origin and its top-right at
+// (160, 120) m. With heading 90 deg the image's up axis points east and its right axis south: its top-left corner,
+// 80 m left and 60 m up from the centre, is 60 m east and 80 m north of it in the azimuthal equidistant map the
+// .prj names about the centre's latitude and longitude.
+TEST(Georeference, TheRastersWorldFilesPutTheirCornersWhereTheFloesAre) {
+  cv::Mat img(120, 160, CV_8U);
+  cv::randu(img, 30, 60);
+  cv::rectangle(img, cv::Rect(20, 20, 50, 40), cv::Scalar(220), cv::FILLED);
+  {
+    test::ScratchDir d;
+    DigitiseRequest req = georeferenced_request(d, img, Json());
+    req.config = Json::object();
+    run_digitise(req);
+    for (const char* name : {"labels", "overlay"}) {
+      const std::filesystem::path out = req.out_dir / name;
+      const std::string pgw = out.string() + ".pgw";
+      const auto bl = world_point(pgw, -0.5, 119.5), tr = world_point(pgw, 159.5, -0.5);
+      EXPECT_NEAR(bl[0], 0, 1e-12);
+      EXPECT_NEAR(bl[1], 0, 1e-12);
+      EXPECT_NEAR(tr[0], 160, 1e-12);
+      EXPECT_NEAR(tr[1], 120, 1e-12);
+      EXPECT_EQ(text_of(out.string() + ".prj"), std::string(kLocalMetresCrs) + "\n");
+    }
+  }
+  test::ScratchDir d;
+  const DigitiseRequest req = georeferenced_request(d, img, {78.2, 15.6, 90.0});
+  run_digitise(req);
+  const std::string pgw = (req.out_dir / "overlay.pgw").string();
+  const auto tl = world_point(pgw, -0.5, -0.5), br = world_point(pgw, 159.5, 119.5);
+  EXPECT_NEAR(tl[0], 60, 1e-9);
+  EXPECT_NEAR(tl[1], 80, 1e-9);
+  EXPECT_NEAR(br[0], -60, 1e-9);
+  EXPECT_NEAR(br[1], -80, 1e-9);
+  const std::string prj = text_of(req.out_dir / "overlay.prj");
+  EXPECT_NE(prj.find("PROJECTION[\"Azimuthal_Equidistant\"]"), std::string::npos) << prj;
+  EXPECT_NE(prj.find("PARAMETER[\"Latitude_Of_Origin\",78.2]"), std::string::npos) << prj;
+  EXPECT_NE(prj.find("PARAMETER[\"Central_Meridian\",15.6]"), std::string::npos) << prj;
 }
 
 TEST(Georeference, ALatitudeOffTheEarthIsRefusedNamingTheKey) {

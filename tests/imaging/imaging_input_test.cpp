@@ -64,7 +64,8 @@ TEST_F(DigitiseBadInput, TheGoodImageWorks) {
   // The reference for the cases below: the same request on a good image succeeds.
   const DigitiseResult res = run_digitise(request(good_));
   EXPECT_EQ(res.floes.floes.size(), 2u);
-  EXPECT_EQ(test::list_dir(out_).size(), 6u);  // floes, labels, overlay, stats, fsd.png, fsd.csv
+  // floes, labels, overlay, stats, fsd.png, fsd.csv, and the rasters' world files and CRS (.pgw, .prj)
+  EXPECT_EQ(test::list_dir(out_).size(), 10u);
 }
 
 TEST_F(DigitiseBadInput, MissingFile) {

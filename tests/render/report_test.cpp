@@ -324,15 +324,35 @@ TEST_F(TinyRun, NoSummaryIsAnErrorAndWritesNothing) {
   }
 }
 
-// Every stage's warnings on the first screen (issue #37, part 3): the tiny run has none and says so; a warning of
-// the floes' maker carried into summary.json is listed, escaped. The video's sidecar and note say how fast it plays:
+// Every stage's warnings on the first screen (issue #37, part 3): a run without any says so; the simulation's own
+// and a warning of the floes' maker carried into summary.json are listed, escaped. The video's sidecar and note say how fast it plays:
 // the case's output interval times the frames per second.
 TEST_F(TinyRun, WarningsAndThePlaybackSpeedAreOnThePage) {
   ASSERT_EQ(ran_.code, 0) << ran_.text;
   const Json summary = load_json_file(run_ / "sim/summary.json");
   ASSERT_TRUE(summary.contains("warnings")) << "summary.json lists the warnings, also when there are none";
-  EXPECT_TRUE(summary["warnings"].empty());
-  write_report(run_, ReportOptions{}, root_ / "nowarn.html", Json::object());
+  // The tiny run's floes come from a clean digitisation. The simulation warns of its own, each warning naming the
+  // stage: of floes it left out (summary.json's removed_floes: those under the vessel at the start) and of an
+  // interval that cannot be trusted (the interval's own flag).
+  const size_t removed = summary["removed_floes"].get<size_t>();
+  const bool trusted = summary["mean_surge_ice_load_interval"]["meaningful"].get<bool>();
+  std::vector<std::string> expected;
+  if (!trusted) expected.push_back("simulate: the mean surge ice load's 95 % interval cannot be trusted");
+  if (removed > 0)
+    expected.push_back("simulate: " + std::to_string(removed) + (removed == 1 ? " floe was" : " floes were") +
+                       " left out of the run");
+  ASSERT_EQ(summary["warnings"].size(), expected.size()) << summary["warnings"].dump();
+  write_report(run_, ReportOptions{}, root_ / "own.html", Json::object());
+  const std::string own = read_text(root_ / "own.html");
+  for (size_t k = 0; k < expected.size(); ++k) {
+    EXPECT_EQ(summary["warnings"][k].get<std::string>().rfind(expected[k], 0), 0u) << summary["warnings"][k];
+    EXPECT_NE(own.find("<li class=\"warning\">" + expected[k]), std::string::npos) << expected[k];
+  }
+  const fs::path quiet = copy_run("quiet");
+  Json none = summary;
+  none["warnings"] = Json::array();
+  std::ofstream(quiet / "sim/summary.json") << none.dump(2);
+  write_report(quiet, ReportOptions{}, root_ / "nowarn.html", Json::object());
   const std::string clean = read_text(root_ / "nowarn.html");
   EXPECT_NE(clean.find("No stage warned."), std::string::npos);
   const Json side = load_json_file(run_ / "video/transit.json");
