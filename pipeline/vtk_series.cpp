@@ -63,9 +63,12 @@ std::string frame_file(const Results& r, const FrameReplay& replay, size_t k) {
     for (int c = 0; c < 3; ++c) centre.push_back(r.state_position_m[3 * static_cast<size_t>(row) + c]);
   };
   auto end_cell = [&] { offsets.push_back(static_cast<int32_t>(connectivity.size())); };
-  auto point = [&](const Eigen::Vector3d& x) {
-    connectivity.push_back(static_cast<int32_t>(points.size() / 3));
+  auto add_point = [&](const Eigen::Vector3d& x) {
     for (int c = 0; c < 3; ++c) points.push_back(static_cast<float>(x[c]));
+  };
+  auto point = [&](const Eigen::Vector3d& x) {  // a point of the cell being written, its own
+    connectivity.push_back(static_cast<int32_t>(points.size() / 3));
+    add_point(x);
   };
   for (size_t i = 0; i < replay.rows().size(); ++i) {
     const int64_t row = replay.rows()[i];
@@ -84,11 +87,27 @@ std::string frame_file(const Results& r, const FrameReplay& replay, size_t k) {
     }
     const size_t gi = static_cast<size_t>(g);
     const int32_t floe_kind = r.floe_level_ice[gi] ? 1 : (r.floe_parent_id[gi] >= 0 ? 2 : 0);
+    // A prism of the floe's thickness on 2 n shared points (top ring, then bottom ring): its top face, its bottom
+    // face (turned to face down), a quad per side of its outline.
+    const double half = r.floe_thickness_m[gi] / 2;
+    const int64_t v0 = r.floe_vertex_offset[gi], n = r.floe_vertex_offset[gi + 1] - v0;
+    const auto first = static_cast<int32_t>(points.size() / 3);
+    for (double z : {half, -half})
+      for (int64_t v = v0; v < v0 + n; ++v)
+        add_point(q * Eigen::Vector3d(r.floe_vertices_m[2 * v], r.floe_vertices_m[2 * v + 1], z) + p);
+    const auto top = [&](int64_t i) { return first + static_cast<int32_t>(i % n); };
+    const auto bottom = [&](int64_t i) { return first + static_cast<int32_t>(n + i % n); };
     cell(row, floe_kind);
-    const double top = r.floe_thickness_m[gi] / 2;
-    for (int64_t v = r.floe_vertex_offset[gi]; v < r.floe_vertex_offset[gi + 1]; ++v)
-      point(q * Eigen::Vector3d(r.floe_vertices_m[2 * v], r.floe_vertices_m[2 * v + 1], top) + p);
+    for (int64_t i = 0; i < n; ++i) connectivity.push_back(top(i));
     end_cell();
+    cell(row, floe_kind);
+    for (int64_t i = n - 1; i >= 0; --i) connectivity.push_back(bottom(i));
+    end_cell();
+    for (int64_t i = 0; i < n; ++i) {
+      cell(row, floe_kind);
+      for (int32_t c : {bottom(i), bottom(i + 1), top(i + 1), top(i)}) connectivity.push_back(c);
+      end_cell();
+    }
   }
   const double t = r.frame_time_s[k];
   const std::vector<double> time_value{t};

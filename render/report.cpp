@@ -602,12 +602,13 @@ void floe_stats_table(std::ostream& body, Page& pg) {
   const Json st = pg.json("floes/stats.json", "floe statistics");
   body << "<table>\n" << scalar_rows(st);
   if (const Json* img = find(st, {"image"})) body << scalar_rows(*img, "image.");
-  for (const char* fit : {"mle", "truncated_mle"})
+  for (const auto& [fit, name] : {std::pair{"mle", "maximum likelihood"}, {"truncated_mle", "maximum likelihood, "
+                                                                                        "truncated at the largest floe"}})
     if (const Json* a = find(st, {"power_law", fit}))
-      body << "<tr><th>power-law exponent (" << fit << ")</th><td>" << scalar_text(a->value("alpha", Json()))
+      body << "<tr><th>power-law exponent (" << name << ")</th><td>" << scalar_text(a->value("alpha", Json()))
            << " &plusmn; " << scalar_text(a->value("alpha_stderr", Json())) << " (n = "
-           << scalar_text(a->value("n", Json())) << ", d_min = " << scalar_text(a->value("d_min_m", Json()))
-           << " m)</td></tr>\n";
+           << scalar_text(a->value("n", Json())) << ", smallest diameter fitted "
+           << scalar_text(a->value("d_min_m", Json())) << " m)</td></tr>\n";
   body << "</table>\n";
 }
 

@@ -154,11 +154,19 @@ TEST_F(PythonReader, TheParaViewSeriesReadByVtkHoldsFrameReplaysBodies) {
     EXPECT_EQ(f["time_value"].get<double>(), r.frame_time_s[k]);
     const size_t step = static_cast<size_t>(std::llround(r.frame_time_s[k] / r.attributes["time_step_s"].get<double>())) - 1;
     EXPECT_EQ(f["surge_ice_load_n"].get<double>(), r.get("ice_load")[6 * step]);
-    ASSERT_EQ(f["body_id"].size(), hull_cells + replay.rows().size() - 1) << "frame " << k;
+    // The hull's triangles, and each floe as a prism: top, bottom and a quad per side of its outline.
+    auto cells_of = [&](size_t i) {
+      const int32_t g = replay.floes()[i];
+      return g < 0 ? hull_cells
+                   : static_cast<size_t>(r.floe_vertex_offset[g + 1] - r.floe_vertex_offset[g]) + 2;
+    };
+    size_t total = 0;
+    for (size_t i = 0; i < replay.rows().size(); ++i) total += cells_of(i);
+    ASSERT_EQ(f["body_id"].size(), total) << "frame " << k;
     size_t cell = 0;
     for (size_t i = 0; i < replay.rows().size(); ++i) {
       const size_t row = static_cast<size_t>(replay.rows()[i]);
-      const size_t cells = replay.floes()[i] < 0 ? hull_cells : 1;
+      const size_t cells = cells_of(i);
       for (size_t c = 0; c < cells; ++c, ++cell) {
         EXPECT_EQ(f["body_id"][cell].get<int>(), r.state_body_id[row]) << "frame " << k << " cell " << cell;
         EXPECT_EQ(f["kind"][cell].get<int>(), replay.floes()[i] < 0 ? 3 : (r.floe_parent_id[replay.floes()[i]] >= 0 ? 2 : 0));
@@ -172,7 +180,8 @@ TEST_F(PythonReader, TheParaViewSeriesReadByVtkHoldsFrameReplaysBodies) {
       const Eigen::Vector3d want = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized() * v0 +
                                    Eigen::Vector3d(r.state_position_m[3 * row], r.state_position_m[3 * row + 1],
                                                    r.state_position_m[3 * row + 2]);
-      for (int d = 0; d < 3; ++d) EXPECT_NEAR(f["first_point"][cell - 1][d].get<double>(), want[d], 1e-3);
+      // The floe's first cell is its top face, from the outline's first vertex.
+      for (int d = 0; d < 3; ++d) EXPECT_NEAR(f["first_point"][cell - cells][d].get<double>(), want[d], 1e-3);
     }
   }
 }
