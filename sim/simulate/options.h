@@ -21,7 +21,7 @@ struct SimulateOptions : EngineSettings {
   // 10 s of a large field take minutes of wall time; a stopped run then loses at most that much.
   double checkpoint_interval_s = 10.0;
   // Also write OUT/paraview (results.pvd and a .vtp per frame: pipeline/vtk_series.h). Off by default: every frame
-  // holds the whole field, ~20 bytes per floe vertex, which for a long run is far more than results.h5.
+  // holds the whole field, ~90 bytes per floe vertex, which for a long run is far more than results.h5.
   bool paraview = false;
   HullLoadOptions hull;
 
