@@ -467,10 +467,15 @@ void case_section(std::ostream& body, const std::string& run_name, const fs::pat
   body << "</table>\n";
 }
 
-// 3. Section "Warnings": what the stages warned of (summary.json's warnings: the floes' maker's and simulate's), on
-// the first screen, so that a result built on a degenerate input is not read as a sound one.
-void warnings_section(std::ostream& body, const Json& summary) {
-  const Json w = summary.value("warnings", Json::array());
+// 3. Section "Warnings": what the stages warned of (summary.json's warnings: the floes' maker's and simulate's; the
+// video sidecar's: render's), on the first screen, so that a result built on a degenerate input is not read as a
+// sound one.
+void warnings_section(std::ostream& body, const Json& summary, const Json& video_sidecar) {
+  Json w = summary.value("warnings", Json::array());
+  if (!w.is_array()) w = Json::array();
+  if (video_sidecar.is_object())
+    for (const Json& line : video_sidecar.value("warnings", Json::array()))
+      if (line.is_string()) w.push_back("render: " + line.get<std::string>());
   body << "<h2>Warnings</h2>\n";
   if (!w.is_array() || w.empty()) {
     body << "<p class=\"note\" id=\"no-warnings\">No stage warned.</p>\n";
@@ -789,7 +794,7 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
   const fs::path case_json = case_file(run_dir).lexically_normal();
   const std::string title = report_title(o, run_name, case_json);
   case_section(body, run_name, case_json, summary, pg);
-  warnings_section(body, summary);
+  warnings_section(body, summary, optional_json(pg, "video/transit.json", "video sidecar"));
   mean_loads_section(body, rs);
   load_plot_section(body, run_dir, pg);
   identified_section(body, run_dir, pg, rs);
@@ -858,7 +863,20 @@ SweepReportSummary write_sweep_report(const fs::path& sweep_dir, const ReportOpt
       body << "<tr><th title=\"" << html_escape(axis_keys.back() + ": " + a.value("doc", "")) << "\">"
            << html_escape(axis_labels.back()) << "</th><td>varied over " << values << "</td></tr>\n";
     }
-  if (sw.contains("ensemble")) body << "<tr><th>ensemble</th><td>" << html_escape(sw["ensemble"].dump()) << "</td></tr>\n";
+  if (const Json& e = sw.value("ensemble", Json()); e.is_object()) {
+    // "3 members at each grid point, each with another floe field and start (0.001 m apart)".
+    std::string vary;
+    for (const Json& v : e.value("vary", Json::array())) {
+      if (!v.is_string()) continue;
+      const std::string what = v == "field_seed" ? "floe field" : v.get<std::string>();
+      vary += (vary.empty() ? "" : " and ") + what;
+    }
+    std::string text = scalar_text(e.value("size", Json())) + " member(s) at each grid point";
+    if (!vary.empty()) text += ", each with another " + html_escape(vary);
+    if (const Json& step = e.value("start_step_m", Json()); step.is_number() && vary.find("start") != std::string::npos)
+      text += " (starts " + readable_number(step.get<double>()) + " m apart)";
+    body << "<tr><th title=\"ensemble\">ensemble</th><td>" << text << "</td></tr>\n";
+  }
   body << "</table>\n";
 
   // The ensemble means, one row per grid point, each against the references.

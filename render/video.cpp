@@ -86,6 +86,13 @@ RenderStats render_video(const Results& r, const RenderOptions& o, const fs::pat
   st.floes_culled_per_frame /= static_cast<double>(n);
 
   const double playback = playback_speed(r, o.fps);
+  // What a viewer must know that the video does not show: frames left out.
+  nlohmann::json warnings = nlohmann::json::array();
+  if (n < r.frames())
+    warnings.push_back("the video shows the first " + std::to_string(n) + " of the run's " +
+                       std::to_string(r.frames()) + " frames (render.max_frames), up to t = " +
+                       std::to_string(static_cast<long>(std::lround(r.frame_time_s[n - 1]))) + " s of " +
+                       std::to_string(static_cast<long>(std::lround(r.frame_time_s.back()))) + " s");
   nlohmann::json side = {
       {"video", out_mp4.filename().string()},
       {"codec", "H.264 (avc1), MP4"},
@@ -101,6 +108,7 @@ RenderStats render_video(const Results& r, const RenderOptions& o, const fs::pat
       {"view", o.view},
       {"split_views", o.view == "split" ? nlohmann::json(o.split_views) : nlohmann::json()},
       {"strip_chart", o.strip_chart},
+      {"warnings", warnings},
       {"provenance", provenance},
   };
   fs::path sidecar = out_mp4;

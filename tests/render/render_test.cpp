@@ -189,6 +189,7 @@ TEST(Render, VideoHasOneFramePerResultsFrameAndShowsTheScene) {
 
   const auto side = nlohmann::json::parse(read_text(dir / "out" / "transit.json"));
   EXPECT_EQ(side["frames"], 12);
+  EXPECT_TRUE(side["warnings"].empty());
   EXPECT_EQ(side["provenance"]["program"], "floesim-render");
   EXPECT_EQ(listing(dir / "out"), (std::vector<std::string>{"transit.json", "transit.mp4"}));
   fs::remove_all(dir);
@@ -203,6 +204,12 @@ TEST(Render, MaxFramesLimitsTheVideoAndStillFrameWritesAnImage) {
   int n = 0;
   for (cv::Mat f; cap.read(f);) ++n;
   EXPECT_EQ(n, 5);
+  // The sidecar warns that the video stops short (the report lists it with the stages' warnings); a whole run's
+  // video (the test above) has none.
+  const auto side = nlohmann::json::parse(read_text(dir / "v.json"));
+  ASSERT_EQ(side["warnings"].size(), 1u) << side.dump();
+  const std::string w = side["warnings"][0];
+  EXPECT_EQ(w.rfind("the video shows the first 5 of the run's 12 frames (render.max_frames)", 0), 0u) << w;
 
   render_still(dir / "results.h5", cfg, 7, dir / "still.png");
   const cv::Mat still = cv::imread((dir / "still.png").string());

@@ -368,6 +368,13 @@ TEST_F(TinyRun, WarningsAndThePlaybackSpeedAreOnThePage) {
   EXPECT_NE(html.find("<li class=\"warning\">floes (floes.geojson): image.png: no water found &lt;one class&gt;</li>"),
             std::string::npos);
   EXPECT_LT(html.find("<h2>Warnings</h2>"), html.find("<h2>Video</h2>")) << "before the details";
+  // The video sidecar's warnings too, named by their stage.
+  Json cut = side;
+  cut["warnings"] = {"the video shows the first 5 of the run's 12 frames"};
+  std::ofstream(run / "video/transit.json") << cut.dump(2);
+  write_report(run, ReportOptions{}, root_ / "cut.html", Json::object());
+  EXPECT_NE(read_text(root_ / "cut.html").find("<li class=\"warning\">render: the video shows the first 5"),
+            std::string::npos);
 }
 
 // The first screen says what was run in words a reader knows (issue #37, part 2): no raw key (a dot or an
