@@ -151,7 +151,11 @@ std::string axis_label(const std::string& field, const std::string& unit, const 
       context += (context.empty() ? "" : " ") + words(p);
     }
   }
+  // A meaning that starts by restating the key ("speed: prescribed forward speed through the water" for speed_mps)
+  // is read from after it.
   std::string head = doc;
+  if (const size_t colon = head.find(": "); colon != std::string::npos && head.substr(0, colon) == words(parts.back()))
+    head = head.substr(colon + 2);
   size_t cut = std::string::npos;
   for (const char* sep : {": ", " (", "; ", ", "}) cut = std::min(cut, head.find(sep));
   if (cut != std::string::npos) head.resize(cut);

@@ -25,8 +25,10 @@ struct PlanAxis {
 inline const std::string& axis_title(const PlanAxis& a) { return a.label.empty() ? a.key : a.label; }
 
 // A reader's name for the option at `field` (its key path inside its stage's settings: "level_ice.thickness_m",
-// "ridges.0.keel_depth_m") from its unit and meaning: the meaning's head (up to its first ": ", " (", "; " or ", ")
-// after the sections it is in, with the unit: "level ice: thickness of the sheet (m)", "ridge 1: keel draft (m)".
+// "ridges.0.keel_depth_m") from its unit and meaning: the meaning's head (up to its first ": ", " (", "; " or ", ";
+// after a first "name: " that only restates the key) after the sections it is in, with the unit: "level ice:
+// thickness of the sheet (m)", "ridge 1: keel draft (m)", "vessel propulsion: prescribed forward speed through the
+// water (m/s)".
 // Without a meaning, the field's own name in words ("initial speed (m/s)").
 std::string axis_label(const std::string& field, const std::string& unit, const std::string& doc);
 

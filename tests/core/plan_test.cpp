@@ -107,7 +107,7 @@ TEST(SweepAxis, ALabelIsTheOptionsMeaningWithItsSectionsAndUnit) {
   EXPECT_EQ(sweep::axis_label("ridges.0.keel_depth_m", "m", "keel draft: its deepest point below the waterline"),
             "ridge 1: keel draft (m)");
   EXPECT_EQ(sweep::axis_label("vessel.propulsion.speed_mps", "m/s", "speed: prescribed forward speed through the water"),
-            "vessel propulsion: speed (m/s)");
+            "vessel propulsion: prescribed forward speed through the water (m/s)");
   EXPECT_EQ(sweep::axis_label("concentration", "-", "target floe area / image area"), "target floe area / image area");
   // Without a description (a key of the case itself): the key's words.
   EXPECT_EQ(sweep::axis_label("image.metres_per_pixel", "", ""), "image: metres per pixel");
