@@ -871,7 +871,8 @@ SweepReportSummary write_sweep_report(const fs::path& sweep_dir, const ReportOpt
       const std::string what = v == "field_seed" ? "floe field" : v.get<std::string>();
       vary += (vary.empty() ? "" : " and ") + what;
     }
-    std::string text = scalar_text(e.value("size", Json())) + " member(s) at each grid point";
+    const Json size = e.value("size", Json());
+    std::string text = scalar_text(size) + (size == 1 ? " member" : " members") + " at each grid point";
     if (!vary.empty()) text += ", each with another " + html_escape(vary);
     if (const Json& step = e.value("start_step_m", Json()); step.is_number() && vary.find("start") != std::string::npos)
       text += " (starts " + readable_number(step.get<double>()) + " m apart)";
