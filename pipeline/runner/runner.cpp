@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <sys/file.h>
 #include <sys/prctl.h>
+#include <sys/statvfs.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -285,6 +286,12 @@ int run_case(const RunOptions& o) {
     return 128 + sig;
   }
   if (code != 0) {
+    // A full disk that ninja met itself (its build log) has no stage to report it: said here, as a stage says it.
+    struct statvfs fs_info {};
+    if (::statvfs(run.c_str(), &fs_info) == 0 && fs_info.f_bavail == 0)
+      std::cerr << "floesim: error: " << (run / "").string()
+                << ": No space left on device (the disk is full: free space there, or write the run to another "
+                   "folder); a stage or ninja's build log could not be written\n";
     std::cerr << "floesim: the run stopped at a failed stage (see its message above). Its artefacts and those "
                  "downstream of it were removed. Stage settings come from "
               << (o.case_dir / "case.json").string() << " (written per stage to " << (run / "config").string()
