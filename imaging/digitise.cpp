@@ -184,9 +184,8 @@ DigitiseResult run_digitise(const DigitiseRequest& req) {
       parts_f(req.out_dir / "convex_parts.geojson"), wgs84_f(req.out_dir / "floes_wgs84.geojson"),
       labels_pgw(req.out_dir / "labels.pgw"), labels_prj(req.out_dir / "labels.prj"),
       overlay_pgw(req.out_dir / "overlay.pgw"), overlay_prj(req.out_dir / "overlay.prj");
-  const bool georeferenced = !o.georeference.empty();
-  const std::optional<GeoReference> where =
-      georeferenced ? std::optional<GeoReference>(georeference_from(o.georeference)) : std::nullopt;
+  std::optional<GeoReference> where;  // digitise.georeference, if the case gives one
+  if (!o.georeference.empty()) where = georeference_from(o.georeference);
   const WorldFile world = raster_world_file(res.floes.width_m, res.floes.height_m, req.metres_per_pixel,
                                             where ? &*where : nullptr);
   for (const AtomicFile* f : {&labels_pgw, &overlay_pgw}) write_file_checked(f->tmp(), world.pgw, f->path());
@@ -205,7 +204,7 @@ DigitiseResult run_digitise(const DigitiseRequest& req) {
     write_json_tmp(score_f, sj);
   }
   if (o.convex_parts) write_json_tmp(parts_f, convex_parts_geojson(res.floes));
-  if (georeferenced) write_json_tmp(wgs84_f, floes_to_wgs84_geojson(res.floes, *where));
+  if (where) write_json_tmp(wgs84_f, floes_to_wgs84_geojson(res.floes, *where));
   geo.commit();
   labels.commit();
   overlay.commit();
@@ -215,7 +214,7 @@ DigitiseResult run_digitise(const DigitiseRequest& req) {
   fsd_csv.commit();
   if (res.score) score_f.commit();
   if (o.convex_parts) parts_f.commit();
-  if (georeferenced) wgs84_f.commit();
+  if (where) wgs84_f.commit();
   return res;
 }
 

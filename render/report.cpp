@@ -477,7 +477,7 @@ void warnings_section(std::ostream& body, const Json& summary, const Json& video
     for (const Json& line : video_sidecar.value("warnings", Json::array()))
       if (line.is_string()) w.push_back("render: " + line.get<std::string>());
   body << "<h2>Warnings</h2>\n";
-  if (!w.is_array() || w.empty()) {
+  if (w.empty()) {
     body << "<p class=\"note\" id=\"no-warnings\">No stage warned.</p>\n";
     return;
   }
@@ -722,8 +722,7 @@ void structure_section(std::ostream& body, const fs::path& run_dir, const Json& 
 }
 
 // ", plays 5x real time (25 frames per second, one per 0.2 s simulated)" from the video's sidecar; "" without one.
-std::string playback_note(Page& pg) {
-  const Json side = optional_json(pg, "video/transit.json", "video sidecar");
+std::string playback_note(const Json& side) {
   const double speed = number_or_nan(side, {"playback_speed"}), fps = number_or_nan(side, {"fps"});
   if (!std::isfinite(speed) || !std::isfinite(fps)) return "";
   return fmt("; it plays %.3g", speed) + "&times; real time (" + fmt("%g", fps) + " frames per second, one per " +
@@ -731,7 +730,8 @@ std::string playback_note(Page& pg) {
 }
 
 // 3. Section "Video": embedded up to max_video_mb, else named beside the page; its size and embedding into rs.
-void video_section(std::ostream& body, const fs::path& run_dir, const ReportOptions& o, Page& pg, ReportSummary& rs) {
+void video_section(std::ostream& body, const fs::path& run_dir, const Json& sidecar, const ReportOptions& o, Page& pg,
+                   ReportSummary& rs) {
   body << "<h2>Video</h2>\n";
   const fs::path video = run_dir / "video/transit.mp4";
   if (fs::is_regular_file(video)) {
@@ -741,12 +741,12 @@ void video_section(std::ostream& body, const fs::path& run_dir, const ReportOpti
       pg.inputs.push_back({"video", video});
       body << "<video controls preload=\"auto\" src=\"data:video/mp4;base64,"
            << base64_encode(read_bytes(video)) << "\"></video>\n<p class=\"note\">video/transit.mp4, " << size
-           << ", embedded" << playback_note(pg) << ".</p>\n";
+           << ", embedded" << playback_note(sidecar) << ".</p>\n";
       rs.video_embedded = true;
     } else {
       body << "<p class=\"missing\" id=\"video-not-embedded\">The video video/transit.mp4 (" << size
            << ") is larger than max_video_mb = " << fmt("%g", o.max_video_mb)
-           << " MB and is not embedded: open it beside this page" << playback_note(pg) << ".</p>\n";
+           << " MB and is not embedded: open it beside this page" << playback_note(sidecar) << ".</p>\n";
     }
   } else {
     pg.missing.push_back("video/transit.mp4 (video)");
@@ -794,7 +794,8 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
   const fs::path case_json = case_file(run_dir).lexically_normal();
   const std::string title = report_title(o, run_name, case_json);
   case_section(body, run_name, case_json, summary, pg);
-  warnings_section(body, summary, optional_json(pg, "video/transit.json", "video sidecar"));
+  const Json video_sidecar = optional_json(pg, "video/transit.json", "video sidecar");  // read once: a provenance input
+  warnings_section(body, summary, video_sidecar);
   mean_loads_section(body, rs);
   load_plot_section(body, run_dir, pg);
   identified_section(body, run_dir, pg, rs);
@@ -802,7 +803,7 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
   hull_section(body, run_dir, summary, pg);
   structure_section(body, run_dir, summary, pg);
   fracture_section(body, summary);
-  video_section(body, run_dir, o, pg, rs);
+  video_section(body, run_dir, video_sidecar, o, pg, rs);
   settings_section(body, run_dir, summary, pg);
 
   // 4. Provenance of the page, then the page: the missing box first.

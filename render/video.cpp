@@ -91,8 +91,8 @@ RenderStats render_video(const Results& r, const RenderOptions& o, const fs::pat
   if (n < r.frames())
     warnings.push_back("the video shows the first " + std::to_string(n) + " of the run's " +
                        std::to_string(r.frames()) + " frames (render.max_frames), up to t = " +
-                       std::to_string(static_cast<long>(std::lround(r.frame_time_s[n - 1]))) + " s of " +
-                       std::to_string(static_cast<long>(std::lround(r.frame_time_s.back()))) + " s");
+                       std::to_string(std::lround(r.frame_time_s[n - 1])) + " s of " +
+                       std::to_string(std::lround(r.frame_time_s.back())) + " s");
   nlohmann::json side = {
       {"video", out_mp4.filename().string()},
       {"codec", "H.264 (avc1), MP4"},

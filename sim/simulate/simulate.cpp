@@ -64,14 +64,14 @@ void fill_run_stats(const World& w, const RecorderSums& sums, long steps, double
   stats.mean_crushing_pairs = sums.crushing / steps;
 }
 
-// What a reader of the run's loads must know of it: a mean whose interval the run is too short for, floes the run
-// left out.
-std::vector<std::string> run_warnings(const nlohmann::json& summary, const Model& model) {
+// What a reader of the run's loads must know of it, from its summary: a mean whose interval the run is too short
+// for, floes the run left out.
+std::vector<std::string> run_warnings(const nlohmann::json& summary) {
   std::vector<std::string> out;
-  const nlohmann::json& ci = summary["mean_surge_ice_load_interval"];
+  const nlohmann::json ci = summary.value("mean_surge_ice_load_interval", nlohmann::json::object());
   if (!ci.value("meaningful", true))
     out.push_back("the mean surge ice load's 95 % interval cannot be trusted: " + ci.value("note", std::string()));
-  if (const size_t n = model.removed_floe_ids.size(); n > 0)
+  if (const size_t n = summary.value("removed_floes", size_t{0}); n > 0)
     out.push_back(std::to_string(n) + (n == 1 ? " floe was" : " floes were") +
                   " left out of the run: they overlapped the vessel's initial footprint");
   return out;
@@ -220,7 +220,7 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
   // Every warning of the stages before (the floes' maker) and of this one, for the report.
   nlohmann::json warnings = nlohmann::json::array();
   for (const std::string& w : field.warnings) warnings.push_back("floes (" + floes_file.filename().string() + "): " + w);
-  for (const std::string& w : run_warnings(summary, world->model())) warnings.push_back("simulate: " + w);
+  for (const std::string& w : run_warnings(summary)) warnings.push_back("simulate: " + w);
   summary["warnings"] = warnings;
   summary["settings"] = options_to_json(o);
   summary["provenance"] = prov;
@@ -262,7 +262,7 @@ std::string run_simulate(const fs::path& floes_file, const fs::path& hull_file, 
     const ForceUnit u = force_unit_for(load_n);
     rep << "mean surge ice load " << load_text(load_n, u) << " (resistance "
         << load_text(summary["mean_surge_ice_resistance_N"].get<double>(), u) << ")";
-    const nlohmann::json& ci = summary["mean_surge_ice_load_interval"];
+    const nlohmann::json ci = summary.value("mean_surge_ice_load_interval", nlohmann::json::object());
     if (ci["half_width_N"].is_number())
       rep << " ± " << load_text(ci["half_width_N"].get<double>(), u) << " (95 %, batch means over "
           << ci["batches"].get<size_t>() << " batches of " << std::setprecision(3) << ci["batch_s"].get<double>()
