@@ -68,6 +68,11 @@ Rig make_rig(const ShearBoxSpec& p) {
   FLOESIM_REQUIRE(p.normal_stress_pa > 0, "shear box: normal_stress_pa must be > 0, got ", p.normal_stress_pa);
   FLOESIM_REQUIRE(p.speed_mps > 0 && p.travel_m > 0 && p.travel_m < 0.5 * p.box_m && p.window_s > 0,
                   "shear box: speed_mps, travel_m (< box_m / 2) and window_s must be > 0");
+  FLOESIM_REQUIRE(p.peak_within_m > 0 && p.peak_within_m <= p.travel_m, "shear box: peak_within_m (",
+                  p.peak_within_m, " m) must be > 0 and at most travel_m (", p.travel_m, " m)");
+  FLOESIM_REQUIRE(!p.bonds_pa.empty(), "shear box: bonds_pa must list at least one bond strength (0: no bonds)");
+  for (double b : p.bonds_pa)
+    FLOESIM_REQUIRE(b >= 0 && std::isfinite(b), "shear box: bonds_pa must be >= 0 (0: no bonds), got ", b);
   Rig rig;
   rig.half = 0.5 * p.box_m;
   rig.plane_z = kTopZ - 0.5 * p.sample_height_m;
@@ -75,8 +80,6 @@ Rig make_rig(const ShearBoxSpec& p) {
   o.threads = p.threads;
   o.sleep.enabled = false;
   o.fracture.enabled = false;
-  o.freeze_bonds.tensile_strength_pa = p.tensile_pa;
-  o.freeze_bonds.shear_strength_pa = p.shear_pa;
   RidgeOptions r;
   r.line = {{0, -rig.half}, {0, rig.half}};
   r.sail_height_m = 0;
@@ -313,6 +316,61 @@ class RigWorld {
   int top_ = 0, frame_ = 0, plate_ = 0, first_ = 0, end_ = 0;
 };
 
+// The consolidated sample (at rest in `consolidated`) frozen with bonds of `bonds_pa` (0: none) and sheared: the
+// bottom frame and the plate along +x, the stresses over the shear plane's area then.
+ShearTest shear(const Rig& consolidated_rig, const State& consolidated, double bonds_pa, const ShearBoxSpec& p,
+                std::ostream* progress) {
+  Rig rig = consolidated_rig;
+  rig.settings.freeze_bonds.tensile_strength_pa = bonds_pa;
+  rig.settings.freeze_bonds.shear_strength_pa = bonds_pa;
+  RigWorld t(rig, posed(rig_model(rig), consolidated), p, progress);
+  World& w = t.world();
+  const double a = p.box_m, plate_z0 = w.state().position[t.plate()].z();
+  ShearTest r;
+  r.bonds_pa = bonds_pa;
+  // Freeze bonds between the blocks that touch, at the poses the next step finds them in.
+  const State before = w.state();
+  t.step(0);
+  t.servo(t.sigma(a * a));
+  if (rig.settings.freeze_bonds.enabled()) {
+    std::vector<uint8_t> freezes(w.model().bodies.size(), 0);
+    for (size_t b = t.first_block(); b < freezes.size(); ++b) freezes[b] = 1;
+    std::vector<FreezeBond> bonds =
+        freeze_touching(w.model(), before, w.contacts(), freezes, rig.settings.freeze_bonds);
+    std::stable_sort(bonds.begin(), bonds.end(), bond_pair_less);
+    r.bonds = static_cast<int>(bonds.size());
+    w.mutable_state().bonds = std::move(bonds);
+  }
+  const double dt = t.dt();
+  const long shear_steps = std::lround(p.travel_m / p.speed_mps / dt);
+  Window tau_w(std::lround(p.window_s / dt)), sigma_w(std::lround(p.window_s / dt));
+  r.tau_peak_pa = -1e300;
+  double tau_sum = 0, sigma_sum = 0, sigma_all = 0;
+  long tail = 0;
+  for (long k = 0; k < shear_steps; ++k) {
+    t.step(p.speed_mps);
+    const double d = (k + 1) * dt * p.speed_mps, area = a * (a - d);
+    const double sigma = t.sigma(area);
+    t.servo(sigma);
+    const double tau = t.shear_force() / area;
+    r.travel_m.push_back(d);
+    r.tau_pa.push_back(tau);
+    r.sigma_pa.push_back(sigma);
+    r.plate_rise_m.push_back(w.state().position[t.plate()].z() - plate_z0);
+    const double tm = tau_w.add(tau), sm = sigma_w.add(sigma);
+    if (tau_w.full() && d <= p.peak_within_m && tm > r.tau_peak_pa)
+      r.tau_peak_pa = tm, r.sigma_at_peak_pa = sm, r.peak_at_m = d;
+    sigma_all += sigma;
+    if (4 * k >= 3 * shear_steps) tau_sum += tau, sigma_sum += sigma, ++tail;
+    t.say("shearing");
+  }
+  r.tau_residual_pa = tail > 0 ? tau_sum / static_cast<double>(tail) : 0;
+  r.sigma_residual_pa = tail > 0 ? sigma_sum / static_cast<double>(tail) : 0;
+  r.sigma_mean_pa = sigma_all / static_cast<double>(std::max(1L, shear_steps));
+  r.bonds_broken = w.state().bonds_broken;
+  return r;
+}
+
 }  // namespace
 
 ShearBoxResult shear_box_test(const ShearBoxSpec& p, std::ostream* progress) {
@@ -342,55 +400,15 @@ ShearBoxResult shear_box_test(const ShearBoxSpec& p, std::ostream* progress) {
   RigWorld t(rig, posed(rig_model(rig), pack.world().state()), p, progress);
   r.consolidated_at_rest = t.settle(true, "consolidating", kConsolidateS, false);
   r.consolidate_s = pack.world().state().time_s + t.world().state().time_s;
-  World& w = t.world();
   r.sigma_consolidated_pa = t.sigma_held();
-  const double volume = t.blocks_volume(), plate_z0 = w.state().position[t.plate()].z();
+  const double volume = t.blocks_volume();
   r.buoyancy_n = t.buoyancy_per_m3() * volume;
   r.sample_height_m = kTopZ - t.plate_top_z();
   r.plane_depth_m = kTopZ - rig.plane_z;
   r.porosity = 1 - volume / (a * a * r.sample_height_m);
   r.held_down_n = t.held_down();
   r.pushed_up_n = t.pushed_up();
-  // 4. Freeze bonds between the blocks that touch, at the poses the next step finds them in.
-  if (rig.settings.freeze_bonds.enabled()) {
-    const State before = w.state();
-    t.step(0);
-    t.servo(t.sigma(a * a));
-    std::vector<uint8_t> freezes(w.model().bodies.size(), 0);
-    for (size_t b = t.first_block(); b < freezes.size(); ++b) freezes[b] = 1;
-    std::vector<FreezeBond> bonds =
-        freeze_touching(w.model(), before, w.contacts(), freezes, rig.settings.freeze_bonds);
-    std::stable_sort(bonds.begin(), bonds.end(), bond_pair_less);
-    r.bonds = static_cast<int>(bonds.size());
-    w.mutable_state().bonds = std::move(bonds);
-  }
-  // 5. The shear: the bottom frame and the plate along +x; the stresses over the shear plane's area then.
-  const double dt = t.dt();
-  const long shear_steps = std::lround(p.travel_m / p.speed_mps / dt);
-  Window tau_w(std::lround(p.window_s / dt)), sigma_w(std::lround(p.window_s / dt));
-  r.tau_peak_pa = -1e300;
-  double tau_sum = 0, sigma_sum = 0, sigma_all = 0;
-  long tail = 0;
-  for (long k = 0; k < shear_steps; ++k) {
-    t.step(p.speed_mps);
-    const double d = (k + 1) * dt * p.speed_mps, area = a * (a - d);
-    const double sigma = t.sigma(area);
-    t.servo(sigma);
-    const double tau = t.shear_force() / area;
-    r.travel_m.push_back(d);
-    r.tau_pa.push_back(tau);
-    r.sigma_pa.push_back(sigma);
-    r.plate_rise_m.push_back(w.state().position[t.plate()].z() - plate_z0);
-    const double tm = tau_w.add(tau), sm = sigma_w.add(sigma);
-    if (tau_w.full() && tm > r.tau_peak_pa) r.tau_peak_pa = tm, r.sigma_at_peak_pa = sm, r.peak_at_m = d;
-    sigma_all += sigma;
-    if (4 * k >= 3 * shear_steps) tau_sum += tau, sigma_sum += sigma, ++tail;
-    t.say("shearing");
-  }
-  r.tau_residual_pa = tail > 0 ? tau_sum / static_cast<double>(tail) : 0;
-  r.sigma_residual_pa = tail > 0 ? sigma_sum / static_cast<double>(tail) : 0;
-  r.sigma_mean_pa = sigma_all / static_cast<double>(std::max(1L, shear_steps));
-  r.bonds_broken = w.state().bonds_broken;
+  for (double bonds_pa : p.bonds_pa) r.shears.push_back(shear(rig, t.world().state(), bonds_pa, p, progress));
   return r;
 }
 

@@ -545,28 +545,36 @@ TEST(RidgePunch, TheRubbleIsHeldAtRestAndThePlugResists) {
 
 // The shear box of sim/bench/ridge-shear-box, small: consolidated and at rest, the rubble's net buoyancy
 // (rho_w - rho_i) g V of its blocks and the loading plate's push are held by the top frame (its balance at rest);
-// sheared, the rubble resists with more than the blocks' own friction
-// (a granular assembly's friction angle is never below its grains' contact friction, atan 0.15 = 8.5 deg here).
+// sheared, the rubble resists with more than the blocks' own friction (a granular assembly's friction angle is never
+// below its grains' contact friction, atan 0.15 = 8.5 deg here); the same sample frozen resists more than unfrozen.
 TEST(ShearBox, TheSampleIsHeldAtRestAndResistsMoreThanItsBlocksFriction) {
   ShearBoxSpec p;
   p.box_m = 4.0;
   p.sample_height_m = 1.6;
   p.normal_stress_pa = 4000;
   p.travel_m = 0.2;
+  p.peak_within_m = 0.2;
   p.speed_mps = 0.05;
   p.window_s = 0.2;
+  p.bonds_pa = {0, 100000};
   const ShearBoxResult r = shear_box_test(p, nullptr);
+  ASSERT_EQ(r.shears.size(), 2u);
+  const ShearTest &loose = r.shears[0], &frozen = r.shears[1];
   std::printf("[measured] shear box of %d blocks, sample %.2f m high (porosity %.3f): the top frame holds %.1f kN "
               "against the buoyancy and the plate's push %.1f kN; normal stress %.0f Pa consolidated; peak shear "
-              "stress %.0f Pa at %.0f Pa\n",
+              "stress %.0f Pa at %.0f Pa, with %d bonds of 100 kPa %.0f Pa at %.0f Pa (%ld broken)\n",
               r.blocks, r.sample_height_m, r.porosity, r.held_down_n / 1e3, r.pushed_up_n / 1e3,
-              r.sigma_consolidated_pa, r.tau_peak_pa, r.sigma_at_peak_pa);
+              r.sigma_consolidated_pa, loose.tau_peak_pa, loose.sigma_at_peak_pa, frozen.bonds, frozen.tau_peak_pa,
+              frozen.sigma_at_peak_pa, frozen.bonds_broken);
   EXPECT_GT(r.blocks, 20);
   EXPECT_GT(r.pushed_up_n, r.buoyancy_n);  // the plate pushes
   EXPECT_NEAR(r.held_down_n, r.pushed_up_n, 0.01 * r.pushed_up_n);
   EXPECT_GT(r.porosity, 0);
   EXPECT_LT(r.porosity, 1);
-  EXPECT_GT(r.tau_peak_pa, 0.15 * r.sigma_at_peak_pa);
+  EXPECT_EQ(loose.bonds, 0);
+  EXPECT_GT(loose.tau_peak_pa, 0.15 * loose.sigma_at_peak_pa);
+  EXPECT_GT(frozen.bonds, r.blocks / 2);  // most blocks touch two others or more
+  EXPECT_GT(frozen.tau_peak_pa, loose.tau_peak_pa);
 }
 
 TEST(ShearBox, BadSpecNamesTheField) {
@@ -576,6 +584,12 @@ TEST(ShearBox, BadSpecNamesTheField) {
   ShearBoxSpec far;
   far.travel_m = 5.0;
   expect_error([&] { shear_box_test(far, nullptr); }, {"travel_m"});
+  ShearBoxSpec late;
+  late.travel_m = 0.2;  // the peak is read within 0.3 m
+  expect_error([&] { shear_box_test(late, nullptr); }, {"peak_within_m", "travel_m"});
+  ShearBoxSpec negative;
+  negative.bonds_pa = {0, -1};
+  expect_error([&] { shear_box_test(negative, nullptr); }, {"bonds_pa"});
 }
 
 TEST(RidgeSection, BadInputNamesTheKey) {
