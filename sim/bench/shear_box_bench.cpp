@@ -43,7 +43,8 @@ int main(int argc, char** argv) {
   app.add_option("--window", p.window_s, "shear stress averaging window, s")->check(CLI::Range(0.01, 10.0));
   app.add_option("--threads", p.threads, "threads")->check(CLI::Range(1, 256));
   app.add_option("--seed", p.seed, "seed of the blocks")->check(CLI::Range(0, 2147483647));
-  app.add_option("--series", series, "write each shear's bonds, travel, shear and normal stress and plate rise per step to this CSV");
+  app.add_option("--series", series,
+                 "write each shear's bonds, travel, shear and normal stress and plate rise per step to this CSV");
   CLI11_PARSE(app, argc, argv);
   if (p.bonds_pa.empty()) p.bonds_pa = {0};
   try {
