@@ -200,6 +200,13 @@ const Json* find(const Json& j, std::initializer_list<const char*> path) {
   return p;
 }
 
+// find's value if it is an object (a section a stage may write as null: a structure's hull has no ship
+// particulars), else null.
+const Json* find_object(const Json& j, std::initializer_list<const char*> path) {
+  const Json* p = find(j, path);
+  return p && p->is_object() ? p : nullptr;
+}
+
 double number_or_nan(const Json& j, std::initializer_list<const char*> path) {
   const Json* p = find(j, path);
   return p && p->is_number() ? p->get<double>() : NAN;
@@ -423,13 +430,18 @@ void case_section(std::ostream& body, const std::string& run_name, const fs::pat
   }
   const Json settings = summary.value("settings", Json::object());
   const Json hull = optional_json(pg, "hull/hull.json", "hull particulars");
-  if (const Json* pt = find(hull, {"particulars"})) {
-    std::string h = "length " + quantity(number_or_nan(*pt, {"length_m"}), "%.1f", "m") + " at the waterline, beam " +
-                    quantity(number_or_nan(*pt, {"beam_m"}), "%.1f", "m") + ", draught " +
-                    quantity(number_or_nan(*pt, {"draught_m"}), "%.1f", "m");
+  // A ship's particulars; a structure's hull has none (floesim-hull says why), only its waterline's hydrostatics.
+  const Json* pt = find_object(hull, {"particulars"});
+  const Json* hy = find_object(hull, {"hydrostatics"});
+  if (pt || hy) {
+    const double length = pt ? number_or_nan(*pt, {"length_m"}) : number_or_nan(*hy, {"length_wl_m"});
+    const double beam = pt ? number_or_nan(*pt, {"beam_m"}) : number_or_nan(*hy, {"beam_wl_m"});
+    const double draught = pt ? number_or_nan(*pt, {"draught_m"}) : number_or_nan(*hy, {"draught_m"});
+    std::string h = "length " + quantity(length, "%.1f", "m") + " at the waterline, beam " +
+                    quantity(beam, "%.1f", "m") + ", draught " + quantity(draught, "%.1f", "m");
     const double disp = number_or_nan(hull, {"hydrostatics", "displacement_t"});
     if (std::isfinite(disp)) h += ", displacement " + quantity(disp, "%.0f", "t");
-    h += "; stem angle " + quantity(number_or_nan(*pt, {"stem_angle_deg"}), "%.0f", "&deg;");
+    if (pt) h += "; stem angle " + quantity(number_or_nan(*pt, {"stem_angle_deg"}), "%.0f", "&deg;");
     rows.push_back({"Hull", h});
   }
   {
@@ -656,7 +668,7 @@ void hull_section(std::ostream& body, const fs::path& run_dir, const Json& summa
   if (fs::is_regular_file(run_dir / "hull/hull.json")) {
     const Json h = pg.json("hull/hull.json", "hull sidecar");
     // What the simulation's vessel summary already gave (the waterline beam, length, draught, ...) is shown once.
-    if (const Json* hy = find(h, {"hydrostatics"})) {
+    if (const Json* hy = find_object(h, {"hydrostatics"})) {
       Json rest = *hy;
       if (const Json* v = find(summary, {"vessel"}))
         for (auto it = v->begin(); it != v->end(); ++it) rest.erase(it.key());
@@ -664,11 +676,11 @@ void hull_section(std::ostream& body, const fs::path& run_dir, const Json& summa
       body << scalar_rows(rest, "hydrostatics.");
     }
     // A user's mesh: how it was placed and where it floats (floesim-hull's report).
-    if (const Json* pl = find(h, {"placement"})) body << scalar_rows(*pl, "placement.");
-    if (const Json* wl = find(h, {"waterline"})) body << scalar_rows(*wl, "waterline.");
+    if (const Json* pl = find_object(h, {"placement"})) body << scalar_rows(*pl, "placement.");
+    if (const Json* wl = find_object(h, {"waterline"})) body << scalar_rows(*wl, "waterline.");
     // The angles and lengths the level-ice resistance formulas take (floesim-resistance).
     // The particulars' length, beam and draught are the hydrostatics' (waterline) ones: shown once.
-    if (const Json* pa = find(h, {"particulars"})) {
+    if (const Json* pa = find_object(h, {"particulars"})) {
       Json rest = *pa;
       for (const char* k : {"length_m", "beam_m", "draught_m"}) rest.erase(k);
       body << scalar_rows(rest, "particulars.");

@@ -278,6 +278,28 @@ TEST_F(TinyRun, AStructuresFiguresHaveASectionOfTheirOwn) {
             std::string::npos);
 }
 
+// A structure's hull (a cylinder, a cone) has no ship particulars: floesim-hull writes "particulars": null and says
+// why in "particulars_error". The page then describes the hull by its waterline's hydrostatics, and says why.
+TEST_F(TinyRun, AStructuresHullWithoutShipParticularsIsDescribedByItsWaterline) {
+  ASSERT_EQ(ran_.code, 0) << ran_.text;
+  const fs::path run = copy_run("structure-hull");
+  Json hull = load_json_file(run / "hull/hull.json");
+  hull["particulars"] = nullptr;
+  hull["particulars_error"] = "no bow to measure a stem angle on";
+  std::ofstream(run / "hull/hull.json") << hull.dump(2);
+  write_report(run, ReportOptions{}, root_ / "structure-hull.html", Json::object());
+  const std::string html = read_text(root_ / "structure-hull.html");
+  const size_t a = html.find("<table id=\"what-was-run\">"), b = html.find("</table>", a);
+  ASSERT_NE(a, std::string::npos);
+  const std::string table = html.substr(a, b - a);
+  char length[80];
+  std::snprintf(length, sizeof length, "length %.1f&nbsp;m at the waterline",
+                hull["hydrostatics"]["length_wl_m"].get<double>());
+  EXPECT_NE(table.find(length), std::string::npos) << table;
+  EXPECT_EQ(table.find("stem angle"), std::string::npos) << table;
+  EXPECT_NE(html.find("no bow to measure a stem angle on"), std::string::npos);
+}
+
 TEST_F(TinyRun, MissingVideoIsSaidOnThePageAndInStdout) {
   ASSERT_EQ(ran_.code, 0) << ran_.text;
   const fs::path run = copy_run("novideo");
