@@ -439,7 +439,7 @@ void case_section(std::ostream& body, const std::string& run_name, const fs::pat
     const double draught = pt ? number_or_nan(*pt, {"draught_m"}) : number_or_nan(*hy, {"draught_m"});
     std::string h = "length " + quantity(length, "%.1f", "m") + " at the waterline, beam " +
                     quantity(beam, "%.1f", "m") + ", draught " + quantity(draught, "%.1f", "m");
-    const double disp = number_or_nan(hull, {"hydrostatics", "displacement_t"});
+    const double disp = hy ? number_or_nan(*hy, {"displacement_t"}) : NAN;
     if (std::isfinite(disp)) h += ", displacement " + quantity(disp, "%.0f", "t");
     if (pt) h += "; stem angle " + quantity(number_or_nan(*pt, {"stem_angle_deg"}), "%.0f", "&deg;");
     rows.push_back({"Hull", h});

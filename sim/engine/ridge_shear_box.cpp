@@ -328,7 +328,8 @@ ShearTest shear(const Rig& consolidated_rig, const State& consolidated, double b
   const double a = p.box_m, plate_z0 = w.state().position[t.plate()].z();
   ShearTest r;
   r.bonds_pa = bonds_pa;
-  // Freeze bonds between the blocks that touch, at the poses the next step finds them in.
+  // Freeze bonds between the blocks that touch, at the poses the next step finds them in (every shear takes that
+  // step, bonds or none, so that the shears of one sample start alike).
   const State before = w.state();
   t.step(0);
   t.servo(t.sigma(a * a));
