@@ -58,6 +58,10 @@ const std::vector<FieldSpec>& series_fields() {
        "part of ice_load from the rubble of ridges' keels and sails (simulate.ridges), body axes", 10},
       {"ice_load_ridge_layer", 6, "Fx Fy Fz Mx My Mz", "N, N m",
        "part of ice_load from ridges' consolidated layers and the pieces broken from them, body axes", 10},
+      {"ice_load_ridge_keel", 6, "Fx Fy Fz Mx My Mz", "N, N m",
+       "part of ice_load_ridge_rubble from keel blocks touching below their consolidated layer's underside (the keel "
+       "action of Dolgopolov's F_K), body axes",
+       12},
       {"station_offset", 3, "x y heading", "m, m, rad",
        "a moored or DP structure (simulate.vessel.station_keeping): its reference point's offset from its station, "
        "earth frame (x, y), and its heading's change; 0 for a ship or a fixed structure",
@@ -102,6 +106,8 @@ const std::vector<StructureField>& structure_fields() {
       {"ridge_rubble_force_n", "x y z", "N", "[3] the part of ice_force_n from ridges' rubble (keels and sails; layout /10)"},
       {"ridge_layer_force_n", "x y z", "N",
        "[3] the part of ice_force_n from ridges' consolidated layers and their pieces (layout /10)"},
+      {"ridge_keel_force_n", "x y z", "N",
+       "[3] the part of ridge_rubble_force_n from keel blocks touching below their layer's underside (layout /12)"},
       {"water_force_n", "x y z", "N", "[3] buoyancy, damping and the water's resistance (0 for a fixed structure)"},
       {"station_keeping_force_n", "x y z", "N", "[3] its mooring lines' or thrusters' force (0 for a fixed structure)"},
       {"offset", "x y heading", "m, m, rad", "[3] its reference point's offset x, y from the station, its heading's change"},
@@ -390,7 +396,7 @@ std::vector<T> read_ds(hid_t file_id, const std::string& name, size_t cols, cons
 // plot and render: /1 had no fracture (no /fracture, no lineage), /2 no solver series beyond sweeps and residual,
 // /3 no /states/in_contact, /4 no /geometry/floe_level_ice, /5 no ice_load_level_ice series, /6 every alive body
 // in every frame (which FrameReplay reads like the changed bodies of /7) and no ice_kinetic_energy series.
-constexpr int kLayoutVersion = 11;
+constexpr int kLayoutVersion = 12;
 constexpr const char* kLayoutPrefix = "floesim-results/";
 std::string layout_name(int version) { return kLayoutPrefix + std::to_string(version); }
 

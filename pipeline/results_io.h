@@ -18,8 +18,9 @@
 //   attribute "floesim" on the root: JSON text with layout version, time_step_s, duration_s,
 //   output_interval_s and the provenance.
 //
-//   Layout "floesim-results/11" (this one) added the dataset attributes unit, columns, column_units and doc (the data
-//   are those of /10). "/10" added the series ice_load_ridge_rubble and ice_load_ridge_layer (NaN when reading an
+//   Layout "floesim-results/12" (this one) added the series ice_load_ridge_keel (NaN when reading an earlier file) and
+//   the structures' field ridge_keel_force_n. "/11" added the dataset attributes unit, columns, column_units and doc
+//   (the data are those of /10). "/10" added the series ice_load_ridge_rubble and ice_load_ridge_layer (NaN when reading an
 //   earlier file) and the structures' fields ridge_rubble_force_n and ridge_layer_force_n. "/9" added
 //   /structures (none when reading an earlier file). "/8" added the
 //   fracture mode 4, crushing, and the series station_offset, station_keeping_demanded and
@@ -28,7 +29,7 @@
 //   layouts stored every alive body in every frame, which FrameReplay reads the same way. "/6" added the series
 //   ice_load_level_ice (NaN when reading an earlier file); "/5" added /geometry/floe_level_ice (all 0 when reading an
 //   earlier file); "/4" added /states/in_contact; "/3" added the solver series (relax sweeps and residual, subspace
-//   solves, capped steps, contact-law violations); "/2" added /fracture and the lineage datasets. "/1" to "/10" files
+//   solves, capped steps, contact-law violations); "/2" added /fracture and the lineage datasets. "/1" to "/11" files
 //   are still read: a series a file lacks is filled as FieldSpec::since says (input floes only, no events; solver
 //   figures NaN: not recorded), /states/in_contact as all 0 (not recorded: no floe is shown in contact) and
 //   /geometry/floe_level_ice as all 0.

@@ -413,9 +413,42 @@ std::string propulsion_text(const Json& settings) {
   return html_escape(mode);
 }
 
+// A structure's run (station keeping other than propulsion): the body is held, the ice comes to it.
+bool is_structure_run(const Json& settings) {
+  const Json* sk = find(settings, {"vessel", "station_keeping"});
+  return sk && sk->is_object() && sk->value("mode", std::string("propulsion")) != "propulsion";
+}
+
+// How a structure was held, from the simulation's settings.
+std::string station_keeping_text(const Json& settings) {
+  const Json* sk = find(settings, {"vessel", "station_keeping"});
+  const std::string mode = sk->value("mode", std::string());
+  if (mode == "fixed") return "fixed: it does not move in the earth frame";
+  if (mode == "moored") {
+    const Json* lines = find(*sk, {"lines"});
+    return "moored by " + std::to_string(lines && lines->is_array() ? lines->size() : 0) + " catenary lines";
+  }
+  if (mode == "dp") return "dynamic positioning (a PID controller holding the station)";
+  if (mode == "compliant")
+    return "compliant: its first mode at " + quantity(number_or_nan(*sk, {"compliant", "natural_frequency_hz"}), "%.2g",
+                                                      "Hz") +
+           ", damping " + quantity(100 * number_or_nan(*sk, {"compliant", "damping_ratio"}), "%.2g", "%") +
+           " of critical";
+  return html_escape(mode);
+}
+
+// The ice's drift towards a structure, from the simulation's settings.
+std::string drift_text(const Json& settings) {
+  const double v = number_or_nan(settings, {"drift", "speed_mps"});
+  if (!(v > 0)) return "none: the ice moves only as the water and the wind drive it";
+  return quantity(v, "%.2f", "m/s") + " towards " +
+         quantity(number_or_nan(settings, {"drift", "direction_deg"}), "%.0f", "&deg;") +
+         " (from +x, counter-clockwise); the run is computed in the ice's frame";
+}
+
 // 3. Section "What was run" (the first screen): the case, the hull and its main particulars, the ice, how the
-// vessel was driven and the speed it made, the simulated time and the steady part, each with a label a reader knows
-// and its unit.
+// vessel was driven and the speed it made (for a structure: how it was held and how the ice drifted), the simulated
+// time and the steady part, each with a label a reader knows and its unit.
 void case_section(std::ostream& body, const std::string& run_name, const fs::path& case_json, const Json& summary,
                   Page& pg) {
   std::vector<std::pair<std::string, std::string>> rows;
@@ -456,8 +489,11 @@ void case_section(std::ostream& body, const std::string& run_name, const fs::pat
            ", crushing strength " + quantity(number_or_nan(settings, {"ice", "crushing_strength_pa"}) / 1e6, "%.2g", "MPa");
     rows.push_back({"Ice", ice});
   }
-  rows.push_back({"Propulsion", propulsion_text(settings)});
-  {
+  if (is_structure_run(settings)) {
+    rows.push_back({"Station keeping", station_keeping_text(settings)});
+    rows.push_back({"Ice drift", drift_text(settings)});
+  } else {
+    rows.push_back({"Propulsion", propulsion_text(settings)});
     std::string v = quantity(number_or_nan(summary, {"mean_vessel_speed_mps"}), "%.2f", "m/s");
     const double hw = number_or_nan(summary, {"mean_vessel_speed_interval", "half_width_mps"});
     if (std::isfinite(hw)) v += " &plusmn; " + quantity(hw, "%.2f", "m/s") + " (95 %)";
@@ -502,7 +538,9 @@ void warnings_section(std::ostream& body, const Json& summary, const Json& video
 
 // 3. Section "Mean loads", in the unit that suits their size and the references' (N for a tank model, kN for a
 // ship), and the table of references.
-void mean_loads_section(std::ostream& body, const ReportSummary& rs) {
+void mean_loads_section(std::ostream& body, const ReportSummary& rs, bool structure) {
+  // A ship meets the ice as a resistance; ice comes to a structure as a load (both are -Fx).
+  const std::string load = structure ? "ice load on the structure (&minus;Fx" : "surge ice resistance (";
   double typical_kN = std::max(std::abs(rs.mean_kN), std::isfinite(rs.moving_average_max_kN)
                                                          ? std::abs(rs.moving_average_max_kN) : 0.0);
   for (const auto& c : rs.references) typical_kN = std::max(typical_kN, std::abs(c.reference_kN));
@@ -511,11 +549,11 @@ void mean_loads_section(std::ostream& body, const ReportSummary& rs) {
   const bool ci = std::isfinite(rs.half_width_kN);
   auto pm = [&](double hw_text_kN) { return ci ? " &plusmn; " + in_unit(hw_text_kN) : std::string(); };
   body << "<h2>Mean loads</h2>\n<table>\n<tr><th>quantity</th><th>" << unit.name << "</th></tr>\n"
-       << "<tr><th>mean surge ice resistance (steady part" << (ci ? ", &plusmn; 95 % interval" : "")
+       << "<tr><th>mean " << load << (structure ? ", " : "") << "steady part" << (ci ? ", &plusmn; 95 % interval" : "")
        << ")</th><td class=\"n\"><span id=\"mean-kN\">" << in_unit(rs.mean_kN) << "</span>"
        << pm(rs.half_width_kN)
        << "</td></tr>\n<tr><th>standard deviation of the surge ice load</th><td class=\"n\">" << in_unit(rs.std_kN)
-       << "</td></tr>\n<tr><th>largest moving average of the resistance"
+       << "</td></tr>\n<tr><th>largest moving average of the " << (structure ? "ice load" : "resistance")
        << (std::isfinite(rs.moving_average_window_s) && rs.moving_average_window_s > 0
                ? " (" + fmt("%g", rs.moving_average_window_s) + " s window)"
                : std::string())
@@ -543,12 +581,13 @@ void mean_loads_section(std::ostream& body, const ReportSummary& rs) {
 }
 
 // 3. Section "Surge ice load": the load plot and the count of fracture events from the plot's numbers.
-void load_plot_section(std::ostream& body, const fs::path& run_dir, Page& pg) {
+void load_plot_section(std::ostream& body, const fs::path& run_dir, Page& pg, bool structure) {
   body << "<h2>Surge ice load</h2>\n";
   if (pg.have("plots/surge_ice_load.png", "load plot"))
     body << "<figure>" << pg.img(run_dir / "plots/surge_ice_load.png", "plot", "surge ice load plot")
-         << "<figcaption>Surge ice resistance (&minus;Fx) against time, its moving average and the steady mean; "
-            "fracture events at the vessel along the bottom.</figcaption></figure>\n";
+         << "<figcaption>" << (structure ? "Ice load on the structure" : "Surge ice resistance")
+         << " (&minus;Fx) against time, its moving average and the steady mean; fracture events at the "
+         << (structure ? "structure" : "vessel") << " along the bottom.</figcaption></figure>\n";
   if (fs::is_regular_file(run_dir / "plots/plot.json")) {
     const Json pj = pg.json("plots/plot.json", "plot summary");
     if (const Json* fr = find(pj, {"fracture", "events"}))
@@ -808,8 +847,9 @@ ReportSummary write_report(const fs::path& run_dir, const ReportOptions& o, cons
   case_section(body, run_name, case_json, summary, pg);
   const Json video_sidecar = optional_json(pg, "video/transit.json", "video sidecar");  // read once: a provenance input
   warnings_section(body, summary, video_sidecar);
-  mean_loads_section(body, rs);
-  load_plot_section(body, run_dir, pg);
+  const bool structure = is_structure_run(summary.value("settings", Json::object()));
+  mean_loads_section(body, rs, structure);
+  load_plot_section(body, run_dir, pg, structure);
   identified_section(body, run_dir, pg, rs);
   ice_field_section(body, run_dir, pg);
   hull_section(body, run_dir, summary, pg);

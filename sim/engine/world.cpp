@@ -7,6 +7,7 @@
 
 #include "pipeline/error.h"
 #include "sim/engine/clearing.h"
+#include "sim/engine/ridge.h"
 
 namespace floesim::sim {
 
@@ -57,6 +58,10 @@ World::World(Model built) : model_(std::move(built)), pool_(model_.settings.thre
   const size_t n = model.bodies.size();
   base_bodies_ = n;
   const EngineSettings& o = model.settings;
+  for (size_t r = 0; r < o.ridges.size(); ++r)
+    layer_bottom_z_.push_back(ridge_section(o.ridges[r], o.ice.density_kg_m3, o.water.density_kg_m3,
+                                            "simulate.ridges[" + std::to_string(r) + "]")
+                                  .layer_bottom_z);
   // Floes rest only where nothing drives them faster than the sleep threshold: in still water (a current drives
   // every floe), under air still enough that the drift it gives a free floe, u_a sqrt(rho_a C_a / (rho_w C_f)) (its
   // top's air drag against its bottom's skin friction: 1.7 % of the air's speed for SAMS ice), stays below
@@ -520,6 +525,7 @@ int World::hull_ice_load(const std::vector<Contact>& contacts, int body, Wrench*
     if (level_ice && other.fixed) *level_ice += w;
     if (ridge && other.ridge_part == RidgePart::layer) ridge->layer += w;
     if (ridge && (other.ridge_part == RidgePart::keel || other.ridge_part == RidgePart::sail)) ridge->rubble += w;
+    if (ridge && other.ridge_part == RidgePart::keel && c.point.z() < layer_bottom_z_[other.ridge]) ridge->keel += w;
     if (part_force) (*part_force)[(c.body_a == body ? c.part_a : c.part_b) - first_part] += w.force;
   }
   return n;

@@ -39,9 +39,13 @@ enum Stage { kCollide, kForces, kSolve, kIntegrate, kRelax, kFracture, kSleep, k
 const char* stage_name(int stage);
 
 // The part of a hull body's ice load from ridges (world frame, about its centre of mass): from the rubble of their
-// keels and sails, and from their consolidated layers (the pieces broken from them included).
+// keels and sails, and from their consolidated layers (the pieces broken from them included). Of the rubble's, the
+// keel's: keel blocks touching the body below their layer's underside (as designed: -h_c rho_i / rho_w), the
+// unconsolidated rubble under the layer that Dolgopolov's F_K integrates (PHYSICS.md 9.3); rubble at the layer's
+// level (blocks risen into the channel the body breaks, the sail) is carried by the layer's push, not the keel's.
 struct RidgeLoad {
   Wrench rubble, layer;
+  Wrench keel;  // part of rubble
 };
 
 // The loads on a structure beside the vessel in one step (world frame, about its centre of mass) and how it is held.
@@ -194,6 +198,7 @@ class World {
   int floes_alive_ = 0;             // floe bodies alive (changes only in the fracture stage)
   std::array<double, kStageCount> stage_seconds_{};
   size_t base_bodies_ = 0;          // bodies of the model as built; pieces come after them
+  std::vector<double> layer_bottom_z_;  // per ridge (settings.ridges): its consolidated layer's underside as designed
   // solver.reference_horizon_s: the model as built with the reference's solver settings (what a branch is restored
   // on), the branch of the current window, and the window's length in steps (0: no branch).
   std::shared_ptr<const Model> branch_base_;

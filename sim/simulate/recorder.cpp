@@ -81,6 +81,7 @@ constexpr LoadSeries kLoadSeries[] = {
     {"ice_load_level_ice", [](const StepReport& r) -> const Wrench& { return r.ice_load_level_ice; }},
     {"ice_load_ridge_rubble", [](const StepReport& r) -> const Wrench& { return r.ridge_load.rubble; }},
     {"ice_load_ridge_layer", [](const StepReport& r) -> const Wrench& { return r.ridge_load.layer; }},
+    {"ice_load_ridge_keel", [](const StepReport& r) -> const Wrench& { return r.ridge_load.keel; }},
     {"hydro_load", [](const StepReport& r) -> const Wrench& { return r.hydro_load; }},
     {"wind_load", [](const StepReport& r) -> const Wrench& { return r.wind_load; }},
     {"propulsion_load", [](const StepReport& r) -> const Wrench& { return r.propulsion_load; }},
@@ -278,6 +279,7 @@ void Recorder::record_structures(const World& w) {
     put({level_ice.force.x(), level_ice.force.y(), level_ice.force.z()});
     put({ridge.rubble.force.x(), ridge.rubble.force.y(), ridge.rubble.force.z()});
     put({ridge.layer.force.x(), ridge.layer.force.y(), ridge.layer.force.z()});
+    put({ridge.keel.force.x(), ridge.keel.force.y(), ridge.keel.force.z()});
     put({water.force.x(), water.force.y(), water.force.z()});
     put({keeping.force.x(), keeping.force.y(), keeping.force.z()});
     put({sk.offset.x(), sk.offset.y(), sk.heading_change_rad});

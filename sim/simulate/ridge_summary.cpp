@@ -127,19 +127,24 @@ nlohmann::json ship_in_ridge(const Model& model, const RidgeOptions& r, const Se
 // A held hull body (a structure): the horizontal loads from the ridges' rubble and layers, their largest raw and
 // through the 1 s moving average (the keel's load is quasi-static: PHYSICS.md 9.3's F_K is a static bound).
 nlohmann::json structure_in_ridges(const SimulateOptions& o, const SeriesSource& series) {
-  const std::vector<double> rubble = series.get("ice_load_ridge_rubble"), layer = series.get("ice_load_ridge_layer");
+  const std::vector<double> rubble = series.get("ice_load_ridge_rubble"), layer = series.get("ice_load_ridge_layer"),
+                            keel = series.get("ice_load_ridge_keel");
   const size_t steps = series.steps();
-  std::vector<double> hr(steps), hl(steps);
+  std::vector<double> hr(steps), hl(steps), hk(steps);
   for (size_t k = 0; k < steps; ++k) {
     hr[k] = std::hypot(rubble[6 * k], rubble[6 * k + 1]);
     hl[k] = std::hypot(layer[6 * k], layer[6 * k + 1]);
+    hk[k] = std::hypot(keel[6 * k], keel[6 * k + 1]);
   }
   const size_t window = std::max<size_t>(1, static_cast<size_t>(std::lround(1.0 / o.time_step_s)));
   auto peak = [](const std::vector<double>& v) { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); };
-  return {{"what", "horizontal ice force on the structure from the ridges' rubble (keels, sails) and from their "
-                   "consolidated layers (with their pieces): largest raw and largest 1 s moving average"},
+  return {{"what", "horizontal ice force on the structure from the ridges' rubble (keels, sails), of it from the keels "
+                   "below their layers' undersides (Dolgopolov's F_K), and from their consolidated layers (with their "
+                   "pieces): largest raw and largest 1 s moving average"},
           {"max_rubble_N", peak(hr)},
           {"max_rubble_1s_N", peak(moving_average_full_windows(hr, window))},
+          {"max_keel_N", peak(hk)},
+          {"max_keel_1s_N", peak(moving_average_full_windows(hk, window))},
           {"max_layer_N", peak(hl)},
           {"max_layer_1s_N", peak(moving_average_full_windows(hl, window))}};
 }

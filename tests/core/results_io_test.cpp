@@ -219,7 +219,7 @@ TEST(ResultsIo, FractureEventsAndLineageRoundTrip) {
   const Results r = fractured_results();
   write_results(p, r);
   const Results b = read_results(p);
-  EXPECT_EQ(b.attributes["layout"], "floesim-results/11");
+  EXPECT_EQ(b.attributes["layout"], "floesim-results/12");
   EXPECT_EQ(b.floe_id, r.floe_id);
   EXPECT_EQ(b.floe_vertices_m, r.floe_vertices_m);
   EXPECT_EQ(b.floe_parent_id, r.floe_parent_id);
@@ -408,14 +408,14 @@ TEST(ResultsIo, LayoutOneFilesFromBeforeFractureReadWithDefaults) {
   // Rewritten, it becomes a file of the current layout with the same content.
   const fs::path q = fs::temp_directory_path() / "floesim_results_layout1_rewritten.h5";
   write_results(q, r);
-  EXPECT_EQ(read_results(q).attributes["layout"], "floesim-results/11");
+  EXPECT_EQ(read_results(q).attributes["layout"], "floesim-results/12");
   fs::remove(q);
 
   // A layout from the future is refused, naming it.
   write_results(p, small_results(2));
-  replace_attributes(p, {{"layout", "floesim-results/12"}});
+  replace_attributes(p, {{"layout", "floesim-results/13"}});
   const std::string e = error_of([&] { read_results(p); });
-  EXPECT_NE(e.find("floesim-results/11"), std::string::npos) << e;
+  EXPECT_NE(e.find("floesim-results/13"), std::string::npos) << e;
   fs::remove(p);
 }
 

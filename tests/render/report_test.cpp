@@ -300,6 +300,40 @@ TEST_F(TinyRun, AStructuresHullWithoutShipParticularsIsDescribedByItsWaterline) 
   EXPECT_NE(html.find("no bow to measure a stem angle on"), std::string::npos);
 }
 
+// A structure is held, not driven: its first screen says how it is held and how the ice drifts to it, with no
+// propulsion row or vessel speed (the vessel's propulsion settings, resolved with their defaults, do not apply to
+// it), and its loads are named ice loads, not resistance.
+TEST_F(TinyRun, AStructuresFirstScreenSaysHowItIsHeldAndHowTheIceDrifts) {
+  ASSERT_EQ(ran_.code, 0) << ran_.text;
+  const fs::path run = copy_run("structure-held");
+  Json s = load_json_file(run / "sim/summary.json");
+  ASSERT_TRUE(s["settings"]["vessel"].contains("propulsion")) << "the settings the page must not show";
+  s["settings"]["vessel"]["station_keeping"] = {
+      {"mode", "compliant"}, {"compliant", {{"natural_frequency_hz", 0.45}, {"damping_ratio", 0.02}}}};
+  s["settings"]["drift"] = {{"speed_mps", 0.5}, {"direction_deg", 180.0}};
+  std::ofstream(run / "sim/summary.json") << s.dump(2);
+  write_report(run, ReportOptions{}, root_ / "structure-held.html", Json::object());
+  const std::string html = read_text(root_ / "structure-held.html");
+  const size_t a = html.find("<table id=\"what-was-run\">"), b = html.find("</table>", a);
+  ASSERT_NE(a, std::string::npos);
+  const std::string table = html.substr(a, b - a);
+  EXPECT_EQ(table.find("Propulsion"), std::string::npos) << table;
+  EXPECT_EQ(table.find("Mean speed"), std::string::npos) << table;
+  EXPECT_NE(table.find("<th>Station keeping</th><td>compliant: its first mode at 0.45&nbsp;Hz, damping 2&nbsp;% "
+                       "of critical</td>"),
+            std::string::npos)
+      << table;
+  EXPECT_NE(table.find("<th>Ice drift</th><td>0.50&nbsp;m/s towards 180&nbsp;&deg;"), std::string::npos) << table;
+  const size_t loads = html.find("<h2>Mean loads"), next = html.find("<h2>", loads + 1);
+  const std::string load_table = html.substr(loads, next - loads);
+  EXPECT_NE(load_table.find("mean ice load on the structure (&minus;Fx, steady part"), std::string::npos)
+      << load_table;
+  EXPECT_EQ(load_table.find("resistance"), std::string::npos) << load_table;
+  // A ship's run keeps its propulsion row.
+  write_report(run_, ReportOptions{}, root_ / "ship-first.html", Json::object());
+  EXPECT_NE(read_text(root_ / "ship-first.html").find("<th>Propulsion</th>"), std::string::npos);
+}
+
 TEST_F(TinyRun, MissingVideoIsSaidOnThePageAndInStdout) {
   ASSERT_EQ(ran_.code, 0) << ran_.text;
   const fs::path run = copy_run("novideo");

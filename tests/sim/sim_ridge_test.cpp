@@ -18,6 +18,8 @@
 #include "sim/engine/ridge_build.h"
 #include "sim/engine/ridge_punch.h"
 #include "sim/engine/ridge_shear_box.h"
+#include "sim/engine/world.h"
+#include "sim/vessel/hull.h"
 #include "tests/sim/sim_fixtures.h"
 
 namespace floesim::sim {
@@ -518,6 +520,56 @@ TEST(FreezeBonds, TwoBlocksHoldBelowTheirStrengthAndBreakAboveIt) {
     EXPECT_EQ(r->bonds_after, 0u);
     EXPECT_GT(r->moved_m, 0.05);  // free: F / m t^2 / 2 = 0.3 m less the water's drag
   }
+}
+
+// A structure's load from a ridge's keel is the rubble's below its layer's underside (PHYSICS.md 9.3: F_K integrates
+// the unconsolidated rubble under the consolidated layer); a block at the layer's level is rubble, not keel. In a
+// vacuum without gravity two blocks of a ridge with a 1 m layer (underside -0.878 m) drift onto a fixed 10 m caisson:
+// one 3 m deep, one at the waterline. The contacts are the only forces, so the keel's impulse on the caisson is the
+// deep block's loss of momentum, and the rubble's the two blocks' together.
+TEST(RidgeLoad, TheKeelsPartIsTheRubbleTouchingBelowTheLayer) {
+  SimulateOptions o = testing::floe_options();
+  o.vessel.station_keeping.mode = "fixed";
+  o.water.enabled = false;
+  o.water.gravity_mps2 = 0;
+  o.fracture.enabled = false;
+  FloeField field;
+  field.floes.push_back(testing::rect_floe(1, 7, -4, 2, 2, 0.5));  // deep: at z = -3 m
+  field.floes.push_back(testing::rect_floe(2, 7, 2, 2, 2, 0.5));   // shallow: at z = -0.2 m
+  StructureShapeOptions shape;
+  shape.shape = "caisson";
+  shape.waterline_width_m = 10;
+  shape.depth_m = 6;
+  shape.height_m = 8;
+  const HullModel caisson = hull_model_from_parts(generate_structure(shape));
+  Model m = build_model(field, &caisson, o);
+  RidgeOptions ridge = small_ridge(-10, 10);
+  ridge.consolidated_thickness_m = 1.0;
+  m.settings.ridges.push_back(ridge);
+  const int deep = 1, shallow = 2;
+  for (int b : {deep, shallow}) {
+    m.bodies[b].ridge = 0;
+    m.bodies[b].ridge_part = RidgePart::keel;
+  }
+  m.bodies[deep].initial_position.z() = -3.0;
+  m.bodies[shallow].initial_position.z() = -0.2;
+  World w(m);
+  for (int b : {deep, shallow}) w.mutable_state().velocity[b] = Vec3(-1.0, 0, 0);
+  auto momentum = [&](int b) { return Vec3(w.model().bodies[b].mass_kg * w.state().velocity[b]); };
+  const Vec3 deep0 = momentum(deep), shallow0 = momentum(shallow);
+  Vec3 keel = Vec3::Zero(), rubble = Vec3::Zero();
+  for (int k = 0; k < 600; ++k) {
+    w.step();
+    keel += o.time_step_s * w.report().ridge_load.keel.force;
+    rubble += o.time_step_s * w.report().ridge_load.rubble.force;
+  }
+  const Vec3 lost_deep = deep0 - momentum(deep), lost_shallow = shallow0 - momentum(shallow);
+  std::printf("[measured] keel impulse %.1f N s (deep block's loss %.1f), rubble %.1f N s (both blocks' %.1f)\n",
+              -keel.x(), -lost_deep.x(), -rubble.x(), -(lost_deep + lost_shallow).x());
+  ASSERT_GT(lost_deep.norm(), 0.5 * deep0.norm()) << "the deep block hit the caisson";
+  ASSERT_GT(lost_shallow.norm(), 0.5 * shallow0.norm()) << "the shallow block hit the caisson";
+  EXPECT_LT((keel - lost_deep).norm(), 1e-9 * deep0.norm());
+  EXPECT_LT((rubble - lost_deep - lost_shallow).norm(), 1e-9 * deep0.norm());
 }
 
 // The punch rig of sim/bench/ridge-punch on a shallow keel: at rest, the rubble's net buoyancy (rho_w - rho_i) g V of
