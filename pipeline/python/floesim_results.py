@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Read floesim's simulation results (results.h5, layouts floesim-results/1 to /11) with h5py and numpy only.
+"""Read floesim's simulation results (results.h5, layouts floesim-results/1 to /12) with h5py and numpy only.
 
 Results(path): the series with their columns and units, every body's state at a frame (frame(k) replays the frames
 exactly as FrameReplay in pipeline/results_io.cpp), the floe outlines, a CSV of the series. Guide: README.md beside
@@ -27,7 +27,7 @@ except ImportError as e:  # run as a script by an interpreter without them: one 
           "(Debian's, for /usr/bin/python3) or pip install h5py numpy", file=sys.stderr)
     sys.exit(2)
 
-LAYOUTS = [f"floesim-results/{v}" for v in range(1, 12)]  # /11 only adds dataset attributes to /10
+LAYOUTS = [f"floesim-results/{v}" for v in range(1, 13)]  # /11 only adds dataset attributes to /10; /12 a series
 _FIX_NOT_RESULTS = "give the results.h5 that floesim-simulate wrote"
 
 
