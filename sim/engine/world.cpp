@@ -525,9 +525,8 @@ int World::hull_ice_load(const std::vector<Contact>& contacts, int body, Wrench*
     if (level_ice && other.fixed) *level_ice += w;
     if (ridge && other.ridge_part == RidgePart::layer) ridge->layer += w;
     if (ridge && (other.ridge_part == RidgePart::keel || other.ridge_part == RidgePart::sail)) ridge->rubble += w;
-    // A rig's world (punch, shear box) holds blocks of a ridge its settings do not list: no layer, no keel part.
-    if (ridge && other.ridge_part == RidgePart::keel && other.ridge >= 0 &&
-        other.ridge < static_cast<int>(layer_bottom_z_.size()) && c.point.z() < layer_bottom_z_[other.ridge])
+    // A rig's blocks (the shear box's) are rubble of no ridge (ridge -1): no layer to lie below.
+    if (ridge && other.ridge_part == RidgePart::keel && other.ridge >= 0 && c.point.z() < layer_bottom_z_[other.ridge])
       ridge->keel += w;
     if (part_force) (*part_force)[(c.body_a == body ? c.part_a : c.part_b) - first_part] += w.force;
   }

@@ -96,6 +96,12 @@ bool has_network_attribute(const std::string& html) {
   return false;
 }
 
+// The first screen's table ("What was run"), or "" if the page has none.
+std::string first_screen_table(const std::string& html) {
+  const size_t a = html.find("<table id=\"what-was-run\">");
+  return a == std::string::npos ? std::string() : html.substr(a, html.find("</table>", a) - a);
+}
+
 // One run of the tiny case shared by the tests (the tests copy it before editing).
 class TinyRun : public ::testing::Test {
  protected:
@@ -289,9 +295,8 @@ TEST_F(TinyRun, AStructuresHullWithoutShipParticularsIsDescribedByItsWaterline) 
   std::ofstream(run / "hull/hull.json") << hull.dump(2);
   write_report(run, ReportOptions{}, root_ / "structure-hull.html", Json::object());
   const std::string html = read_text(root_ / "structure-hull.html");
-  const size_t a = html.find("<table id=\"what-was-run\">"), b = html.find("</table>", a);
-  ASSERT_NE(a, std::string::npos);
-  const std::string table = html.substr(a, b - a);
+  const std::string table = first_screen_table(html);
+  ASSERT_FALSE(table.empty());
   char length[80];
   std::snprintf(length, sizeof length, "length %.1f&nbsp;m at the waterline",
                 hull["hydrostatics"]["length_wl_m"].get<double>());
@@ -314,9 +319,8 @@ TEST_F(TinyRun, AStructuresFirstScreenSaysHowItIsHeldAndHowTheIceDrifts) {
   std::ofstream(run / "sim/summary.json") << s.dump(2);
   write_report(run, ReportOptions{}, root_ / "structure-held.html", Json::object());
   const std::string html = read_text(root_ / "structure-held.html");
-  const size_t a = html.find("<table id=\"what-was-run\">"), b = html.find("</table>", a);
-  ASSERT_NE(a, std::string::npos);
-  const std::string table = html.substr(a, b - a);
+  const std::string table = first_screen_table(html);
+  ASSERT_FALSE(table.empty());
   EXPECT_EQ(table.find("Propulsion"), std::string::npos) << table;
   EXPECT_EQ(table.find("Mean speed"), std::string::npos) << table;
   EXPECT_NE(table.find("<th>Station keeping</th><td>compliant: its first mode at 0.45&nbsp;Hz, damping 2&nbsp;% "
@@ -440,10 +444,9 @@ TEST_F(TinyRun, TheFirstScreenSaysWhatWasRunInHumanLabels) {
   ASSERT_EQ(ran_.code, 0) << ran_.text;
   write_report(run_, ReportOptions{}, root_ / "first.html", Json::object());
   const std::string html = read_text(root_ / "first.html");
-  const size_t a = html.find("<table id=\"what-was-run\">"), b = html.find("</table>", a);
-  ASSERT_NE(a, std::string::npos);
-  EXPECT_LT(a, html.find("<h2>Mean loads")) << "before the answer";
-  const std::string table = html.substr(a, b - a);
+  const std::string table = first_screen_table(html);
+  ASSERT_FALSE(table.empty());
+  EXPECT_LT(html.find("<table id=\"what-was-run\">"), html.find("<h2>Mean loads")) << "before the answer";
   std::vector<std::string> labels;
   for (size_t p = table.find("<th>"); p != std::string::npos; p = table.find("<th>", p + 1))
     labels.push_back(table.substr(p + 4, table.find("</th>", p) - p - 4));
