@@ -530,6 +530,10 @@ struct CollisionWorld::Impl {
 
   // A hull body's pair with ice: the hull bodies are the model's first, so the hull is always a.
   bool is_structure_pair(const PairCandidate& pc) const { return pc.body_a < hull_count; }
+  // Between two bodies of ice (or ice and a wall): ice.mu_ice_ice, or none between two that pack (Body::frictionless).
+  double ice_ice_mu(int a, int b) const {
+    return model.bodies[a].frictionless && model.bodies[b].frictionless ? 0.0 : model.settings.ice.mu_ice_ice;
+  }
   bool is_compliant(const PairCandidate& pc) const {
     // Domain walls are boundaries, not ice or a structure under test: always rigid.
     if (model.bodies[pc.body_a].kind == BodyKind::wall || model.bodies[pc.body_b].kind == BodyKind::wall)
@@ -710,7 +714,7 @@ struct CollisionWorld::Impl {
       // Mean depth of the crushed overlap (diagnostics only: no bias), or the gap back to the crushed depth.
       c.gap = gap > 0 ? gap : -patch.volume_m3 / patch.area_m2;
       c.type = ContactType::crushing;
-      c.mu = structure ? model.settings.ice.mu_ice_structure : model.settings.ice.mu_ice_ice;
+      c.mu = structure ? model.settings.ice.mu_ice_structure : ice_ice_mu(a, b);
       c.area_m2 = pr.area_m2;
       c.area_end_m2 = pr.area_end_m2;
       c.area_step_m = patch.area_step_m;
@@ -937,7 +941,7 @@ struct CollisionWorld::Impl {
     const PartWorld& wb = world[pc.part_b];
     const double spec = model.settings.solver.speculative_m;
     const bool structure = is_structure_pair(pc);
-    const double mu = structure ? model.settings.ice.mu_ice_structure : model.settings.ice.mu_ice_ice;
+    const double mu = structure ? model.settings.ice.mu_ice_structure : ice_ice_mu(pc.body_a, pc.body_b);
     auto emit = [&](const Vec3& p, const Vec3& n, double gap) {
       Contact c;
       c.body_a = pc.body_a;

@@ -125,6 +125,9 @@ struct Body {
   RidgePart ridge_part = RidgePart::none;
   // Starts awake even where floes start asleep: rubble released out of equilibrium, not yet settled.
   bool start_awake = false;
+  // Its contacts with other such bodies slide without friction: a ridge's rubble while it packs (settle_ridges,
+  // sim/engine/ridge_build.h). Never set in a run's model.
+  bool frictionless = false;
 };
 
 // What the vessel model needs of the hull, computed from the mesh at the design waterline (z = 0).

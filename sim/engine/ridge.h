@@ -137,16 +137,22 @@ struct RidgeFieldOptions {
 // The ridges of a ridge field, in order along x.
 std::vector<RidgeOptions> ridge_field_ridges(const RidgeFieldOptions& f);
 
-// How the ridges' rubble is settled before a run (settle_ridges, sim/engine/ridge_build.h): in still water, until
-// every block has been slower than rest_speed_mps (and turning slower than rest_speed_mps per metre) for
-// rest_time_s; the ridge as built is then measured on voxels of edge voxel_m.
+// How the ridges' rubble is settled before a run (settle_ridges, sim/engine/ridge_build.h): in still water, each
+// ridge's first packed without friction until its keel is as porous as designed (its porosity; at most pack_max_s),
+// then all with friction until every block has been slower than rest_speed_mps (and turning slower than
+// rest_speed_mps per metre) for rest_time_s; the ridge as built is then measured on voxels of edge voxel_m.
 struct RidgeSettlingOptions {
+  double pack_max_s = 60;
   double max_s = 300;
   double rest_speed_mps = 0.01;
   double rest_time_s = 2.0;
   double voxel_m = 0.1;
   template <class V>
   void visit(V& v) {
+    v.field("pack_max_s", pack_max_s, "s",
+            "the longest a ridge's rubble packs without friction, as a keel packs by creep and waves, before it is "
+            "as porous as designed (0: friction from the start)",
+            non_negative());
     v.field("max_s", max_s, "s", "simulated time the rubble may take to come to rest (not at rest by then: an error)",
             positive());
     v.field("rest_speed_mps", rest_speed_mps, "m/s",

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <iomanip>
 #include <map>
+#include <memory>
 
 #include "pipeline/error.h"
 #include "sim/engine/world.h"
@@ -12,6 +13,8 @@
 namespace floesim::sim {
 
 namespace {
+
+constexpr double kPackCheckS = 1.0;  // how often packing measures each ridge's porosity
 
 // Whether world point p lies in block b at pose (x, q): inside its slab and its (convex) outline.
 bool block_holds(const Body& b, const Vec3& x, const Mat3& R, const Vec3& p) {
@@ -222,18 +225,59 @@ RidgeSettling settle_ridges(const FloeField& field, Model& model, std::ostream* 
   o.water.current_speed_mps = o.drift.speed_mps;
   o.water.current_direction_deg = o.drift.direction_deg;
   o.wind.speed_mps = 0;
-  World w(build_model(field, nullptr, o));
-  const Model& m = w.model();
+  // 2. Packing: each ridge's blocks frictionless among themselves until its keel is as porous as designed (its
+  // porosity, measured every kPackCheckS) or for pack_max_s, so that it packs as a keel packs by creep and by waves,
+  // not jammed loose where its blocks first met (the shear box's sample packs so too, sim/engine/ridge_shear_box.cpp);
+  // against the layer and the sheet they keep their friction, which holds the pile from flowing out under the ice.
+  // The world is rebuilt whenever a ridge has packed (the bodies' friction is the model's), its bodies where they
+  // are, moving as they move.
+  const auto t0 = std::chrono::steady_clock::now();
+  const double dt = o.time_step_s;
+  const long report_every = std::max(1L, std::lround(10.0 / dt));
+  const long check_every = std::max(1L, std::lround(kPackCheckS / dt));
+  std::vector<uint8_t> packing(o.ridges.size(), rs.pack_max_s > 0);
+  std::vector<double> packed_s(o.ridges.size(), 0.0);
+  auto make_world = [&](const State* from) {
+    Model next = build_model(field, nullptr, o);
+    for (size_t b = 0; b < next.bodies.size(); ++b) {
+      Body& body = next.bodies[b];
+      body.frictionless = body.ridge >= 0 && body.ridge_part != RidgePart::layer && packing[body.ridge];
+      if (from) body.initial_position = from->position[b], body.initial_orientation = from->orientation[b];
+    }
+    auto world = std::make_unique<World>(std::move(next));
+    if (from) {
+      State& st = world->mutable_state();
+      st.velocity = from->velocity;
+      st.angular_velocity = from->angular_velocity;
+      world->sync();
+    }
+    return world;
+  };
+  std::unique_ptr<World> w = make_world(nullptr);
+  while (std::find(packing.begin(), packing.end(), 1) != packing.end()) {
+    w->step();
+    ++out.steps;
+    if (out.steps % check_every != 0) continue;
+    const double t = out.steps * dt;
+    bool packed = false;
+    for (size_t r = 0; r < packing.size(); ++r) {
+      if (!packing[r]) continue;
+      const double e = measure_ridge(w->model(), w->state(), static_cast<int>(r), rs.voxel_m).porosity_by_volume;
+      if (progress && out.steps % report_every == 0)
+        *progress << "  packing the ridges' rubble (frictionless): t = " << std::fixed << std::setprecision(1) << t
+                  << " s, ridge " << r << " porosity " << std::setprecision(3) << e << std::defaultfloat << std::endl;
+      if (e <= o.ridges[r].porosity || t >= rs.pack_max_s) packing[r] = 0, packed_s[r] = t, packed = true;
+    }
+    if (packed) w = make_world(&w->state());
+  }
+  const Model& m = w->model();
   std::vector<int> rubble;
   for (size_t b = 0; b < m.bodies.size(); ++b)
     if (m.bodies[b].ridge_part == RidgePart::keel || m.bodies[b].ridge_part == RidgePart::sail)
       rubble.push_back(static_cast<int>(b));
   out.blocks = static_cast<int>(rubble.size());
-  // 2. Steps until every block has been at rest for rest_time_s.
-  const auto t0 = std::chrono::steady_clock::now();
-  const double dt = o.time_step_s;
+  // 3. Then with friction until every block has been at rest for rest_time_s.
   const long max_steps = std::lround(rs.max_s / dt), rest_steps = std::lround(rs.rest_time_s / dt);
-  const long report_every = std::max(1L, std::lround(10.0 / dt));
   long at_rest = 0;
   double fastest = 0;
   std::vector<uint8_t> touching;
@@ -241,39 +285,39 @@ RidgeSettling settle_ridges(const FloeField& field, Model& model, std::ostream* 
     FLOESIM_REQUIRE(out.steps < max_steps, "ridge_settling.max_s: the ridges' rubble is not at rest after ",
                     rs.max_s, " s of settling (the fastest block moves at ", fastest,
                     " m/s): raise ridge_settling.max_s or ridge_settling.rest_speed_mps");
-    w.step();
+    w->step();
     ++out.steps;
     // A block touching nothing that neither heaves nor turns floats at its equilibrium: out of the ridge (it came
     // out from under the ice), a floe that quadratic drag stops only slowly. Its drift is not the ridge settling.
     touching.assign(m.bodies.size(), 0);
-    for (const Contact& c : w.contacts()) touching[c.body_a] = touching[c.body_b] = 1;
+    for (const Contact& c : w->contacts()) touching[c.body_a] = touching[c.body_b] = 1;
     fastest = 0;
     for (int b : rubble) {
-      if (!w.state().alive[b]) continue;
-      const Vec3& v = w.state().velocity[b];
-      fastest = std::max({fastest, touching[b] ? v.norm() : std::abs(v.z()), w.state().angular_velocity[b].norm()});
+      if (!w->state().alive[b]) continue;
+      const Vec3& v = w->state().velocity[b];
+      fastest = std::max({fastest, touching[b] ? v.norm() : std::abs(v.z()), w->state().angular_velocity[b].norm()});
     }
     at_rest = fastest < rs.rest_speed_mps ? at_rest + 1 : 0;
     if (progress && out.steps % report_every == 0)
-      *progress << "  settling the ridges: t = " << std::fixed << std::setprecision(1) << w.state().time_s
-                << " s, fastest block " << std::setprecision(3) << fastest << " m/s, awake floes "
-                << w.report().awake_floes << std::defaultfloat << std::endl;
+      *progress << "  settling the ridges: t = " << std::fixed << std::setprecision(1)
+                << out.steps * dt << " s, fastest block " << std::setprecision(3) << fastest
+                << " m/s, awake floes " << w->report().awake_floes << std::defaultfloat << std::endl;
   }
-  // 3. Freeze bonds: the blocks woken for one more step, so that every pair that touches is found (a pair of
+  // 4. Freeze bonds: the blocks woken for one more step, so that every pair that touches is found (a pair of
   // sleepers is not looked at), and frozen at the poses that step found them in, to each other and to the layer.
   std::vector<FreezeBond> bonds;
   if (o.freeze_bonds.enabled()) {
-    for (int b : rubble) w.wake(b);
-    const State before = w.state();
-    w.step();
+    for (int b : rubble) w->wake(b);
+    const State before = w->state();
+    w->step();
     ++out.steps;
     std::vector<uint8_t> freezes(m.bodies.size(), 0);
     for (size_t b = 0; b < m.bodies.size(); ++b) freezes[b] = m.bodies[b].ridge_part != RidgePart::none;
-    bonds = freeze_touching(m, before, w.contacts(), freezes, o.freeze_bonds);
+    bonds = freeze_touching(m, before, w->contacts(), freezes, o.freeze_bonds);
   }
-  out.time_s = w.state().time_s;
+  out.time_s = out.steps * dt;
   out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  // 4. The settled poses and the bonds into the run's model, by id; they start asleep where floes may.
+  // 5. The settled poses and the bonds into the run's model, by id; they start asleep where floes may.
   std::map<int, int> index_of;
   for (size_t b = 0; b < model.bodies.size(); ++b)
     if (model.bodies[b].ridge_part == RidgePart::keel || model.bodies[b].ridge_part == RidgePart::sail)
@@ -284,8 +328,8 @@ RidgeSettling settle_ridges(const FloeField& field, Model& model, std::ostream* 
     const auto it = index_of.find(m.bodies[b].id);
     FLOESIM_REQUIRE(it != index_of.end(), "internal: block ", m.bodies[b].id, " is not in the run's model");
     Body& target = model.bodies[it->second];
-    target.initial_position = w.state().position[b];
-    target.initial_orientation = w.state().orientation[b];
+    target.initial_position = w->state().position[b];
+    target.initial_orientation = w->state().orientation[b];
     target.start_awake = false;
   }
   model.initial_bonds.clear();
@@ -304,8 +348,10 @@ RidgeSettling settle_ridges(const FloeField& field, Model& model, std::ostream* 
     model.initial_bonds.push_back(fb);
   }
   out.bonds = static_cast<int>(bonds.size());
-  for (size_t r = 0; r < o.ridges.size(); ++r)
-    out.ridges.push_back(measure_ridge(m, w.state(), static_cast<int>(r), rs.voxel_m));
+  for (size_t r = 0; r < o.ridges.size(); ++r) {
+    out.ridges.push_back(measure_ridge(m, w->state(), static_cast<int>(r), rs.voxel_m));
+    out.ridges.back().packed_s = packed_s[r];
+  }
   return out;
 }
 

@@ -36,6 +36,7 @@ struct RidgeBuilt {
   // has their ratio rho_i / (rho_w - rho_i) (PHYSICS.md §9.1).
   double ice_below_m3 = 0, ice_above_m3 = 0;
   double max_block_speed_mps = 0;      // the fastest block (at rest: settled)
+  double packed_s = 0;                 // how long its rubble packed without friction (settle_ridges)
 };
 
 // Measures ridge `ridge` (its index in settings.ridges) in `state`, over its line's first segment (a straight ridge;
@@ -61,7 +62,9 @@ struct RidgeSettling {
 
 // Settles the rubble of `model`'s ridges (settings.ridge_settling) in a world of its own: the same floes and
 // settings (and threads) without the hull bodies, with fracture off, in still water and air in the ice's frame (the
-// case's current and wind act from the run's start). It steps until every block has been at rest for rest_time_s
+// case's current and wind act from the run's start). Each ridge's blocks first pack without friction among
+// themselves until its keel is as porous as designed (RidgeOptions::porosity, measured every second) or for
+// pack_max_s; then it steps with friction until every block has been at rest for rest_time_s
 // (a block touching nothing counts by its heave and turning alone: one that came out from under the ice drifts on),
 // then gives `model`'s blocks their settled poses (matched by id) and lets them start asleep, freezes the blocks
 // that touch together and to their consolidated layer (settings.freeze_bonds: Model::initial_bonds) and measures

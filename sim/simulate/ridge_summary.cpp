@@ -28,7 +28,8 @@ nlohmann::json ridge_as_built(const RidgeBuilt& b, double ice_density, double wa
                                                                  : nlohmann::json(nullptr)},
                       {"porosity_by_volume", b.porosity_by_volume},
                       {"porosity_by_voxels", b.porosity_by_voxels},
-                      {"fastest_block_mps", b.max_block_speed_mps}};
+                      {"fastest_block_mps", b.max_block_speed_mps},
+                      {"packed_frictionless_s", b.packed_s}};
   j["hydrostatics"] = {
       {"what", "the ridge's ice (layer and blocks) under the waterline over that above it, against "
                "rho_i / (rho_w - rho_i), which a ridge floating freely at rest has (PHYSICS.md 9.1); a layer held "

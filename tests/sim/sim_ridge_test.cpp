@@ -373,6 +373,36 @@ TEST(RidgeSettling, AFreeFloatingRidgeSettlesToItsHydrostaticRatio) {
   EXPECT_GT(moved, b.blocks / 2);  // the run starts from the settled rubble, not the released
 }
 
+// Settling packs each ridge's rubble without friction until its keel is as porous as designed (PHYSICS.md 9.5:
+// released blocks settled until the macro-porosity is 0.25-0.35), then lets it rest with friction: the keel as
+// built is as porous as designed within 0.03 by both measures (block volume over the envelope, and voxels), and
+// the same keel settled with friction from the start is looser (jammed where its blocks first met).
+TEST(RidgeSettling, RubblePacksWithoutFrictionToTheDesignedPorosity) {
+  SimulateOptions o = strip_options(20, 2, 0.5, 10);
+  RidgeOptions r = settling_ridge(-2, 2);
+  r.keel_depth_m = 3.5;
+  r.keel_width_m = 12;
+  r.keel_angle_deg = 30;
+  o.ridges = {r};
+  auto settle = [&](double pack_max_s) {
+    o.ridge_settling.pack_max_s = pack_max_s;
+    Model m = build_model(FloeField{}, nullptr, o);
+    return settle_ridges(FloeField{}, m, nullptr);
+  };
+  const RidgeSettling packed = settle(60), jammed = settle(0);
+  const RidgeBuilt &p = packed.ridges.at(0), &j = jammed.ridges.at(0);
+  std::printf("[measured] %d blocks: packed without friction for %.1f s, porosity as built %.3f by volume, %.3f by "
+              "voxels (designed %.2f); settled with friction from the start %.3f, %.3f\n",
+              p.blocks, p.packed_s, p.porosity_by_volume, p.porosity_by_voxels, r.porosity, j.porosity_by_volume,
+              j.porosity_by_voxels);
+  EXPECT_GT(p.packed_s, 0.0);
+  EXPECT_LT(p.packed_s, 60.0);  // it reached the designed porosity
+  EXPECT_NEAR(p.porosity_by_volume, r.porosity, 0.03);
+  EXPECT_NEAR(p.porosity_by_voxels, r.porosity, 0.03);
+  EXPECT_EQ(j.packed_s, 0.0);
+  EXPECT_GT(j.porosity_by_volume, p.porosity_by_volume + 0.02);
+}
+
 // Ridges along a route (simulate.ridge_field): over a long route the count per km is the stated density less what
 // the rule against overlapping layers drops, the keel depths are the stated exponential (its mean above the cut-off
 // within a few standard errors), widths and sails follow the depth by §9.1's ratios, and the same seed gives the
